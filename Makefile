@@ -1,0 +1,73 @@
+# pdesolid: `make` builds build/pdesolid; `make test` builds and runs every test
+# (under AddressSanitizer and UndefinedBehaviorSanitizer); `make bench` runs the
+# benchmarks. Dependencies point one way: clients -> api -> core.
+
+CC      ?= cc
+OPT     ?= -O2 -g
+STD     := -std=c11 -D_DEFAULT_SOURCE
+WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wmissing-prototypes
+CFLAGS  += $(STD) $(OPT) $(WARN) -Icore -Iapi
+LDLIBS  := -lm
+CJSON   := $(shell pkg-config --libs libcjson 2>/dev/null || echo -lcjson)
+CJSON_CFLAGS := $(shell pkg-config --cflags libcjson 2>/dev/null)
+CMOCKA  := $(shell pkg-config --libs cmocka 2>/dev/null || echo -lcmocka)
+SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+
+CORE_SRC := $(wildcard core/*.c)
+API_SRC  := $(wildcard api/*.c)
+CLI_SRC  := $(wildcard clients/cli/*.c)
+TEST_SRC := $(filter-out tests/support.c,$(wildcard tests/test_*.c))
+BENCH_SRC := $(wildcard bench/*.c)
+
+# Normal objects in build/obj, sanitised ones in build/san.
+obj = $(patsubst %.c,build/obj/%.o,$(1))
+san = $(patsubst %.c,build/san/%.o,$(1))
+
+CORE_OBJ := $(call obj,$(CORE_SRC))
+API_OBJ  := $(call obj,$(API_SRC))
+CLI_OBJ  := $(call obj,$(CLI_SRC))
+
+TESTS := $(patsubst tests/%.c,build/san/tests/%,$(TEST_SRC))
+BENCHES := $(patsubst bench/%.c,build/bench/%,$(BENCH_SRC))
+
+.PHONY: all test bench clean deps
+all: build/pdesolid
+
+build/obj/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(CJSON_CFLAGS) -MMD -MP -c $< -o $@
+
+build/san/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(CJSON_CFLAGS) $(SAN) -MMD -MP -c $< -o $@
+
+build/libpdecore.a: $(CORE_OBJ)
+	$(AR) rcs $@ $^
+
+build/libpdeapi.a: $(API_OBJ)
+	$(AR) rcs $@ $^
+
+build/pdesolid: $(CLI_OBJ) build/libpdeapi.a build/libpdecore.a
+	$(CC) $(CFLAGS) $^ $(CJSON) $(LDLIBS) -o $@
+
+# The sanitised CLI, which the CLI tests drive alongside build/pdesolid.
+build/san/pdesolid: $(call san,$(CLI_SRC) $(API_SRC) $(CORE_SRC))
+	$(CC) $(CFLAGS) $(SAN) $^ $(CJSON) $(LDLIBS) -o $@
+
+build/san/tests/%: build/san/tests/%.o build/san/tests/support.o $(call san,$(API_SRC) $(CORE_SRC))
+	$(CC) $(CFLAGS) $(SAN) $^ $(CJSON) $(CMOCKA) $(LDLIBS) -lpthread -o $@
+
+test: build/pdesolid build/san/pdesolid $(TESTS)
+	@set -e; for t in $(TESTS); do echo "== $$t"; PDESOLID=build/pdesolid PDESOLID_SAN=build/san/pdesolid ./$$t; done
+
+build/bench/%: bench/%.c build/libpdeapi.a build/libpdecore.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -O3 $^ $(CJSON) $(LDLIBS) -o $@
+
+bench: $(BENCHES)
+	@for b in $(BENCHES); do ./$$b; done
+
+clean:
+	rm -rf build
+
+-include $(shell find build -name '*.d' 2>/dev/null)

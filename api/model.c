@@ -1,0 +1,411 @@
+/*
+ * model.c: the JSON model format (model.h) read with cJSON into a pde_model.
+ *
+ * Every object is checked against the keys it may hold, so a typo is an
+ * error that names the key, not a silently ignored field. cJSON keeps
+ * duplicate keys as separate children, which are caught the same way.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cJSON.h>
+
+#include "model.h"
+
+struct api_model {
+    pde_model m;
+    pde_bterm *b[3];
+    pde_fterm *f[3];
+};
+
+static const char *const comp_key[3] = { "x", "y", "z" };
+
+int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
+{
+    if (!err)
+        return -1;
+    snprintf(err->pointer, sizeof err->pointer, "%s", pointer);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err->message, sizeof err->message, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+static const char *type_name(const cJSON *j)
+{
+    if (cJSON_IsNumber(j)) return "a number";
+    if (cJSON_IsString(j)) return "a string";
+    if (cJSON_IsBool(j)) return "a boolean";
+    if (cJSON_IsNull(j)) return "null";
+    if (cJSON_IsArray(j)) return "an array";
+    if (cJSON_IsObject(j)) return "an object";
+    return "invalid";
+}
+
+/*
+ * Checks that obj is an object whose keys are all in keys[] (NULL-ended) and
+ * appear once; found[i] gets the child for keys[i] or NULL.
+ */
+static int check_object(const cJSON *obj, const char *ptr, const char *const *keys,
+                        const cJSON **found, api_error *err)
+{
+    if (!cJSON_IsObject(obj))
+        return api_fail(err, ptr, "must be an object, not %s", type_name(obj));
+    size_t nk = 0;
+    while (keys[nk])
+        found[nk++] = NULL;
+    for (const cJSON *c = obj->child; c; c = c->next) {
+        size_t i = 0;
+        while (i < nk && strcmp(keys[i], c->string) != 0)
+            i++;
+        if (i == nk) {
+            char allowed[160] = "";
+            for (size_t k = 0; k < nk; k++)
+                snprintf(allowed + strlen(allowed), sizeof allowed - strlen(allowed), "%s\"%s\"",
+                         k ? ", " : "", keys[k]);
+            return api_fail(err, ptr, "unknown key \"%.60s\"; the keys here are %s", c->string, allowed);
+        }
+        if (found[i])
+            return api_fail(err, ptr, "the key \"%s\" appears twice", keys[i]);
+        found[i] = c;
+    }
+    return 0;
+}
+
+static void child_ptr(char *out, size_t n, const char *ptr, const char *key)
+{
+    snprintf(out, n, "%s/%s", ptr, key);
+}
+
+/* A finite number, or 0 when absent. */
+static int get_number(const cJSON *j, const char *ptr, double *out, api_error *err)
+{
+    if (!j) {
+        *out = 0.0;
+        return 0;
+    }
+    if (!cJSON_IsNumber(j))
+        return api_fail(err, ptr, "must be a number, not %s", type_name(j));
+    if (!isfinite(j->valuedouble))
+        return api_fail(err, ptr, "must be a finite number; this one overflows a double");
+    *out = j->valuedouble;
+    return 0;
+}
+
+static int get_factor(const cJSON *j, const char *ptr, pde_factor *f, api_error *err)
+{
+    static const char *const kinds[] = { "pow", "sin", "cos", "exp", "sinh", "cosh", NULL };
+    f->kind = PDE_POW;
+    f->p = 0.0;
+    if (!j)
+        return 0;
+    const cJSON *found[6];
+    if (check_object(j, ptr, kinds, found, err))
+        return -1;
+    int which = -1;
+    for (int k = 0; k < 6; k++)
+        if (found[k]) {
+            if (which >= 0)
+                return api_fail(err, ptr, "a factor has one key, not both \"%s\" and \"%s\"",
+                                kinds[which], kinds[k]);
+            which = k;
+        }
+    if (which < 0)
+        return api_fail(err, ptr, "a factor needs one of \"pow\", \"sin\", \"cos\", \"exp\", \"sinh\", \"cosh\"");
+    char p[200];
+    child_ptr(p, sizeof p, ptr, kinds[which]);
+    if (get_number(found[which], p, &f->p, err))
+        return -1;
+    f->kind = (pde_factor_kind)which;
+    if (which == PDE_POW && (f->p != floor(f->p) || f->p < 0 || f->p > PDE_MAX_POW))
+        return api_fail(err, p, "the power must be a whole number from 0 to %d, not %.17g", PDE_MAX_POW, f->p);
+    if ((which == PDE_SIN || which == PDE_COS) && fabs(f->p) > 1e6)
+        return api_fail(err, p, "k must be at most 1e6 in size (the factor is %s(k*pi*t))", kinds[which]);
+    if (which >= PDE_EXP && fabs(f->p) > PDE_MAX_ARG)
+        return api_fail(err, p, "alpha must be at most %g in size, or %s(alpha*t) overflows a double",
+                        PDE_MAX_ARG, kinds[which]);
+    return 0;
+}
+
+static int get_vector3(const cJSON *j, const char *ptr, double out[3], api_error *err)
+{
+    if (!j)
+        return api_fail(err, ptr, "is required: an array of three numbers, one for each of x, y, z");
+    if (!cJSON_IsArray(j) || cJSON_GetArraySize(j) != 3)
+        return api_fail(err, ptr, "must be an array of three numbers, one for each of x, y, z");
+    int i = 0;
+    for (const cJSON *c = j->child; c; c = c->next, i++) {
+        char p[200];
+        snprintf(p, sizeof p, "%s/%d", ptr, i);
+        if (!c || get_number(c, p, &out[i], err))
+            return -1;
+    }
+    return 0;
+}
+
+/* An array of terms; returns its length via *n and the array itself via *items. */
+static int term_array(const cJSON *j, const char *ptr, size_t *n, api_error *err)
+{
+    if (!cJSON_IsArray(j))
+        return api_fail(err, ptr, "must be an array of terms, not %s", type_name(j));
+    size_t k = 0;
+    for (const cJSON *c = j->child; c; c = c->next)
+        if (++k > API_MAX_TERMS)
+            return api_fail(err, ptr, "has more than %d terms, the limit", API_MAX_TERMS);
+    *n = k;
+    return 0;
+}
+
+static int parse_bterms(const cJSON *j, const char *ptr, api_model *m, int ci, api_error *err)
+{
+    static const char *const keys[] = { "u", "v", "w0", "dw0", "w1", "dw1", NULL };
+    size_t n;
+    if (term_array(j, ptr, &n, err))
+        return -1;
+    m->b[ci] = calloc(n ? n : 1, sizeof *m->b[ci]);
+    if (!m->b[ci])
+        return api_fail(err, ptr, "out of memory");
+    size_t i = 0;
+    for (const cJSON *c = j->child; c; c = c->next, i++) {
+        char p[200], q[220];
+        snprintf(p, sizeof p, "%s/%zu", ptr, i);
+        const cJSON *f[6];
+        pde_bterm *t = &m->b[ci][i];
+        if (check_object(c, p, keys, f, err))
+            return -1;
+        double *num[4] = { &t->w0, &t->dw0, &t->w1, &t->dw1 };
+        for (int k = 0; k < 2; k++) {
+            child_ptr(q, sizeof q, p, keys[k]);
+            if (get_factor(f[k], q, k ? &t->v : &t->u, err))
+                return -1;
+        }
+        for (int k = 0; k < 4; k++) {
+            child_ptr(q, sizeof q, p, keys[k + 2]);
+            if (get_number(f[k + 2], q, num[k], err))
+                return -1;
+        }
+    }
+    m->m.comp[ci].bterms = m->b[ci];
+    m->m.comp[ci].nbterms = n;
+    return 0;
+}
+
+static int parse_fterms(const cJSON *j, const char *ptr, api_model *m, int ci, api_error *err)
+{
+    static const char *const keys[] = { "coef", "u", "v", "w", NULL };
+    size_t n;
+    if (term_array(j, ptr, &n, err))
+        return -1;
+    m->f[ci] = calloc(n ? n : 1, sizeof *m->f[ci]);
+    if (!m->f[ci])
+        return api_fail(err, ptr, "out of memory");
+    size_t i = 0;
+    for (const cJSON *c = j->child; c; c = c->next, i++) {
+        char p[200], q[220];
+        snprintf(p, sizeof p, "%s/%zu", ptr, i);
+        const cJSON *f[4];
+        pde_fterm *t = &m->f[ci][i];
+        if (check_object(c, p, keys, f, err))
+            return -1;
+        child_ptr(q, sizeof q, p, "coef");
+        if (get_number(f[0], q, &t->coef, err))
+            return -1;
+        pde_factor *fac[3] = { &t->u, &t->v, &t->w };
+        for (int k = 0; k < 3; k++) {
+            child_ptr(q, sizeof q, p, keys[k + 1]);
+            if (get_factor(f[k + 1], q, fac[k], err))
+                return -1;
+        }
+    }
+    m->m.comp[ci].fterms = m->f[ci];
+    m->m.comp[ci].nfterms = n;
+    return 0;
+}
+
+static int parse_model(const cJSON *root, api_model *m, api_error *err)
+{
+    static const char *const top[] = { "pde", "boundary", "force", NULL };
+    static const char *const abc[] = { "a", "b", "c", NULL };
+    static const char *const xyz[] = { "x", "y", "z", NULL };
+    const cJSON *t[3], *p[3], *comps[3];
+    if (check_object(root, "", top, t, err))
+        return -1;
+    if (!t[0])
+        return api_fail(err, "/pde", "is required: {\"a\": [..], \"b\": [..], \"c\": [..]}, the PDE's coefficients");
+    if (check_object(t[0], "/pde", abc, p, err))
+        return -1;
+    double v[3][3];
+    for (int k = 0; k < 3; k++) {
+        char q[32];
+        snprintf(q, sizeof q, "/pde/%s", abc[k]);
+        if (get_vector3(p[k], q, v[k], err))
+            return -1;
+    }
+    for (int ci = 0; ci < 3; ci++) {
+        m->m.comp[ci].a = v[0][ci];
+        m->m.comp[ci].b = v[1][ci];
+        m->m.comp[ci].c = v[2][ci];
+    }
+    for (int sect = 1; sect <= 2; sect++) {
+        if (!t[sect])
+            continue;
+        const char *name = top[sect];
+        char q[32];
+        snprintf(q, sizeof q, "/%s", name);
+        if (check_object(t[sect], q, xyz, comps, err))
+            return -1;
+        for (int ci = 0; ci < 3; ci++) {
+            if (!comps[ci])
+                continue;
+            char r[40];
+            snprintf(r, sizeof r, "/%s/%s", name, comp_key[ci]);
+            if ((sect == 1 ? parse_bterms : parse_fterms)(comps[ci], r, m, ci, err))
+                return -1;
+        }
+    }
+    return 0;
+}
+
+/* cJSON over a private NUL-terminated copy: 1.7.15 may read past a buffer without one. */
+static cJSON *parse_json(const char *text, size_t len, api_error *err)
+{
+    char *copy = malloc(len + 1);
+    if (!copy) {
+        api_fail(err, "", "out of memory");
+        return NULL;
+    }
+    memcpy(copy, text, len);
+    copy[len] = '\0';
+    const char *end = NULL;
+    cJSON *root = cJSON_ParseWithLengthOpts(copy, len + 1, &end, 0);
+    if (!root) {
+        size_t at = end && end >= copy && end <= copy + len ? (size_t)(end - copy) : 0;
+        size_t line = 1, col = 1;
+        for (size_t i = 0; i < at; i++, col++)
+            if (copy[i] == '\n')
+                line++, col = 0;
+        if (len == 0 || strspn(copy, " \t\r\n") == len)
+            api_fail(err, "", "the document is empty; it must be a JSON object");
+        else
+            api_fail(err, "", "not valid JSON: syntax error at line %zu, column %zu (byte %zu)%s", line,
+                     col, at, at >= len ? ", the end of the text, or nesting deeper than 1000" : "");
+    } else {
+        /* Anything but white space after the value is an error too. */
+        const char *rest = end ? end : copy + len;
+        while (rest < copy + len && strchr(" \t\r\n", *rest))
+            rest++;
+        if (rest < copy + len) {
+            api_fail(err, "", "not valid JSON: text after the end of the value, at byte %zu",
+                     (size_t)(rest - copy));
+            cJSON_Delete(root);
+            root = NULL;
+        }
+    }
+    free(copy);
+    return root;
+}
+
+api_model *api_model_parse(const char *text, size_t len, api_error *err)
+{
+    cJSON *root = parse_json(text, len, err);
+    if (!root)
+        return NULL;
+    api_model *m = calloc(1, sizeof *m);
+    if (!m) {
+        api_fail(err, "", "out of memory");
+    } else if (parse_model(root, m, err)) {
+        api_model_free(m);
+        m = NULL;
+    }
+    cJSON_Delete(root);
+    return m;
+}
+
+void api_model_free(api_model *m)
+{
+    if (!m)
+        return;
+    for (int i = 0; i < 3; i++) {
+        free(m->b[i]);
+        free(m->f[i]);
+    }
+    free(m);
+}
+
+const pde_model *api_model_get(const api_model *m)
+{
+    return &m->m;
+}
+
+int api_solve(const api_model *m, pde_solution **out, api_error *err)
+{
+    pde_diag d;
+    pde_status st = pde_solve(&m->m, out, &d);
+    if (st == PDE_OK)
+        return 0;
+    char ptr[160] = "";
+    if (d.component >= 0 && d.term < 0 && d.field[0])
+        snprintf(ptr, sizeof ptr, "/pde/%s/%d", d.field, d.component);
+    else if (d.component >= 0 && d.term >= 0)
+        snprintf(ptr, sizeof ptr, "/%s/%s/%ld%s%s", d.in_force ? "force" : "boundary",
+                 comp_key[d.component], d.term, d.field[0] ? "/" : "", d.field);
+    else if (d.component >= 0)
+        snprintf(ptr, sizeof ptr, "/pde");
+    api_fail(err, ptr, "%s", d.message[0] ? d.message : pde_strerror(st));
+    return (int)st;
+}
+
+int api_points_parse(const char *text, size_t len, double **out, size_t *n, api_error *err)
+{
+    cJSON *root = parse_json(text, len, err);
+    if (!root)
+        return -1;
+    int rc = 0;
+    double *pts = NULL;
+    size_t k = 0;
+    if (!cJSON_IsArray(root)) {
+        rc = api_fail(err, "", "must be an array of [u, v, w] points, not %s", type_name(root));
+        goto done;
+    }
+    for (const cJSON *c = root->child; c; c = c->next)
+        if (++k > API_MAX_POINTS) {
+            rc = api_fail(err, "", "has more than %d points, the limit", API_MAX_POINTS);
+            goto done;
+        }
+    pts = malloc((k ? k : 1) * 3 * sizeof *pts);
+    if (!pts) {
+        rc = api_fail(err, "", "out of memory");
+        goto done;
+    }
+    size_t i = 0;
+    for (const cJSON *c = root->child; c; c = c->next, i++) {
+        char p[40];
+        snprintf(p, sizeof p, "/%zu", i);
+        if (!cJSON_IsArray(c) || cJSON_GetArraySize(c) != 3) {
+            rc = api_fail(err, p, "must be a point [u, v, w] of three numbers");
+            goto done;
+        }
+        int q = 0;
+        for (const cJSON *x = c->child; x; x = x->next, q++) {
+            char pq[64];
+            snprintf(pq, sizeof pq, "%.40s/%d", p, q);
+            if (get_number(x, pq, &pts[3 * i + q], err)) {
+                rc = -1;
+                goto done;
+            }
+        }
+    }
+done:
+    cJSON_Delete(root);
+    if (rc) {
+        free(pts);
+        return rc;
+    }
+    *out = pts;
+    *n = k;
+    return 0;
+}

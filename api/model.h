@@ -1,0 +1,63 @@
+/*
+ * model.h: JSON model documents to pde_model, with errors that point at the
+ * offending field.
+ *
+ * USAGE
+ *
+ *   api_error err;
+ *   api_model *m = api_model_parse(text, len, &err);
+ *   if (!m) { fprintf(stderr, "%s: %s\n", err.pointer, err.message); ... }
+ *   pde_solution *sol;
+ *   if (api_solve(m, &sol, &err) != 0) ...      // core errors become pointers too
+ *   api_model_free(m);
+ *
+ * The format (docs/API.md):
+ *   {"pde": {"a": [ax, ay, az], "b": [..], "c": [..]},
+ *    "boundary": {"x": [{"u": F, "v": F, "w0": n, "dw0": n, "w1": n, "dw1": n}, ..], "y": .., "z": ..},
+ *    "force":    {"x": [{"coef": n, "u": F, "v": F, "w": F}, ..], ..}}
+ * where a factor F is one of {"pow": n}, {"sin": k}, {"cos": k}, {"exp": a},
+ * {"sinh": a}, {"cosh": a}. An omitted factor is 1, an omitted number 0,
+ * "boundary", "force" and each component in them are optional; "pde" and its
+ * three arrays are required. Unknown and duplicate keys are errors.
+ *
+ * Parsing uses cJSON, which records its last error in a global: callers that
+ * parse on several threads must serialise api_model_parse() and
+ * api_points_parse(). Everything else here is reentrant.
+ */
+#ifndef API_MODEL_H
+#define API_MODEL_H
+
+#include <stddef.h>
+
+#include "pde.h"
+
+/* A JSON pointer (RFC 6901) to the field at fault, "" for the whole document, and a sentence. */
+typedef struct {
+    char pointer[160];
+    char message[320];
+} api_error;
+
+#define API_MAX_TERMS 4096    /* terms in one component's boundary or force list */
+#define API_MAX_POINTS 1000000
+
+typedef struct api_model api_model;
+
+/* Parses len bytes (no NUL needed). Returns NULL and fills err on failure. */
+api_model *api_model_parse(const char *text, size_t len, api_error *err);
+void api_model_free(api_model *m);
+const pde_model *api_model_get(const api_model *m);
+
+/* pde_solve() with the core's diagnosis turned into a JSON pointer. Returns 0 or the pde_status. */
+int api_solve(const api_model *m, pde_solution **out, api_error *err);
+
+/*
+ * Parses [[u, v, w], ...] into a new array of 3 n doubles, stored in *out
+ * (free() it). Returns 0, or -1 with err filled.
+ */
+int api_points_parse(const char *text, size_t len, double **out, size_t *n, api_error *err);
+
+/* Sets err from a printf format; returns -1, for one-line error returns. */
+int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+#endif

@@ -1,0 +1,171 @@
+/*
+ * factor.c: the one-variable factors f(t) of boundary and force terms, and
+ * the exponential-polynomial w-terms of a solution: values and derivatives of
+ * any order.
+ */
+#include <complex.h>
+#include <math.h>
+
+#include "internal.h"
+
+/* n (n-1) ... (n-k+1) */
+static double falling(double n, int k)
+{
+    double r = 1.0;
+    for (int i = 0; i < k; i++)
+        r *= n - i;
+    return r;
+}
+
+static double ipow(double t, int n)
+{
+    double r = 1.0;
+    for (; n > 0; n >>= 1, t *= t)
+        if (n & 1)
+            r *= t;
+    return r;
+}
+
+double factor_lambda(pde_factor f)
+{
+    double w;
+    switch (f.kind) {
+    case PDE_SIN:
+    case PDE_COS:
+        w = f.p * M_PI;
+        break;
+    case PDE_EXP:
+    case PDE_SINH:
+    case PDE_COSH:
+        w = f.p;
+        break;
+    default:
+        return 0.0;
+    }
+    return (w * w) * (w * w);
+}
+
+double factor_deriv(pde_factor f, double t, int n)
+{
+    double w;
+    switch (f.kind) {
+    case PDE_POW: {
+        int p = (int)f.p;
+        if (n > p)
+            return 0.0;
+        return falling(p, n) * ipow(t, p - n);
+    }
+    case PDE_SIN:
+    case PDE_COS: {
+        w = f.p * M_PI;
+        double s = sin(w * t), c = cos(w * t);
+        /* Each derivative turns sin -> cos -> -sin -> -cos; cos starts one step on. */
+        int phase = (n + (f.kind == PDE_COS)) & 3;
+        double v = phase == 0 ? s : phase == 1 ? c : phase == 2 ? -s : -c;
+        return ipow(w, n) * v;
+    }
+    case PDE_EXP:
+        return ipow(f.p, n) * exp(f.p * t);
+    case PDE_SINH:
+    case PDE_COSH: {
+        int odd = (n & 1) ^ (f.kind == PDE_COSH);
+        return ipow(f.p, n) * (odd ? sinh(f.p * t) : cosh(f.p * t));
+    }
+    }
+    return 0.0;
+}
+
+void factor_eval(pde_factor f, double t, double *val, double *der)
+{
+    double w;
+    switch (f.kind) {
+    case PDE_POW: {
+        int p = (int)f.p;
+        double tp = p > 0 ? ipow(t, p - 1) : 0.0;
+        *val = p > 0 ? tp * t : 1.0;
+        *der = p * tp;
+        return;
+    }
+    case PDE_SIN:
+        w = f.p * M_PI;
+        *val = sin(w * t);
+        *der = w * cos(w * t);
+        return;
+    case PDE_COS:
+        w = f.p * M_PI;
+        *val = cos(w * t);
+        *der = -w * sin(w * t);
+        return;
+    case PDE_EXP:
+        *val = exp(f.p * t);
+        *der = f.p * *val;
+        return;
+    case PDE_SINH:
+        *val = sinh(f.p * t);
+        *der = f.p * cosh(f.p * t);
+        return;
+    case PDE_COSH:
+        *val = cosh(f.p * t);
+        *der = f.p * sinh(f.p * t);
+        return;
+    }
+    *val = *der = 0.0;
+}
+
+/* P(w) and P'(w) by Horner. */
+static void horner2(const double *c, int deg, double w, double *p, double *dp)
+{
+    double v = c[deg], d = 0.0;
+    for (int k = deg - 1; k >= 0; k--) {
+        d = d * w + v;
+        v = v * w + c[k];
+    }
+    *p = v;
+    *dp = d;
+}
+
+void mode_h(const pde_mode *m, double w, double *h, double *dh)
+{
+    double hv = 0.0, hd = 0.0;
+    for (size_t k = 0; k < m->nterms; k++) {
+        const pde_wterm *t = &m->terms[k];
+        double a, da;
+        horner2(t->A, t->deg, w, &a, &da);
+        double E = t->alpha != 0.0 ? exp(t->alpha * (w - t->shift)) : 1.0;
+        if (t->beta == 0.0) {
+            hv += E * a;
+            hd += E * (t->alpha * a + da);
+        } else {
+            double b, db;
+            horner2(t->B, t->deg, w, &b, &db);
+            double c = cos(t->beta * w), s = sin(t->beta * w);
+            double v = a * c + b * s;
+            hv += E * v;
+            hd += E * (t->alpha * v + da * c + db * s + t->beta * (b * c - a * s));
+        }
+    }
+    *h = hv;
+    *dh = hd;
+}
+
+/*
+ * The term is Re[(A - iB)(w) exp(alpha (w - shift)) exp(i beta w)], and
+ * d^n/dw^n [P(w) e^{zw}] = e^{zw} sum_j C(n,j) z^(n-j) P^(j)(w), z = alpha + i beta.
+ */
+double wterm_deriv(const pde_wterm *t, double w, int n)
+{
+    double complex z = t->alpha + I * t->beta;
+    double complex sum = 0.0, zp = 1.0;
+    double binom = 1.0;
+    for (int j = n; j >= 0; j--) {
+        /* P^(j)(w): Horner over the j-th derivative's coefficients. */
+        double complex pj = 0.0;
+        for (int k = t->deg; k >= j; k--)
+            pj = pj * w + falling(k, j) * (t->A[k] - I * t->B[k]);
+        sum += binom * zp * pj;
+        zp *= z;
+        binom = binom * j / (n - j + 1);
+    }
+    double E = exp(t->alpha * (w - t->shift));
+    return E * creal(sum * cexp(I * t->beta * w));
+}

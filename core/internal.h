@@ -1,0 +1,77 @@
+/*
+ * internal.h: what the modules of core/ share and nothing outside sees.
+ *
+ * A solution lives in one arena: a chain of blocks freed together, so that a
+ * solve that fails halfway frees everything by freeing the arena, and the
+ * cache can count the bytes of a solution in one number.
+ */
+#ifndef PDE_INTERNAL_H
+#define PDE_INTERNAL_H
+
+#include <complex.h>
+#include <stddef.h>
+
+#include "pde.h"
+
+typedef struct arena_block arena_block;
+
+typedef struct {
+    arena_block *head;
+    size_t bytes;
+} arena;
+
+/* Zeroed memory, aligned for any type; NULL when out of memory. */
+void *arena_alloc(arena *a, size_t size);
+void arena_free(arena *a);
+
+/* One component's part of a solution. */
+typedef struct {
+    double a, b, c;
+    size_t nmodes;
+    pde_mode *modes;
+    size_t nbterms, nfterms;    /* the model's terms, kept for residuals and the force */
+    pde_bterm *bterms;
+    pde_fterm *fterms;
+} comp_solution;
+
+struct pde_solution {
+    arena mem;                  /* owns everything below, and the solution itself */
+    comp_solution comp[3];
+};
+
+/* f^(n)(t) of one factor, for any order n >= 0. */
+double factor_deriv(pde_factor f, double t, int n);
+
+/* f(t) and f'(t) together, the common case. */
+void factor_eval(pde_factor f, double t, double *val, double *der);
+
+/* The d4 eigenvalue: f'''' = lambda f, 0 for t^n (which chains instead). */
+double factor_lambda(pde_factor f);
+
+/* d^n/dw^n of one w-term at w. */
+double wterm_deriv(const pde_wterm *t, double w, int n);
+
+/* h(w) and h'(w) of a mode. */
+void mode_h(const pde_mode *m, double w, double *h, double *dh);
+
+/* A sampling grid (pde.h). The rows hold, for row j of the current plane, x
+ * then xu, xv, xw, each as three runs of nu doubles (x, y, z components). */
+struct pde_grid {
+    const pde_solution *sol;
+    size_t nu, nv;
+    size_t nm[3];
+    double *phi[3], *dphi[3];   /* nm x nu: f_u and f_u' of each mode at each u */
+    double *psi[3], *dpsi[3];   /* nm x nv */
+    double *h[3], *dh[3];       /* nm: h and h' at the current plane */
+    double *row;                /* 12 nu */
+    double *coef;               /* 3 maxm: a row's coefficient of each mode */
+    size_t maxm;
+};
+
+enum { GRID_X = 1, GRID_XU = 2, GRID_XV = 4, GRID_XW = 8 };
+
+/* Moves the grid to the plane w; then grid_row() fills the rows wanted for row j. */
+void grid_set_w(pde_grid *g, double w);
+void grid_row(pde_grid *g, size_t j, unsigned want);
+
+#endif

@@ -1,0 +1,202 @@
+/*
+ * pde.h: the closed-form solver for the fourth-order PDE solid.
+ *
+ * For each component i of x = (x, y, z), on (u, v, w) in [0,1]^3,
+ *
+ *     a_i x_uuuu + b_i x_vvvv + c_i x_wwww = p_i(u, v, w)            (paper eq. 1)
+ *
+ * with x and x_w given on w = 0 and w = 1 (eq. 2). Boundary data are sums of
+ * separable terms f(u) f(v) (eq. 3), forces are sums of coef f(u) f(v) f(w).
+ *
+ * USAGE
+ *
+ *   pde_model m = {0};                      // fill m.comp[0..2]
+ *   pde_solution *sol;
+ *   pde_diag diag;
+ *   if (pde_solve(&m, &sol, &diag) != PDE_OK) { puts(diag.message); ... }
+ *   double x[3];
+ *   pde_eval(sol, u, v, w, x);
+ *   pde_solution_free(sol);
+ *
+ * Plan, then execute (as FFTW does): pde_solve() does all the work once and
+ * builds an immutable solution. Every other call takes the solution const and
+ * may run on any number of threads at once. A pde_grid holds scratch memory
+ * and belongs to one thread at a time; make one per thread.
+ *
+ * OWNERSHIP
+ *
+ * pde_solve() copies what it needs from the model; the model may be freed
+ * afterwards. The solution is freed with pde_solution_free(), a grid with
+ * pde_grid_free(); both accept NULL. Pointers returned by pde_solution_modes()
+ * live as long as the solution.
+ *
+ * ERRORS
+ *
+ * Every fallible call returns a pde_status; results come back through
+ * out-parameters, which are left untouched on error. No call aborts or writes
+ * global state. pde_solve() also fills a pde_diag naming the component, the
+ * term and the field at fault.
+ */
+#ifndef PDE_H
+#define PDE_H
+
+#include <stddef.h>
+
+typedef enum {
+    PDE_OK = 0,        /* success */
+    PDE_ERR_NOMEM,     /* an allocation failed */
+    PDE_ERR_INVALID,   /* a number is not finite, or a factor is malformed */
+    PDE_ERR_ILLPOSED,  /* the equation is not fourth order in w (c_i = 0) */
+    PDE_ERR_SINGULAR,  /* the boundary problem has no unique solution */
+    PDE_ERR_RANGE,     /* a value of the model or solution overflows a double */
+    PDE_ERR_LIMIT      /* the model exceeds a size limit below */
+} pde_status;
+
+/* A sentence describing the status; never NULL. */
+const char *pde_strerror(pde_status status);
+
+/* Limits that keep one solve bounded in time and memory. */
+#define PDE_MAX_POW   100    /* largest n of a t^n factor */
+#define PDE_MAX_ARG   700.0  /* largest |alpha| of exp, sinh, cosh: e^700 < DBL_MAX */
+#define PDE_MAX_MODES 4096   /* separated (u, v) modes per component */
+
+/* A one-variable factor f(t). A zeroed factor is {PDE_POW, 0}, the constant 1. */
+typedef enum {
+    PDE_POW = 0,  /* t^n, n an integer in [0, PDE_MAX_POW] */
+    PDE_SIN,      /* sin(k pi t) */
+    PDE_COS,      /* cos(k pi t) */
+    PDE_EXP,      /* exp(alpha t) */
+    PDE_SINH,     /* sinh(alpha t) */
+    PDE_COSH      /* cosh(alpha t) */
+} pde_factor_kind;
+
+typedef struct {
+    pde_factor_kind kind;
+    double p;     /* n, k or alpha */
+} pde_factor;
+
+/* A boundary term: f(u) f(v) times w0 at w = 0, dw0 as x_w at w = 0, and so on. */
+typedef struct {
+    pde_factor u, v;
+    double w0, dw0, w1, dw1;
+} pde_bterm;
+
+/* A force term: coef f(u) f(v) f(w). */
+typedef struct {
+    double coef;
+    pde_factor u, v, w;
+} pde_fterm;
+
+typedef struct {
+    double a, b, c;
+    const pde_bterm *bterms;
+    size_t nbterms;
+    const pde_fterm *fterms;
+    size_t nfterms;
+} pde_component;
+
+typedef struct {
+    pde_component comp[3];   /* x, y, z */
+} pde_model;
+
+/* Where and why pde_solve() failed. term is -1 when no term is at fault. */
+typedef struct {
+    int component;        /* 0, 1, 2, or -1 */
+    int in_force;         /* 1: term indexes fterms; 0: bterms */
+    long term;            /* index of the term, or -1 */
+    char field[8];        /* "a", "b", "c", "u", "v", "w", "coef", "w0", ... or "" */
+    char message[240];    /* a sentence for a person */
+} pde_diag;
+
+typedef struct pde_solution pde_solution;
+
+/*
+ * Solves the model. On success stores a new solution in *out. On failure
+ * returns the status, leaves *out unchanged and, if diag is not NULL,
+ * describes the failure there. Terms with equal factors add up; a term
+ * whose factor is identically zero (sin 0, sinh 0) contributes nothing.
+ */
+pde_status pde_solve(const pde_model *model, pde_solution **out, pde_diag *diag);
+
+void pde_solution_free(pde_solution *sol);
+
+/* Bytes held by the solution, for a cache's accounting. Cannot fail. */
+size_t pde_solution_bytes(const pde_solution *sol);
+
+/*
+ * The closed form, read-only. Component i of x is the sum over its modes of
+ * h(w) f_u(u) f_v(v), and h(w) is the sum of its terms
+ *
+ *     exp(alpha (w - shift)) (A(w) cos(beta w) + B(w) sin(beta w))
+ *
+ * with polynomials A, B of degree deg (coefficients of w^0 first) and shift
+ * 1 for growing exponentials, so that no term exceeds its coefficients.
+ */
+typedef struct {
+    double alpha, beta, shift;
+    int deg;
+    const double *A, *B;
+} pde_wterm;
+
+typedef struct {
+    pde_factor u, v;        /* normalised: k, alpha >= 0 except for exp */
+    double e;               /* h'''' = e h + force: e = -(a lu + b lv) / c (eq. 8) */
+    size_t nterms;
+    const pde_wterm *terms;
+} pde_mode;
+
+const pde_mode *pde_solution_modes(const pde_solution *sol, int comp, size_t *nmodes);
+
+/* x(u, v, w). Cannot fail; any point is accepted, [0,1]^3 is the solid. */
+void pde_eval(const pde_solution *sol, double u, double v, double w, double x[3]);
+
+/* x and its first partial derivatives; any of the outputs may be NULL. */
+void pde_eval_d(const pde_solution *sol, double u, double v, double w,
+                double x[3], double xu[3], double xv[3], double xw[3]);
+
+/* d^(nu+nv+nw) x_comp / du^nu dv^nv dw^nw, for any orders (residuals, tests). */
+double pde_eval_partial(const pde_solution *sol, int comp, double u, double v, double w,
+                        int nu, int nv, int nw);
+
+/* p_comp(u, v, w), the force of the model. */
+double pde_force(const pde_solution *sol, int comp, double u, double v, double w);
+
+/*
+ * Tensor-product sampling. A grid fixes the u and v samples; each call to
+ * pde_grid_plane() then fills one plane w = const, u fastest, as interleaved
+ * float32 x, y, z (3 nu nv floats). Each h(w) is evaluated once per plane and
+ * each f(u), f(v) once per grid, so a point costs one multiply-add per mode.
+ * Faces u = 0 or 1 are grids with nu = 1, and so on.
+ */
+typedef struct pde_grid pde_grid;
+
+pde_status pde_grid_create(const pde_solution *sol, const double *us, size_t nu,
+                           const double *vs, size_t nv, pde_grid **out);
+void pde_grid_free(pde_grid *grid);
+void pde_grid_plane(pde_grid *grid, double w, float *xyz);
+/* The same plane with dx/du, dx/dv, dx/dw (each 3 nu nv floats; may be NULL). */
+void pde_grid_plane_d(pde_grid *grid, double w, float *xyz, float *xu, float *xv, float *xw);
+
+/* Samples i/(n-1) on each axis (0.5 when n = 1) into out, 3 nu nv nw floats. */
+pde_status pde_sample(const pde_solution *sol, size_t nu, size_t nv, size_t nw, float *out);
+
+/* Properties of the solid, computed from the closed form. */
+typedef struct {
+    double bbox_min[3], bbox_max[3];
+    double volume;           /* integral of |det J| over the unit cube */
+    double signed_volume;    /* integral of det J */
+    double detj_min, detj_max;
+    double detj_min_at[3];   /* (u, v, w) of the minimum */
+    int folds;               /* det J takes both signs: the solid overlaps itself */
+    double bc_residual;      /* largest boundary-condition error, relative */
+    double pde_residual;     /* largest PDE residual at sample points, relative */
+} pde_props;
+
+/* A zeroed options struct gives the defaults. */
+typedef struct {
+    int res;   /* samples per axis for bounds, det J and residuals; 0: 17 */
+} pde_props_opts;
+
+pde_status pde_properties(const pde_solution *sol, const pde_props_opts *opts, pde_props *out);
+
+#endif

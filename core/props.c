@@ -1,0 +1,283 @@
+/*
+ * props.c: properties of a solved solid, from its closed form.
+ *
+ * Bounds and the extremes of det J are sampled on a uniform grid and on the
+ * quadrature nodes, then polished by a compass search from the best sample.
+ * The volume is composite Gauss-Legendre quadrature of |det J|, with panels
+ * sized to the fastest oscillation along each axis. The accuracy certificate
+ * measures what the solve promises: the boundary conditions against the
+ * model's own boundary terms, and the PDE with analytic fourth derivatives.
+ */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+
+#include "internal.h"
+
+#define GL_N 8
+static const double gl_x[GL_N] = { -0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
+                                   -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
+                                   0.7966664774136267,  0.9602898564975363 };
+static const double gl_w[GL_N] = { 0.1012285362903763, 0.2223810344533745, 0.3137066458778873,
+                                   0.3626837833783620, 0.3626837833783620, 0.3137066458778873,
+                                   0.2223810344533745, 0.1012285362903763 };
+#define MAX_PANELS 64
+
+static double det3(const double a[3], const double b[3], const double c[3])
+{
+    return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
+}
+
+static double factor_freq(pde_factor f)
+{
+    switch (f.kind) {
+    case PDE_POW: return f.p;
+    case PDE_SIN:
+    case PDE_COS: return fabs(f.p) * M_PI;
+    default: return fabs(f.p);
+    }
+}
+
+/* Panels for each axis: one per 3 radians of the fastest factor (det J multiplies three). */
+static void panel_counts(const pde_solution *s, int np[3])
+{
+    double f[3] = { 0, 0, 0 };
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
+            const pde_mode *md = &s->comp[c].modes[m];
+            f[0] = fmax(f[0], factor_freq(md->u));
+            f[1] = fmax(f[1], factor_freq(md->v));
+            for (size_t k = 0; k < md->nterms; k++) {
+                const pde_wterm *t = &md->terms[k];
+                f[2] = fmax(f[2], fmax(fmax(fabs(t->alpha), t->beta), (double)t->deg));
+            }
+        }
+    for (int a = 0; a < 3; a++) {
+        double n = 1.0 + f[a] / 3.0;
+        np[a] = n > MAX_PANELS ? MAX_PANELS : (int)n;
+    }
+}
+
+static double detj_at(const pde_solution *s, const double p[3])
+{
+    double xu[3], xv[3], xw[3];
+    pde_eval_d(s, p[0], p[1], p[2], NULL, xu, xv, xw);
+    return det3(xu, xv, xw);
+}
+
+/* sign * (what) at p: what 0..2 a coordinate, 3 det J. */
+static double objective(const pde_solution *s, int what, double sign, const double p[3])
+{
+    if (what == 3)
+        return sign * detj_at(s, p);
+    double x[3];
+    pde_eval(s, p[0], p[1], p[2], x);
+    return sign * x[what];
+}
+
+/* Compass search for a minimum of the objective in the unit cube, from p. */
+static double polish(const pde_solution *s, int what, double sign, double p[3], double step)
+{
+    double best = objective(s, what, sign, p);
+    for (int evals = 0; step > 1e-7 && evals < 400;) {
+        int moved = 0;
+        for (int a = 0; a < 3 && !moved; a++)
+            for (int d = -1; d <= 1 && !moved; d += 2) {
+                double q[3] = { p[0], p[1], p[2] };
+                q[a] = fmin(1.0, fmax(0.0, q[a] + d * step));
+                if (q[a] == p[a])
+                    continue;
+                double f = objective(s, what, sign, q);
+                evals++;
+                if (f < best) {
+                    best = f;
+                    p[0] = q[0], p[1] = q[1], p[2] = q[2];
+                    moved = 1;
+                }
+            }
+        if (!moved)
+            step *= 0.5;
+    }
+    return sign * best;
+}
+
+typedef struct {
+    double lo[3], hi[3], lo_at[3][3], hi_at[3][3];
+    double jmin, jmax, jmin_at[3], jmax_at[3];
+} extremes;
+
+static void note_point(extremes *e, const double p[3], const double x[3], double dj)
+{
+    for (int c = 0; c < 3; c++) {
+        if (x[c] < e->lo[c])
+            e->lo[c] = x[c], e->lo_at[c][0] = p[0], e->lo_at[c][1] = p[1], e->lo_at[c][2] = p[2];
+        if (x[c] > e->hi[c])
+            e->hi[c] = x[c], e->hi_at[c][0] = p[0], e->hi_at[c][1] = p[1], e->hi_at[c][2] = p[2];
+    }
+    if (dj < e->jmin)
+        e->jmin = dj, e->jmin_at[0] = p[0], e->jmin_at[1] = p[1], e->jmin_at[2] = p[2];
+    if (dj > e->jmax)
+        e->jmax = dj, e->jmax_at[0] = p[0], e->jmax_at[1] = p[1], e->jmax_at[2] = p[2];
+}
+
+/* Walks a grid over us x vs x ws, noting extremes; with weights, integrates det J. */
+static pde_status sweep(const pde_solution *s, const double *us, size_t nu, const double *vs,
+                        size_t nv, const double *ws, size_t nw, const double *wts_u,
+                        const double *wts_v, const double *wts_w, extremes *e, double *vol,
+                        double *svol)
+{
+    pde_grid *g;
+    pde_status st = pde_grid_create(s, us, nu, vs, nv, &g);
+    if (st != PDE_OK)
+        return st;
+    double acc = 0.0, sacc = 0.0;
+    for (size_t k = 0; k < nw; k++) {
+        grid_set_w(g, ws[k]);
+        for (size_t j = 0; j < nv; j++) {
+            grid_row(g, j, GRID_X | GRID_XU | GRID_XV | GRID_XW);
+            for (size_t i = 0; i < nu; i++) {
+                double x[3], a[3], b[3], c[3];
+                for (int q = 0; q < 3; q++) {
+                    x[q] = g->row[q * nu + i];
+                    a[q] = g->row[(3 + q) * nu + i];
+                    b[q] = g->row[(6 + q) * nu + i];
+                    c[q] = g->row[(9 + q) * nu + i];
+                }
+                double dj = det3(a, b, c);
+                const double p[3] = { us[i], vs[j], ws[k] };
+                note_point(e, p, x, dj);
+                if (wts_u) {
+                    double wt = wts_u[i] * wts_v[j] * wts_w[k];
+                    acc += wt * fabs(dj);
+                    sacc += wt * dj;
+                }
+            }
+        }
+    }
+    pde_grid_free(g);
+    if (vol) {
+        *vol = acc;
+        *svol = sacc;
+    }
+    return PDE_OK;
+}
+
+/* Largest relative error of the boundary conditions of each component, on res x res points. */
+static double bc_residual(const pde_solution *s, int res)
+{
+    double worst = 0.0;
+    for (int c = 0; c < 3; c++) {
+        const comp_solution *cs = &s->comp[c];
+        double err = 0.0, scale = 0.0;
+        for (int i = 0; i < res; i++)
+            for (int j = 0; j < res; j++) {
+                double u = (double)i / (res - 1), v = (double)j / (res - 1);
+                double g[4] = { 0, 0, 0, 0 };
+                for (size_t t = 0; t < cs->nbterms; t++) {
+                    const pde_bterm *b = &cs->bterms[t];
+                    double f = factor_deriv(b->u, u, 0) * factor_deriv(b->v, v, 0);
+                    g[0] += b->w0 * f;
+                    g[1] += b->dw0 * f;
+                    g[2] += b->w1 * f;
+                    g[3] += b->dw1 * f;
+                }
+                for (int side = 0; side < 2; side++) {
+                    double x[3], xw[3];
+                    pde_eval_d(s, u, v, side, x, NULL, NULL, xw);
+                    err = fmax(err, fmax(fabs(x[c] - g[2 * side]), fabs(xw[c] - g[2 * side + 1])));
+                    scale = fmax(scale, fmax(fmax(fabs(g[2 * side]), fabs(g[2 * side + 1])),
+                                             fmax(fabs(x[c]), fabs(xw[c]))));
+                }
+            }
+        worst = fmax(worst, scale > 0.0 ? err / scale : err);
+    }
+    return worst;
+}
+
+/* Largest |a x_uuuu + b x_vvvv + c x_wwww - p| relative to its terms, inside the cube. */
+static double pde_residual(const pde_solution *s, int res)
+{
+    double worst = 0.0;
+    for (int c = 0; c < 3; c++) {
+        const comp_solution *cs = &s->comp[c];
+        double err = 0.0, scale = 0.0;
+        for (int i = 0; i < res; i++)
+            for (int j = 0; j < res; j++)
+                for (int k = 0; k < res; k++) {
+                    double u = (i + 0.5) / res, v = (j + 0.5) / res, w = (k + 0.5) / res;
+                    double tu = cs->a * pde_eval_partial(s, c, u, v, w, 4, 0, 0);
+                    double tv = cs->b * pde_eval_partial(s, c, u, v, w, 0, 4, 0);
+                    double tw = cs->c * pde_eval_partial(s, c, u, v, w, 0, 0, 4);
+                    double p = pde_force(s, c, u, v, w);
+                    err = fmax(err, fabs(tu + tv + tw - p));
+                    scale = fmax(scale, fabs(tu) + fabs(tv) + fabs(tw) + fabs(p));
+                }
+        worst = fmax(worst, scale > 0.0 ? err / scale : err);
+    }
+    return worst;
+}
+
+pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde_props *out)
+{
+    if (!s || !out)
+        return PDE_ERR_INVALID;
+    int res = opts && opts->res > 0 ? opts->res : 17;
+    if (res < 2 || res > 1025)
+        return PDE_ERR_INVALID;
+    int np[3];
+    panel_counts(s, np);
+    size_t nq[3], total = 0;
+    for (int a = 0; a < 3; a++) {
+        nq[a] = (size_t)np[a] * GL_N;
+        total += 2 * nq[a];
+    }
+    double *buf = malloc((total + (size_t)res) * sizeof *buf);
+    if (!buf)
+        return PDE_ERR_NOMEM;
+    double *node[3], *wt[3], *uni = buf + total, *p = buf;
+    for (int a = 0; a < 3; a++) {
+        node[a] = p;
+        wt[a] = p + nq[a];
+        p += 2 * nq[a];
+        double h = 1.0 / np[a];
+        for (int q = 0; q < np[a]; q++)
+            for (int r = 0; r < GL_N; r++) {
+                node[a][q * GL_N + r] = h * (q + 0.5 * (gl_x[r] + 1.0));
+                wt[a][q * GL_N + r] = 0.5 * h * gl_w[r];
+            }
+    }
+    for (int i = 0; i < res; i++)
+        uni[i] = (double)i / (res - 1);
+
+    extremes e;
+    for (int c = 0; c < 3; c++)
+        e.lo[c] = DBL_MAX, e.hi[c] = -DBL_MAX;
+    e.jmin = DBL_MAX;
+    e.jmax = -DBL_MAX;
+    double vol, svol;
+    pde_status st = sweep(s, node[0], nq[0], node[1], nq[1], node[2], nq[2], wt[0], wt[1], wt[2],
+                          &e, &vol, &svol);
+    if (st == PDE_OK)
+        st = sweep(s, uni, res, uni, res, uni, res, NULL, NULL, NULL, &e, NULL, NULL);
+    free(buf);
+    if (st != PDE_OK)
+        return st;
+
+    double step = 1.0 / (res - 1);
+    for (int c = 0; c < 3; c++) {
+        out->bbox_min[c] = polish(s, c, 1.0, e.lo_at[c], step);
+        out->bbox_max[c] = polish(s, c, -1.0, e.hi_at[c], step);
+    }
+    out->detj_min = polish(s, 3, 1.0, e.jmin_at, step);
+    out->detj_max = polish(s, 3, -1.0, e.jmax_at, step);
+    for (int a = 0; a < 3; a++)
+        out->detj_min_at[a] = e.jmin_at[a];
+    double tol = 1e-9 * fmax(fabs(out->detj_min), fabs(out->detj_max));
+    out->folds = out->detj_min < -tol && out->detj_max > tol;
+    out->volume = vol;
+    out->signed_volume = svol;
+    out->bc_residual = bc_residual(s, res);
+    out->pde_residual = pde_residual(s, res < 9 ? res : 9);
+    return PDE_OK;
+}

@@ -1,0 +1,652 @@
+/*
+ * solve.c: pde_solve(), the plan. Separates variables (eq. 4), solves each
+ * mode's boundary value problem exactly, and stores the closed form.
+ *
+ * DESIGN
+ * A mode is a pair of basis functions (f_u, f_v). Sines, cosines and
+ * exponentials are eigenfunctions of d4 (eq. 6), so their mode obeys
+ * c h'''' + (a lu + b lv) h = force (eq. 7). A power t^m is not: d4 t^m =
+ * m(m-1)(m-2)(m-3) t^(m-4), so the modes t^m, t^(m-4), ... form a chain, each
+ * forced by the one above it. Modes are sorted by their total polynomial
+ * degree, highest first, so each mode's parents are solved before it.
+ *
+ * The force's own boundary values are taken off the boundary data of every
+ * mode it touches before the homogeneous part is fitted; the paper's eq. (30)
+ * skips this step, so its tangents at w = 0, 1 are not met.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ep.h"
+
+#define COND_LIMIT 1e12   /* boundary systems worse than this are singular */
+
+const char *pde_strerror(pde_status status)
+{
+    switch (status) {
+    case PDE_OK: return "success";
+    case PDE_ERR_NOMEM: return "out of memory";
+    case PDE_ERR_INVALID: return "invalid model";
+    case PDE_ERR_ILLPOSED: return "ill-posed equation";
+    case PDE_ERR_SINGULAR: return "singular boundary problem";
+    case PDE_ERR_RANGE: return "value out of range";
+    case PDE_ERR_LIMIT: return "model too large";
+    }
+    return "unknown status";
+}
+
+static const char *const comp_name[3] = { "x", "y", "z" };
+
+typedef struct {
+    pde_factor u, v;
+    int level;            /* total degree of the power factors */
+    int src_force;        /* the term that first asked for this mode */
+    long src_term;
+    double bc[4];         /* w0, dw0, w1, dw1 */
+    long first_force;     /* head of this mode's list of force terms, -1 if none */
+    ep h;                 /* the solved h(w), complex */
+} mode;
+
+static pde_status fail(pde_diag *d, pde_status st, int comp, int in_force, long term,
+                       const char *field, const char *fmt, ...)
+    __attribute__((format(printf, 7, 8)));
+
+static pde_status fail(pde_diag *d, pde_status st, int comp, int in_force, long term,
+                       const char *field, const char *fmt, ...)
+{
+    if (!d)
+        return st;
+    d->component = comp;
+    d->in_force = in_force;
+    d->term = term;
+    snprintf(d->field, sizeof d->field, "%s", field);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(d->message, sizeof d->message, fmt, ap);
+    va_end(ap);
+    return st;
+}
+
+/* Checks a factor; returns NULL if valid, else what is wrong with it. */
+static const char *factor_problem(pde_factor f)
+{
+    if (!isfinite(f.p))
+        return "is not a finite number";
+    switch (f.kind) {
+    case PDE_POW:
+        if (f.p != floor(f.p) || f.p < 0 || f.p > PDE_MAX_POW)
+            return "must be an integer power from 0 to 100";
+        return NULL;
+    case PDE_SIN:
+    case PDE_COS:
+        if (fabs(f.p) > 1e6)
+            return "has a frequency k beyond 1e6";
+        return NULL;
+    case PDE_EXP:
+    case PDE_SINH:
+    case PDE_COSH:
+        if (fabs(f.p) > PDE_MAX_ARG)
+            return "has |alpha| > 700, so its values overflow a double";
+        return NULL;
+    }
+    return "has an unknown kind";
+}
+
+/* The basis function a factor is a multiple of: returns 0 if f is identically 0. */
+static int normalise(pde_factor f, pde_factor *key, double *sign)
+{
+    static const pde_factor one = { PDE_POW, 0.0 };
+    *key = f;
+    *sign = 1.0;
+    switch (f.kind) {
+    case PDE_POW:
+        break;
+    case PDE_SIN:
+    case PDE_SINH:
+        if (f.p == 0.0)
+            return 0;
+        if (f.p < 0.0) {
+            key->p = -f.p;
+            *sign = -1.0;
+        }
+        break;
+    case PDE_COS:
+    case PDE_COSH:
+    case PDE_EXP:
+        if (f.p == 0.0)
+            *key = one;
+        else if (f.kind != PDE_EXP)
+            key->p = fabs(f.p);
+        break;
+    }
+    return 1;
+}
+
+static int factor_cmp(pde_factor a, pde_factor b)
+{
+    if (a.kind != b.kind)
+        return a.kind < b.kind ? -1 : 1;
+    return a.p < b.p ? -1 : a.p > b.p;
+}
+
+static int level_of(pde_factor u, pde_factor v)
+{
+    return (u.kind == PDE_POW ? (int)u.p : 0) + (v.kind == PDE_POW ? (int)v.p : 0);
+}
+
+/* Order: level descending, then the factors. Equal keys: the earliest source first. */
+static int mode_cmp_key(const void *pa, const void *pb)
+{
+    const mode *a = pa, *b = pb;
+    if (a->level != b->level)
+        return a->level > b->level ? -1 : 1;
+    int c = factor_cmp(a->u, b->u);
+    return c ? c : factor_cmp(a->v, b->v);
+}
+
+static int mode_cmp(const void *pa, const void *pb)
+{
+    int c = mode_cmp_key(pa, pb);
+    if (c)
+        return c;
+    const mode *a = pa, *b = pb;
+    if (a->src_force != b->src_force)
+        return a->src_force - b->src_force;
+    return (a->src_term > b->src_term) - (a->src_term < b->src_term);
+}
+
+static mode *find_mode(mode *modes, size_t n, pde_factor u, pde_factor v)
+{
+    mode key = { .u = u, .v = v, .level = level_of(u, v) };
+    return bsearch(&key, modes, n, sizeof *modes, mode_cmp_key);
+}
+
+typedef struct {
+    mode *m;
+    size_t n, cap;
+} mode_list;
+
+/* Adds the mode (u, v) and the chain below it: t^m -> t^(m-4) -> ... */
+static pde_status push_chain(arena *s, mode_list *l, pde_factor u, pde_factor v,
+                             int in_force, long term)
+{
+    int iu = u.kind == PDE_POW ? (int)u.p / 4 : 0;
+    int iv = v.kind == PDE_POW ? (int)v.p / 4 : 0;
+    size_t need = l->n + (size_t)(iu + 1) * (size_t)(iv + 1);
+    if (need > (size_t)PDE_MAX_MODES * 4)
+        return PDE_ERR_LIMIT;
+    if (need > l->cap) {
+        size_t cap = l->cap ? l->cap : 16;
+        while (cap < need)
+            cap *= 2;
+        mode *nm = arena_alloc(s, cap * sizeof *nm);
+        if (!nm)
+            return PDE_ERR_NOMEM;
+        if (l->n)
+            memcpy(nm, l->m, l->n * sizeof *nm);
+        l->m = nm;
+        l->cap = cap;
+    }
+    for (int i = 0; i <= iu; i++)
+        for (int j = 0; j <= iv; j++) {
+            mode *m = &l->m[l->n++];
+            memset(m, 0, sizeof *m);
+            m->u = u;
+            m->v = v;
+            m->u.p -= 4 * i;
+            m->v.p -= 4 * j;
+            m->level = level_of(m->u, m->v);
+            m->src_force = in_force;
+            m->src_term = term;
+            m->first_force = -1;
+        }
+    return PDE_OK;
+}
+
+/* f(w) as an ep, times scale: sines and cosines as exp(i k pi w), of which h is the real part. */
+static pde_status force_w(arena *s, ep *q, pde_factor f, double scale)
+{
+    cplx one = 1.0;
+    switch (f.kind) {
+    case PDE_POW: {
+        int n = (int)f.p;
+        cplx *p = arena_alloc(s, (size_t)(n + 1) * sizeof *p);
+        if (!p)
+            return PDE_ERR_NOMEM;
+        p[n] = 1.0;
+        return ep_add(s, q, 0.0, 0, p, n, scale);
+    }
+    case PDE_SIN:
+    case PDE_COS: {
+        if (f.p == 0.0)
+            return f.kind == PDE_COS ? ep_add(s, q, 0.0, 0, &one, 0, scale) : PDE_OK;
+        cplx z = I * f.p * M_PI;     /* Re(-i e^{i th}) = sin th, Re(e^{i th}) = cos th */
+        return ep_add(s, q, z, 0, &one, 0, f.kind == PDE_SIN ? -I * scale : scale);
+    }
+    case PDE_EXP:
+    case PDE_SINH:
+    case PDE_COSH: {
+        double a = f.p;
+        if (a == 0.0)
+            return f.kind == PDE_SINH ? PDE_OK : ep_add(s, q, 0.0, 0, &one, 0, scale);
+        /* e^{a w} = e^{a shift} e^{a (w - shift)}: the stored exponent stays <= 0. */
+        double sp = a > 0 ? exp(a) : 1.0, sm = a < 0 ? exp(-a) : 1.0;
+        if (f.kind == PDE_EXP)
+            return ep_add(s, q, a, a > 0, &one, 0, scale * sp);
+        pde_status st = ep_add(s, q, a, a > 0, &one, 0, 0.5 * scale * sp);
+        if (st != PDE_OK)
+            return st;
+        double sg = f.kind == PDE_SINH ? -0.5 : 0.5;
+        return ep_add(s, q, -a, -a > 0, &one, 0, sg * scale * sm);
+    }
+    }
+    return PDE_OK;
+}
+
+/* Solves the 4x4 complex system M c = b with partial pivoting; returns the 1-norm condition number. */
+static double solve4(cplx M[4][4], cplx b[4], cplx c[4])
+{
+    cplx A[4][4];
+    int piv[4] = { 0, 1, 2, 3 };
+    double norm = 0.0;
+    for (int j = 0; j < 4; j++) {
+        double col = 0.0;
+        for (int i = 0; i < 4; i++)
+            col += cabs(M[i][j]);
+        if (col > norm)
+            norm = col;
+    }
+    memcpy(A, M, sizeof A);
+    for (int k = 0; k < 4; k++) {
+        int p = k;
+        for (int i = k + 1; i < 4; i++)
+            if (cabs(A[i][k]) > cabs(A[p][k]))
+                p = i;
+        if (A[p][k] == 0.0)
+            return INFINITY;
+        if (p != k) {
+            for (int j = 0; j < 4; j++) {
+                cplx t = A[k][j];
+                A[k][j] = A[p][j];
+                A[p][j] = t;
+            }
+            int t = piv[k];
+            piv[k] = piv[p];
+            piv[p] = t;
+        }
+        for (int i = k + 1; i < 4; i++) {
+            A[i][k] /= A[k][k];
+            for (int j = k + 1; j < 4; j++)
+                A[i][j] -= A[i][k] * A[k][j];
+        }
+    }
+    /* Columns 0..3 of the inverse, then column 4 is the solution. */
+    double inorm = 0.0;
+    for (int col = 0; col < 5; col++) {
+        cplx y[4];
+        for (int i = 0; i < 4; i++) {
+            cplx rhs = col < 4 ? (piv[i] == col ? 1.0 : 0.0) : b[piv[i]];
+            for (int j = 0; j < i; j++)
+                rhs -= A[i][j] * y[j];
+            y[i] = rhs;
+        }
+        for (int i = 3; i >= 0; i--) {
+            for (int j = i + 1; j < 4; j++)
+                y[i] -= A[i][j] * y[j];
+            y[i] /= A[i][i];
+        }
+        if (col < 4) {
+            double s = 0.0;
+            for (int i = 0; i < 4; i++)
+                s += cabs(y[i]);
+            if (s > inorm)
+                inorm = s;
+        } else {
+            memcpy(c, y, sizeof y);
+        }
+    }
+    return norm * inorm;
+}
+
+/* The real closed form of a complex ep: Re sum P e^{z(w-s)}, terms with equal (alpha, |beta|, s) merged. */
+static pde_status to_real(arena *mem, const ep *h, pde_mode *out)
+{
+    pde_wterm *terms = arena_alloc(mem, (h->n ? h->n : 1) * sizeof *terms);
+    if (!terms)
+        return PDE_ERR_NOMEM;
+    size_t n = 0;
+    for (size_t i = 0; i < h->n; i++) {
+        const ep_term *t = &h->t[i];
+        double alpha = creal(t->z), beta = cimag(t->z);
+        double sgn = beta > 0 ? -1.0 : 1.0;
+        cplx rot = t->shift && beta != 0.0 ? cexp(-I * beta) : 1.0;   /* e^{-i beta shift} */
+        size_t k = 0;
+        while (k < n && !(terms[k].alpha == alpha && terms[k].beta == fabs(beta) &&
+                          terms[k].shift == t->shift))
+            k++;
+        pde_wterm *w = &terms[k];
+        int deg = t->deg;
+        if (k == n) {
+            n++;
+            w->alpha = alpha;
+            w->beta = fabs(beta);
+            w->shift = t->shift;
+            w->deg = -1;
+        }
+        if (deg > w->deg) {
+            double *A = arena_alloc(mem, (size_t)(deg + 1) * sizeof *A);
+            double *B = arena_alloc(mem, (size_t)(deg + 1) * sizeof *B);
+            if (!A || !B)
+                return PDE_ERR_NOMEM;
+            for (int j = 0; j <= w->deg; j++) {
+                A[j] = w->A[j];
+                B[j] = w->B[j];
+            }
+            w->A = A;
+            w->B = B;
+            w->deg = deg;
+        }
+        double *A = (double *)w->A, *B = (double *)w->B;
+        for (int j = 0; j <= deg; j++) {
+            cplx p = t->p[j] * rot;
+            A[j] += creal(p);
+            if (beta != 0.0)
+                B[j] += sgn * cimag(p);
+        }
+    }
+    out->terms = terms;
+    out->nterms = n;
+    return PDE_OK;
+}
+
+static int wterms_finite(const pde_mode *m)
+{
+    for (size_t k = 0; k < m->nterms; k++)
+        for (int j = 0; j <= m->terms[k].deg; j++)
+            if (!isfinite(m->terms[k].A[j]) || !isfinite(m->terms[k].B[j]))
+                return 0;
+    return 1;
+}
+
+static const char *factor_word(pde_factor_kind k)
+{
+    static const char *const w[] = { "pow", "sin", "cos", "exp", "sinh", "cosh" };
+    return (unsigned)k < 6 ? w[k] : "?";
+}
+
+static pde_status check_terms(const pde_component *c, int ci, pde_diag *diag)
+{
+    static const char *const bf[4] = { "w0", "dw0", "w1", "dw1" };
+    static const char *const uvw[3] = { "u", "v", "w" };
+    for (size_t j = 0; j < c->nbterms; j++) {
+        const pde_bterm *t = &c->bterms[j];
+        const double d[4] = { t->w0, t->dw0, t->w1, t->dw1 };
+        for (int k = 0; k < 4; k++)
+            if (!isfinite(d[k]))
+                return fail(diag, PDE_ERR_INVALID, ci, 0, (long)j, bf[k],
+                            "%s is not a finite number", bf[k]);
+        const pde_factor f[2] = { t->u, t->v };
+        for (int k = 0; k < 2; k++) {
+            const char *why = factor_problem(f[k]);
+            if (why)
+                return fail(diag, PDE_ERR_INVALID, ci, 0, (long)j, uvw[k], "the %s factor %s %s",
+                            uvw[k], factor_word(f[k].kind), why);
+        }
+    }
+    for (size_t j = 0; j < c->nfterms; j++) {
+        const pde_fterm *t = &c->fterms[j];
+        if (!isfinite(t->coef))
+            return fail(diag, PDE_ERR_INVALID, ci, 1, (long)j, "coef", "coef is not a finite number");
+        const pde_factor f[3] = { t->u, t->v, t->w };
+        for (int k = 0; k < 3; k++) {
+            const char *why = factor_problem(f[k]);
+            if (why)
+                return fail(diag, PDE_ERR_INVALID, ci, 1, (long)j, uvw[k], "the %s factor %s %s",
+                            uvw[k], factor_word(f[k].kind), why);
+        }
+    }
+    return PDE_OK;
+}
+
+/* Collects the modes of one component, sorted, with their data attached. */
+static pde_status collect(arena *s, const pde_component *c, int ci, mode **out, size_t *nout,
+                          long **next_force, pde_diag *diag)
+{
+    mode_list l = { 0 };
+    pde_factor ku, kv;
+    double su, sv;
+    for (int in_force = 0; in_force < 2; in_force++) {
+        size_t nt = in_force ? c->nfterms : c->nbterms;
+        for (size_t j = 0; j < nt; j++) {
+            pde_factor fu = in_force ? c->fterms[j].u : c->bterms[j].u;
+            pde_factor fv = in_force ? c->fterms[j].v : c->bterms[j].v;
+            if (!normalise(fu, &ku, &su) || !normalise(fv, &kv, &sv))
+                continue;
+            pde_status st = push_chain(s, &l, ku, kv, in_force, (long)j);
+            if (st == PDE_ERR_LIMIT)
+                return fail(diag, st, ci, in_force, (long)j, "",
+                            "component %s needs more than %d separated modes", comp_name[ci],
+                            PDE_MAX_MODES);
+            if (st != PDE_OK)
+                return st;
+        }
+    }
+    if (l.n)
+        qsort(l.m, l.n, sizeof *l.m, mode_cmp);
+    size_t n = 0;
+    for (size_t i = 0; i < l.n; i++)
+        if (n == 0 || mode_cmp_key(&l.m[n - 1], &l.m[i]) != 0)
+            l.m[n++] = l.m[i];
+    if (n > PDE_MAX_MODES)
+        return fail(diag, PDE_ERR_LIMIT, ci, -1, -1, "", "component %s needs %zu separated modes, more than %d",
+                    comp_name[ci], n, PDE_MAX_MODES);
+    long *next = arena_alloc(s, (c->nfterms ? c->nfterms : 1) * sizeof *next);
+    if (!next)
+        return PDE_ERR_NOMEM;
+    for (size_t j = 0; j < c->nbterms; j++) {
+        const pde_bterm *t = &c->bterms[j];
+        if (!normalise(t->u, &ku, &su) || !normalise(t->v, &kv, &sv))
+            continue;
+        mode *m = find_mode(l.m, n, ku, kv);
+        double sg = su * sv;
+        m->bc[0] += sg * t->w0;
+        m->bc[1] += sg * t->dw0;
+        m->bc[2] += sg * t->w1;
+        m->bc[3] += sg * t->dw1;
+    }
+    /* Force lists, kept in term order. */
+    for (size_t j = c->nfterms; j-- > 0;) {
+        const pde_fterm *t = &c->fterms[j];
+        next[j] = -1;
+        if (!normalise(t->u, &ku, &su) || !normalise(t->v, &kv, &sv))
+            continue;
+        mode *m = find_mode(l.m, n, ku, kv);
+        next[j] = m->first_force;
+        m->first_force = (long)j;
+    }
+    *out = l.m;
+    *nout = n;
+    *next_force = next;
+    return PDE_OK;
+}
+
+/* Solves one mode: forcing from its force terms and its chain parents, then the boundary fit. */
+static pde_status solve_mode(arena *s, const pde_component *c, int ci, mode *modes, size_t nmodes,
+                             mode *m, const long *next_force, pde_diag *diag)
+{
+    double mu = c->a * factor_lambda(m->u) + c->b * factor_lambda(m->v);
+    double e = -mu / c->c;                                   /* eq. (8) */
+    if (!isfinite(e))
+        return fail(diag, PDE_ERR_RANGE, ci, m->src_force, m->src_term, "",
+                    "component %s: the separation constant e = -(a lu + b lv)/c overflows",
+                    comp_name[ci]);
+    ep q = { 0 };
+    pde_status st;
+    for (long j = m->first_force; j >= 0; j = next_force[j]) {
+        const pde_fterm *t = &c->fterms[j];
+        pde_factor ku, kv;
+        double su, sv;
+        normalise(t->u, &ku, &su);
+        normalise(t->v, &kv, &sv);
+        if ((st = force_w(s, &q, t->w, t->coef * su * sv / c->c)) != PDE_OK)
+            return st;
+    }
+    /* Chain: a (m+4)(m+3)(m+2)(m+1) h_{u^(m+4)} appears on the left of this mode's equation. */
+    for (int axis = 0; axis < 2; axis++) {
+        pde_factor pu = m->u, pv = m->v;
+        pde_factor *f = axis == 0 ? &pu : &pv;
+        if (f->kind != PDE_POW)
+            continue;
+        double k = (f->p + 4) * (f->p + 3) * (f->p + 2) * (f->p + 1);
+        f->p += 4;
+        mode *parent = f->p <= PDE_MAX_POW ? find_mode(modes, nmodes, pu, pv) : NULL;
+        double coef = axis == 0 ? c->a : c->b;
+        if (parent && coef != 0.0 && (st = ep_add_ep(s, &q, &parent->h, -coef * k / c->c)) != PDE_OK)
+            return st;
+    }
+    if (q.n == 0 && m->bc[0] == 0.0 && m->bc[1] == 0.0 && m->bc[2] == 0.0 && m->bc[3] == 0.0)
+        return PDE_OK;    /* h = 0 */
+
+    ep hp = { 0 }, basis[4];
+    double dscale;
+    if ((st = ep_particular(s, e, &q, &hp)) != PDE_OK || (st = ep_homogeneous(s, e, basis, &dscale)) != PDE_OK)
+        return st;
+    cplx bp[4], M[4][4], rhs[4], coef[4];
+    ep_boundary(&hp, bp);
+    for (int j = 0; j < 4; j++) {
+        cplx col[4];
+        ep_boundary(&basis[j], col);
+        for (int i = 0; i < 4; i++)
+            M[i][j] = col[i] * (i & 1 ? dscale : 1.0);
+    }
+    for (int i = 0; i < 4; i++)
+        rhs[i] = (m->bc[i] - bp[i]) * (i & 1 ? dscale : 1.0);
+    double cond = solve4(M, rhs, coef);
+    if (!(cond <= COND_LIMIT)) {
+        char where[64];
+        pde_factor fu = m->u, fv = m->v;
+        snprintf(where, sizeof where, "%s(%g)*%s(%g)", factor_word(fu.kind), fu.p,
+                 factor_word(fv.kind), fv.p);
+        return fail(diag, PDE_ERR_SINGULAR, ci, m->src_force, m->src_term, "",
+                    "component %s, mode %s: e = %.17g is an eigenvalue of the clamped problem "
+                    "(cos t cosh t = 1 with t = e^(1/4)), so h'''' = e h with these boundary "
+                    "conditions has no unique solution; change a, b or c of %s",
+                    comp_name[ci], where, e, comp_name[ci]);
+    }
+    m->h = hp;
+    for (int j = 0; j < 4; j++)
+        if ((st = ep_add_ep(s, &m->h, &basis[j], coef[j])) != PDE_OK)
+            return st;
+    return PDE_OK;
+}
+
+static pde_status solve_component(arena *mem, arena *s, const pde_model *model, int ci,
+                                  comp_solution *out, pde_diag *diag)
+{
+    const pde_component *c = &model->comp[ci];
+    static const char *const abc[3] = { "a", "b", "c" };
+    const double v[3] = { c->a, c->b, c->c };
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(v[k]))
+            return fail(diag, PDE_ERR_INVALID, ci, -1, -1, abc[k], "%s of component %s is not a finite number",
+                        abc[k], comp_name[ci]);
+    if (c->c == 0.0)
+        return fail(diag, PDE_ERR_ILLPOSED, ci, -1, -1, "c",
+                    "c of component %s is 0: the equation is then not fourth order in w and "
+                    "the four boundary conditions cannot all hold", comp_name[ci]);
+    if ((c->nbterms && !c->bterms) || (c->nfterms && !c->fterms))
+        return fail(diag, PDE_ERR_INVALID, ci, -1, -1, "", "component %s has a NULL term list",
+                    comp_name[ci]);
+    pde_status st = check_terms(c, ci, diag);
+    if (st != PDE_OK)
+        return st;
+
+    mode *modes = NULL;
+    size_t n = 0;
+    long *next_force = NULL;
+    if ((st = collect(s, c, ci, &modes, &n, &next_force, diag)) != PDE_OK)
+        return st;
+    for (size_t i = 0; i < n; i++)
+        if ((st = solve_mode(s, c, ci, modes, n, &modes[i], next_force, diag)) != PDE_OK)
+            return st;
+
+    out->a = c->a;
+    out->b = c->b;
+    out->c = c->c;
+    out->modes = arena_alloc(mem, (n ? n : 1) * sizeof *out->modes);
+    out->bterms = arena_alloc(mem, (c->nbterms ? c->nbterms : 1) * sizeof *out->bterms);
+    out->fterms = arena_alloc(mem, (c->nfterms ? c->nfterms : 1) * sizeof *out->fterms);
+    if (!out->modes || !out->bterms || !out->fterms)
+        return PDE_ERR_NOMEM;
+    if (c->nbterms)
+        memcpy(out->bterms, c->bterms, c->nbterms * sizeof *out->bterms);
+    if (c->nfterms)
+        memcpy(out->fterms, c->fterms, c->nfterms * sizeof *out->fterms);
+    out->nbterms = c->nbterms;
+    out->nfterms = c->nfterms;
+    size_t kept = 0;
+    for (size_t i = 0; i < n; i++) {
+        pde_mode *pm = &out->modes[kept];
+        pm->u = modes[i].u;
+        pm->v = modes[i].v;
+        pm->e = -(c->a * factor_lambda(pm->u) + c->b * factor_lambda(pm->v)) / c->c;
+        if ((st = to_real(mem, &modes[i].h, pm)) != PDE_OK)
+            return st;
+        if (!wterms_finite(pm))
+            return fail(diag, PDE_ERR_RANGE, ci, modes[i].src_force, modes[i].src_term, "",
+                        "component %s: the solution's coefficients overflow a double", comp_name[ci]);
+        if (pm->nterms)
+            kept++;
+    }
+    out->nmodes = kept;
+    return PDE_OK;
+}
+
+pde_status pde_solve(const pde_model *model, pde_solution **out, pde_diag *diag)
+{
+    if (diag)
+        memset(diag, 0, sizeof *diag), diag->component = -1, diag->term = -1;
+    if (!model || !out)
+        return fail(diag, PDE_ERR_INVALID, -1, -1, -1, "", "no model given");
+    arena mem = { 0 }, scratch = { 0 };
+    pde_solution *sol = arena_alloc(&mem, sizeof *sol);
+    pde_status st = sol ? PDE_OK : PDE_ERR_NOMEM;
+    for (int ci = 0; ci < 3 && st == PDE_OK; ci++)
+        st = solve_component(&mem, &scratch, model, ci, &sol->comp[ci], diag);
+    arena_free(&scratch);
+    if (st != PDE_OK) {
+        if (st == PDE_ERR_NOMEM && diag && !diag->message[0])
+            snprintf(diag->message, sizeof diag->message, "out of memory");
+        arena_free(&mem);
+        return st;
+    }
+    sol->mem = mem;
+    *out = sol;
+    return PDE_OK;
+}
+
+void pde_solution_free(pde_solution *sol)
+{
+    if (!sol)
+        return;
+    arena mem = sol->mem;     /* the solution lives inside its own arena */
+    arena_free(&mem);
+}
+
+size_t pde_solution_bytes(const pde_solution *sol)
+{
+    return sol ? sol->mem.bytes : 0;
+}
+
+const pde_mode *pde_solution_modes(const pde_solution *sol, int comp, size_t *nmodes)
+{
+    if (!sol || comp < 0 || comp > 2) {
+        *nmodes = 0;
+        return NULL;
+    }
+    *nmodes = sol->comp[comp].nmodes;
+    return sol->comp[comp].modes;
+}
