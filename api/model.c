@@ -353,8 +353,6 @@ int api_solve(const api_model *m, pde_solution **out, api_error *err)
     else if (d.component >= 0 && d.term >= 0)
         snprintf(ptr, sizeof ptr, "/%s/%s/%ld%s%s", d.in_force ? "force" : "boundary",
                  comp_key[d.component], d.term, d.field[0] ? "/" : "", d.field);
-    else if (d.component >= 0)
-        snprintf(ptr, sizeof ptr, "/pde");
     api_fail(err, ptr, "%s", d.message[0] ? d.message : pde_strerror(st));
     return (int)st;
 }

@@ -1,0 +1,437 @@
+/*
+ * support.c: the tests' independent solver and helpers (support.h).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "support.h"
+
+/* ---- banded Gaussian elimination with partial pivoting ---- */
+
+typedef struct {
+    int n, kl, ku, w;   /* row i stores columns i-kl .. i+kl+ku */
+    double *a;
+} band;
+
+static double *bat(band *b, int i, int j)
+{
+    return &b->a[(size_t)i * b->w + (j - i + b->kl)];
+}
+
+static int band_solve(band *b, double *rhs)
+{
+    int n = b->n, kl = b->kl, ku = b->ku;
+    for (int k = 0; k < n; k++) {
+        int last = k + kl < n - 1 ? k + kl : n - 1;
+        int p = k;
+        for (int i = k + 1; i <= last; i++)
+            if (fabs(*bat(b, i, k)) > fabs(*bat(b, p, k)))
+                p = i;
+        if (*bat(b, p, k) == 0.0)
+            return -1;
+        int right = k + kl + ku < n - 1 ? k + kl + ku : n - 1;
+        if (p != k) {
+            for (int j = k; j <= right; j++) {
+                double t = *bat(b, k, j);
+                *bat(b, k, j) = j - p >= -kl ? *bat(b, p, j) : 0.0;
+                if (j - p >= -kl)
+                    *bat(b, p, j) = t;
+            }
+            double t = rhs[k];
+            rhs[k] = rhs[p];
+            rhs[p] = t;
+        }
+        for (int i = k + 1; i <= last; i++) {
+            double f = *bat(b, i, k) / *bat(b, k, k);
+            if (f == 0.0)
+                continue;
+            for (int j = k + 1; j <= right; j++)
+                *bat(b, i, j) -= f * *bat(b, k, j);
+            *bat(b, i, k) = 0.0;
+            rhs[i] -= f * rhs[k];
+        }
+    }
+    for (int i = n - 1; i >= 0; i--) {
+        int right = i + kl + ku < n - 1 ? i + kl + ku : n - 1;
+        double s = rhs[i];
+        for (int j = i + 1; j <= right; j++)
+            s -= *bat(b, i, j) * rhs[j];
+        rhs[i] = s / *bat(b, i, i);
+    }
+    return 0;
+}
+
+/* ---- the first-order system y' = A y + f(w) ---- */
+
+struct indep_solution {
+    indep_problem p;
+    int n, K;            /* state size 4M, intervals */
+    double s;            /* state scale: y_j = h^(j) / s^j */
+    double *A;           /* n x n */
+    double *Y;           /* (K+1) x n states at the nodes */
+    double *qbuf;
+};
+
+static const double gl16_x[16] = {
+    -0.9894009349916499, -0.9445750230732326, -0.8656312023878318, -0.7554044083550030,
+    -0.6178762444026438, -0.4580167776572274, -0.2816035507792589, -0.0950125098376374,
+    0.0950125098376374,  0.2816035507792589,  0.4580167776572274,  0.6178762444026438,
+    0.7554044083550030,  0.8656312023878318,  0.9445750230732326,  0.9894009349916499 };
+static const double gl16_w[16] = {
+    0.0271524594117541, 0.0622535239386479, 0.0951585116824928, 0.1246289712555339,
+    0.1495959888165767, 0.1691565193950025, 0.1826034150449236, 0.1894506104550685,
+    0.1894506104550685, 0.1826034150449236, 0.1691565193950025, 0.1495959888165767,
+    0.1246289712555339, 0.0951585116824928, 0.0622535239386479, 0.0271524594117541 };
+
+/* E = exp(A tau) by Taylor series; ||A tau|| is kept below about 1 by the caller. */
+static void expm(const indep_solution *s, double tau, double *E)
+{
+    int n = s->n;
+    double *T = malloc(2 * (size_t)n * n * sizeof *T), *U = T + (size_t)n * n;
+    for (int i = 0; i < n * n; i++)
+        E[i] = T[i] = (i / n == i % n) ? 1.0 : 0.0;
+    for (int k = 1; k <= 40; k++) {
+        /* T = T A tau / k */
+        double mx = 0.0;
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+                double acc = 0.0;
+                for (int l = 0; l < n; l++)
+                    acc += T[i * n + l] * s->A[l * n + j];
+                U[i * n + j] = acc * tau / k;
+                mx = fmax(mx, fabs(U[i * n + j]));
+            }
+        memcpy(T, U, (size_t)n * n * sizeof *T);
+        for (int i = 0; i < n * n; i++)
+            E[i] += T[i];
+        if (mx < 1e-300 || (k > 4 && mx < 1e-19))
+            break;
+    }
+    free(T);
+}
+
+/* The force in the scaled state: only the y_{m,3} rows get q_m / (c s^3). */
+static void force(const indep_solution *s, double w, double *f)
+{
+    memset(f, 0, (size_t)s->n * sizeof *f);
+    if (!s->p.q)
+        return;
+    s->p.q(w, s->qbuf, s->p.ctx);
+    for (int m = 0; m < s->p.M; m++)
+        f[4 * m + 3] = s->qbuf[m] / (s->p.c * s->s * s->s * s->s);
+}
+
+/* y(a + tau) = E(tau) y(a) + integral_0^tau E(tau - r) f(a + r) dr, into out. */
+static void propagate(const indep_solution *s, double a, double tau, const double *ya, double *out)
+{
+    int n = s->n;
+    double *E = malloc(((size_t)n * n + 2 * (size_t)n) * sizeof *E), *f = E + (size_t)n * n,
+           *acc = f + n;
+    expm(s, tau, E);
+    for (int i = 0; i < n; i++) {
+        acc[i] = 0.0;
+        for (int j = 0; j < n; j++)
+            acc[i] += E[i * n + j] * ya[j];
+    }
+    if (s->p.q && tau > 0.0) {
+        for (int g = 0; g < 16; g++) {
+            double r = 0.5 * tau * (gl16_x[g] + 1.0), wt = 0.5 * tau * gl16_w[g];
+            expm(s, tau - r, E);
+            force(s, a + r, f);
+            for (int i = 0; i < n; i++)
+                for (int j = 0; j < n; j++)
+                    acc[i] += wt * E[i * n + j] * f[j];
+        }
+    }
+    memcpy(out, acc, (size_t)n * sizeof *out);
+    free(E);
+}
+
+indep_solution *indep_solve(const indep_problem *p)
+{
+    indep_solution *s = calloc(1, sizeof *s);
+    int M = p->M, n = 4 * M;
+    s->p = *p;
+    s->n = n;
+    double big = 1.0;
+    for (int m = 0; m < M; m++)
+        big = fmax(big, pow(fabs(p->mu[m] / p->c), 0.25));
+    if (p->K)
+        for (int i = 0; i < M * M; i++)
+            big = fmax(big, pow(fabs(p->K[i] / p->c), 0.25));
+    s->s = big;
+    double rate = fmax(big, p->freq);
+    s->K = (int)fmax(16.0, ceil(2.0 * rate));
+    s->A = calloc((size_t)n * n, sizeof *s->A);
+    s->qbuf = calloc((size_t)M, sizeof *s->qbuf);
+    double c3 = p->c * big * big * big;
+    for (int m = 0; m < M; m++) {
+        for (int j = 0; j < 3; j++)
+            s->A[(4 * m + j) * n + 4 * m + j + 1] = big;
+        s->A[(4 * m + 3) * n + 4 * m] -= p->mu[m] / c3;
+        if (p->K)
+            for (int k = 0; k < M; k++)
+                s->A[(4 * m + 3) * n + 4 * k] -= p->K[m * M + k] / c3;
+    }
+    /* Unknowns: Y_0 .. Y_K. Rows: 2M boundary at 0, K blocks of n continuity, 2M boundary at 1. */
+    int K = s->K, N = n * (K + 1);
+    band b = { N, 2 * n, 2 * n, 0, NULL };
+    b.w = 2 * b.kl + b.ku + 1;
+    b.a = calloc((size_t)N * b.w, sizeof *b.a);
+    double *rhs = calloc((size_t)N, sizeof *rhs), *E = malloc((size_t)n * n * sizeof *E);
+    double *zero = calloc((size_t)n, sizeof *zero), *r = malloc((size_t)n * sizeof *r);
+    int row = 0;
+    for (int m = 0; m < M; m++) {
+        *bat(&b, row, 4 * m) = 1.0;
+        rhs[row++] = p->bc[4 * m];
+        *bat(&b, row, 4 * m + 1) = 1.0;
+        rhs[row++] = p->bc[4 * m + 1] / big;
+    }
+    double h = 1.0 / K;
+    expm(s, h, E);
+    for (int k = 0; k < K; k++) {
+        propagate(s, k * h, h, zero, r);   /* the forced part alone */
+        for (int i = 0; i < n; i++, row++) {
+            for (int j = 0; j < n; j++)
+                *bat(&b, row, n * k + j) = E[i * n + j];
+            *bat(&b, row, n * (k + 1) + i) = -1.0;
+            rhs[row] = -r[i];
+        }
+    }
+    for (int m = 0; m < M; m++) {
+        *bat(&b, row, n * K + 4 * m) = 1.0;
+        rhs[row++] = p->bc[4 * m + 2];
+        *bat(&b, row, n * K + 4 * m + 1) = 1.0;
+        rhs[row++] = p->bc[4 * m + 3] / big;
+    }
+    if (band_solve(&b, rhs) != 0) {
+        free(rhs);
+        rhs = NULL;
+    }
+    s->Y = rhs;
+    free(b.a);
+    free(E);
+    free(zero);
+    free(r);
+    if (!s->Y) {
+        indep_free(s);
+        return NULL;
+    }
+    return s;
+}
+
+double indep_eval(const indep_solution *s, int m, int d, double w)
+{
+    int k = (int)floor(w * s->K);
+    if (k < 0)
+        k = 0;
+    if (k >= s->K)
+        k = s->K - 1;
+    double a = (double)k / s->K;
+    double *y = malloc((size_t)s->n * sizeof *y);
+    propagate(s, a, w - a, s->Y + (size_t)k * s->n, y);
+    double v = y[4 * m + d] * pow(s->s, d);
+    free(y);
+    return v;
+}
+
+void indep_free(indep_solution *s)
+{
+    if (!s)
+        return;
+    free(s->A);
+    free(s->Y);
+    free(s->qbuf);
+    free(s);
+}
+
+int close_rel(double a, double b, double tol, double floor)
+{
+    return fabs(a - b) <= tol * fmax(fmax(fabs(a), fabs(b)), floor);
+}
+
+/* ---- factors ---- */
+
+pde_factor F_pow(int n) { return (pde_factor){ PDE_POW, n }; }
+pde_factor F_sin(double k) { return (pde_factor){ PDE_SIN, k }; }
+pde_factor F_cos(double k) { return (pde_factor){ PDE_COS, k }; }
+pde_factor F_exp(double a) { return (pde_factor){ PDE_EXP, a }; }
+pde_factor F_sinh(double a) { return (pde_factor){ PDE_SINH, a }; }
+pde_factor F_cosh(double a) { return (pde_factor){ PDE_COSH, a }; }
+
+double tfactor(pde_factor f, double t, int n)
+{
+    double k = f.p * M_PI, a = f.p;
+    switch (f.kind) {
+    case PDE_POW: {
+        double c = 1.0;
+        int p = (int)f.p;
+        if (n > p)
+            return 0.0;
+        for (int i = 0; i < n; i++)
+            c *= p - i;
+        return c * pow(t, p - n);
+    }
+    case PDE_SIN: return pow(k, n) * sin(k * t + n * M_PI / 2);
+    case PDE_COS: return pow(k, n) * cos(k * t + n * M_PI / 2);
+    case PDE_EXP: return pow(a, n) * exp(a * t);
+    case PDE_SINH: return pow(a, n) * (n % 2 ? cosh(a * t) : sinh(a * t));
+    case PDE_COSH: return pow(a, n) * (n % 2 ? sinh(a * t) : cosh(a * t));
+    }
+    return NAN;
+}
+
+/* ---- the paper's figures ---- */
+
+static pde_bterm fig_b[3][2];
+static pde_fterm fig_f[2];
+
+/* Example 1, eq. (17): a[0..3], b[0..3], primes, h0, h1 and primes. */
+static void example1(pde_model *m, const double a[4], const double ap[4], const double b[4],
+                     const double bp[4], double h0, double h0p, double h1, double h1p)
+{
+    fig_b[0][0] = (pde_bterm){ F_pow(0), F_pow(0), a[0], ap[0], a[2], ap[2] };
+    fig_b[0][1] = (pde_bterm){ F_pow(1), F_pow(0), a[1], ap[1], a[3], ap[3] };
+    fig_b[1][0] = (pde_bterm){ F_pow(0), F_pow(0), b[0], bp[0], b[2], bp[2] };
+    fig_b[1][1] = (pde_bterm){ F_pow(0), F_pow(1), b[1], bp[1], b[3], bp[3] };
+    fig_b[2][0] = (pde_bterm){ F_pow(0), F_pow(0), h0, h0p, h1, h1p };
+    memset(m, 0, sizeof *m);
+    for (int c = 0; c < 3; c++) {
+        /* Not given in the paper, and immaterial: every mode has e = 0. */
+        m->comp[c] = (pde_component){ 1, 1, -10, fig_b[c], c < 2 ? 2 : 1, NULL, 0 };
+    }
+}
+
+/* Example 4, eqs. (25) and (28). */
+static void example4(pde_model *m, double b, double c, double r0, double r0p, double r1, double r1p,
+                     double h0, double h0p, double h1, double h1p, double p0, double xi)
+{
+    fig_b[0][0] = (pde_bterm){ F_pow(1), F_sin(2), r0, r0p, r1, r1p };
+    fig_b[1][0] = (pde_bterm){ F_pow(1), F_cos(2), r0, r0p, r1, r1p };
+    fig_b[2][0] = (pde_bterm){ F_pow(0), F_pow(0), h0, h0p, h1, h1p };
+    fig_f[0] = (pde_fterm){ p0, F_pow(1), F_cos(2), F_sin(xi) };
+    fig_f[1] = (pde_fterm){ p0, F_pow(1), F_sin(2), F_sin(xi) };
+    memset(m, 0, sizeof *m);
+    m->comp[0] = (pde_component){ 1, b, c, fig_b[0], 1, &fig_f[0], 1 };
+    m->comp[1] = (pde_component){ 1, b, c, fig_b[1], 1, &fig_f[1], 1 };
+    m->comp[2] = (pde_component){ 1, 1, -10, fig_b[2], 1, NULL, 0 };
+}
+
+static const double fig4[24][12] = {
+    /* b, c, r0, r0', r1, r1', h0, h0', h1, h1', p0, xi */
+    { 1, -9.5, 0.5, 0, 0.5, 0, 0, 0, 3, 7.5, 3e4, 3 },
+    { 2.5, -10, 0.5, 2.5, 0.5, 2.5, 0, 0, 3, 3, 8e4, 5 },
+    { 4, -100, 0.5, 2.5, 0.5, 2.5, 0, 0, 3, 6, 1.8e6, 7 },
+    { 4, -10, 0.5, -1.5, 0.5, 2, 0, 3, 3, 6, 3e5, 7 },
+    { 4, -10, 0.5, -1.5, 0.5, 2, 0, 3, 3, 6, -3e5, 7 },
+    { 2.5, -10, 0.5, -1.5, 0.5, 1.5, 0, 6, 3, 4.5, 1e5, 7 },
+    { 2.5, -10, 0.5, -1.5, 0.5, 2, 0, 3, 3, 9, -3e4, 5 },
+    { 2.5, -10, 0.5, -1, 0.5, 0.5, 0, 3, 3, 6, 1.5e4, 3 },
+    { 2.5, -10, 0.8, 0.8, 0.5, -1.6, 0, 3, 3, 6, 1.5e4, 3 },
+    { 2.5, -10, 0.6, -1.8, 0.5, -0.6, 0, 3, 3, 6, -5.5e4, 5 },
+    { 2.5, -10, 0.6, -1.8, 0.5, -0.6, 0, 3, 3, 6, 5.5e4, 5 },
+    { 3.5, -10, 0.8, -2.4, 0.5, 0.5, 0, 3, 3, 9, -5.5e4, 5 },
+    { 3.5, -10, 0.8, -2.4, 0.5, 0.5, 0, 3, 3, 9, 5.5e4, 9 },
+    { 5, -20, 1.5, -4.5, 0.5, 0, 0, 3, 3, 3, 5e5, 7 },
+    { 3, -20, 1, -5, 0.5, -1, 0, 6, 3, 6, -9e5, 11 },
+    { 15, -40, 1, -2, 0.5, -1, 0, 6, 3, 4.5, 3e6, 11 },
+    { 1, -10, 1, 3, 0.5, -1, 0, 6, 3, 9, 3e4, 3 },
+    { 1, -10, 1, -3, 0.5, -2, 0, 9, 3, 3, 3e4, 3 },
+    { 1, -10, 1, -3, 0.5, -2, 0, 9, 3, 3, 3e5, 7 },
+    { 1, -10, 1, -3, 0.5, -1, 0, 9, 3, 0, 3e5, 5 },
+    { 1, -10, 1, 3, 0.5, 1, 0, 9, 3, 7.5, 3e4, 5 },
+    { 1, -10, 1, 1, 0.5, 3, 0, 3, 3, 9, 5e5, 9 },
+    { 1, -10, 1, 6, 0.5, 3, 0, 3, 3, 10.5, 3e5, 9 },
+    { 1, -10, 0.8, -4, 1, -2.4, 0, 6, 3, 9, 5e5, 7 },
+};
+
+static const char *const fig_names[] = {
+    "fig1a", "fig1c", "fig1e", "fig1g", "fig2a", "fig2b", "fig2c", "fig3a", "fig3b", "fig3c", "fig3d",
+    "fig4a", "fig4b", "fig4c", "fig4d", "fig4e", "fig4f", "fig4g", "fig4h", "fig4i", "fig4j", "fig4k",
+    "fig4l", "fig4m", "fig4n", "fig4o", "fig4p", "fig4q", "fig4r", "fig4s", "fig4t", "fig4u", "fig4v",
+    "fig4w", "fig4x" };
+
+size_t paper_figure_count(void)
+{
+    return sizeof fig_names / sizeof *fig_names;
+}
+
+const char *paper_figure_name(size_t i)
+{
+    return fig_names[i];
+}
+
+void paper_figure_model(size_t i, pde_model *m)
+{
+    if (i < 4) {
+        /* Fig. 1a, then 1c, 1e, 1g as the text changes the parameters. */
+        double a[4] = { -0.5, 1, -0.5, 1 }, b[4] = { -0.5, 1, -0.5, 1 }, ap[4] = { 0 }, bp[4] = { 0 };
+        double h0 = 0, h1 = 1, h0p = 0, h1p = 0;
+        if (i >= 1)
+            a[2] = b[2] = -1, a[3] = b[3] = h1 = 2;
+        if (i >= 2) {
+            a[0] = -0.5, a[1] = 1.5, a[2] = b[0] = -1, a[3] = b[1] = 3, b[2] = -0.4, b[3] = 1;
+            h0 = 0, h1 = 2;
+            memcpy(ap, a, sizeof a);
+            memcpy(bp, b, sizeof b);
+            h0p = h1, h1p = 2 * h1;
+        }
+        if (i == 3) {
+            ap[0] = 2.5 * a[0], ap[1] = 2.5 * a[1], ap[2] = -2 * a[2], ap[3] = -2 * a[3];
+            bp[0] = -2.5 * b[0], bp[1] = -2.5 * b[1], h1p = h1;
+        }
+        example1(m, a, ap, b, bp, h0, h0p, h1, h1p);
+        return;
+    }
+    if (i < 7) {
+        /* Example 2, eq. (19): r0 = r0' = a0 = 0.5, b0 = 1, h1 = 2, the rest 0. */
+        static const double bc[3][2] = { { 4, -100 }, { 2.5, -10 }, { 4, -10 } };
+        fig_b[0][0] = (pde_bterm){ F_pow(1), F_sin(2), 0.5, 0.5, 0.5, 0 };
+        fig_b[1][0] = (pde_bterm){ F_pow(1), F_cos(2), 0.5, 0.5, 1, 0 };
+        fig_b[2][0] = (pde_bterm){ F_pow(0), F_pow(0), 0, 0, 2, 0 };
+        memset(m, 0, sizeof *m);
+        for (int c = 0; c < 3; c++)
+            m->comp[c] = (pde_component){ 1, bc[i - 4][0], bc[i - 4][1], fig_b[c], 1, NULL, 0 };
+        return;
+    }
+    if (i < 11) {
+        /* Example 3, eq. (22). */
+        static const double v[4][3] = { { 20, 0, 0.5 }, { 30, 0, 0.5 }, { 8, 10, 0.8 }, { 14, 6, 0.8 } };
+        double nxy = v[i - 7][0], nz = v[i - 7][1], r2 = v[i - 7][2];
+        double r0 = 0.5, r1 = 0.1, h0 = 2, h1 = 0.1, h2 = 0, h3 = -0.1;
+        fig_b[0][0] = (pde_bterm){ F_pow(1), F_sin(2), r0, 0, r2, 0 };
+        fig_b[0][1] = (pde_bterm){ F_pow(1), F_sin(nxy), r1, 0, 0, 0 };
+        fig_b[1][0] = (pde_bterm){ F_pow(1), F_cos(2), r0, 0, r2, 0 };
+        fig_b[1][1] = (pde_bterm){ F_pow(1), F_cos(nxy), r1, 0, 0, 0 };
+        fig_b[2][0] = (pde_bterm){ F_pow(0), F_pow(0), h0, 0, h2, 0 };
+        fig_b[2][1] = (pde_bterm){ F_pow(1), F_sin(nz), h1, 0, h3, 0 };
+        memset(m, 0, sizeof *m);
+        for (int c = 0; c < 3; c++)
+            m->comp[c] = (pde_component){ 1, 2.5, -10, fig_b[c], 2, NULL, 0 };
+        return;
+    }
+    const double *p = fig4[i - 11];
+    example4(m, p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9], p[10], p[11]);
+}
+
+char *read_file(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    size_t cap = 4096, n = 0;
+    char *buf = malloc(cap + 1);
+    size_t got;
+    while ((got = fread(buf + n, 1, cap - n, f)) > 0) {
+        n += got;
+        if (n == cap)
+            buf = realloc(buf, (cap *= 2) + 1);
+    }
+    fclose(f);
+    buf[n] = '\0';
+    if (len)
+        *len = n;
+    return buf;
+}

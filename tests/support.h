@@ -1,0 +1,72 @@
+/*
+ * support.h: what the tests share. Above all an independent solver of the
+ * boundary value problems the core solves in closed form, written another
+ * way: multiple shooting on the first-order system, with a Taylor matrix
+ * exponential on each short interval, Gauss-Legendre quadrature of the force,
+ * and a banded pivoted solve of the continuity and boundary equations.
+ */
+#ifndef TEST_SUPPORT_H
+#define TEST_SUPPORT_H
+
+#include <stddef.h>
+
+#include "pde.h"
+
+/*
+ * M coupled modes: c h_m'''' + mu_m h_m + sum_k K[m][k] h_k = q_m(w) on [0,1],
+ * with h_m(0), h_m'(0), h_m(1), h_m'(1) = bc[4m .. 4m+3].
+ */
+typedef struct {
+    int M;
+    double c;
+    const double *mu;      /* M */
+    const double *K;       /* M x M, row-major, or NULL */
+    const double *bc;      /* 4 M */
+    void (*q)(double w, double *out, void *ctx);   /* fills M values, or NULL */
+    void *ctx;
+    double freq;           /* fastest angular frequency or rate in q */
+} indep_problem;
+
+typedef struct indep_solution indep_solution;
+
+indep_solution *indep_solve(const indep_problem *p);
+/* h_m^(d)(w) for d = 0..3. */
+double indep_eval(const indep_solution *s, int m, int d, double w);
+void indep_free(indep_solution *s);
+
+/* |a - b| <= tol * max(|a|, |b|, floor): a relative test with an absolute floor. */
+int close_rel(double a, double b, double tol, double floor);
+
+#define assert_rel(a, b, tol, floor)                                                          \
+    do {                                                                                      \
+        double a_ = (a), b_ = (b);                                                            \
+        if (!close_rel(a_, b_, (tol), (floor)))                                               \
+            fail_msg("%s = %.17g, %s = %.17g, relative difference %.3g > %g", #a, a_, #b, b_,  \
+                     fabs(a_ - b_) / fmax(fmax(fabs(a_), fabs(b_)), (floor)), (double)(tol)); \
+    } while (0)
+
+/* Factors, to write models briefly. */
+pde_factor F_pow(int n);
+pde_factor F_sin(double k);
+pde_factor F_cos(double k);
+pde_factor F_exp(double a);
+pde_factor F_sinh(double a);
+pde_factor F_cosh(double a);
+
+/* f^(n)(t), written again here so that tests do not lean on the core's own. */
+double tfactor(pde_factor f, double t, int n);
+
+/*
+ * The paper's solids, built from its four examples' parameters as the text
+ * gives them (figures 1a, 1c, 1e, 1g, 2a-2c, 3a-3d, 4a-4x): a test's own
+ * transcription. names[i] is "fig1a" and so on; returns the number of them.
+ * A built model points into static storage: use it before the next call.
+ */
+size_t paper_figure_count(void);
+const char *paper_figure_name(size_t i);
+void paper_figure_model(size_t i, pde_model *m);
+
+/* Reads a whole file into a NUL-terminated buffer; NULL on failure. */
+char *read_file(const char *path, size_t *len);
+
+#endif
