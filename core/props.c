@@ -22,6 +22,7 @@ static const double gl_w[GL_N] = { 0.1012285362903763, 0.2223810344533745, 0.313
                                    0.3626837833783620, 0.3626837833783620, 0.3137066458778873,
                                    0.2223810344533745, 0.1012285362903763 };
 #define MAX_PANELS 64
+#define MAX_NODES (2u << 20)   /* quadrature nodes in all, to bound the time */
 
 static double det3(const double a[3], const double b[3], const double c[3])
 {
@@ -56,6 +57,11 @@ static void panel_counts(const pde_solution *s, int np[3])
     for (int a = 0; a < 3; a++) {
         double n = 1.0 + f[a] / 3.0;
         np[a] = n > MAX_PANELS ? MAX_PANELS : (int)n;
+    }
+    /* Fast oscillation along all three axes: halve the busiest axis until the work is bounded. */
+    while ((size_t)np[0] * np[1] * np[2] * GL_N * GL_N * GL_N > MAX_NODES) {
+        int a = np[0] >= np[1] && np[0] >= np[2] ? 0 : np[1] >= np[2] ? 1 : 2;
+        np[a] = (np[a] + 1) / 2;
     }
 }
 

@@ -1,0 +1,255 @@
+/*
+ * test_props.c: properties of solids, and the accuracy of every paper
+ * figure's solution: boundary conditions against the model's own boundary
+ * terms, and the PDE by finite differences of the evaluated solution.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "support.h"
+
+static double hermite(const double d[4], double w, int der)
+{
+    double H[4], D[4];
+    H[0] = 2 * w * w * w - 3 * w * w + 1, D[0] = 6 * w * w - 6 * w;
+    H[1] = w * w * w - 2 * w * w + w, D[1] = 3 * w * w - 4 * w + 1;
+    H[2] = -2 * w * w * w + 3 * w * w, D[2] = -6 * w * w + 6 * w;
+    H[3] = w * w * w - w * w, D[3] = 3 * w * w - 2 * w;
+    double s = 0;
+    for (int i = 0; i < 4; i++)
+        s += d[i] * (der ? D[i] : H[i]);
+    return s;
+}
+
+static pde_solution *figure(size_t i, pde_model *m)
+{
+    paper_figure_model(i, m);
+    pde_solution *sol = NULL;
+    pde_diag d;
+    if (pde_solve(m, &sol, &d) != PDE_OK)
+        fail_msg("%s: %s", paper_figure_name(i), d.message);
+    return sol;
+}
+
+static void props_should_give_unit_volume_and_exact_bounds_for_the_cuboid(void **state)
+{
+    (void)state;
+    pde_model m;
+    pde_solution *sol = figure(0, &m);   /* fig. 1a: x = u - 1/2, y = v - 1/2, z = 3w^2 - 2w^3 */
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    assert_rel(p.volume, 1.0, 1e-12, 0);
+    assert_rel(p.signed_volume, 1.0, 1e-12, 0);
+    const double lo[3] = { -0.5, -0.5, 0 }, hi[3] = { 0.5, 0.5, 1 };
+    for (int c = 0; c < 3; c++) {
+        assert_rel(p.bbox_min[c], lo[c], 1e-12, 1);
+        assert_rel(p.bbox_max[c], hi[c], 1e-12, 1);
+    }
+    /* det J = z'(w) = 6w(1 - w): 0 on the faces w = 0, 1, and 1.5 at w = 1/2. */
+    assert_rel(p.detj_min, 0.0, 1e-12, 1);
+    assert_rel(p.detj_max, 1.5, 1e-9, 1);
+    assert_false(p.folds);
+    assert_true(p.bc_residual < 1e-14);
+    assert_true(p.pde_residual < 1e-14);
+    pde_solution_free(sol);
+}
+
+static void props_should_match_the_hand_integrated_volume_of_figure_1(void **state)
+{
+    (void)state;
+    for (size_t f = 1; f < 4; f++) {
+        pde_model m;
+        pde_solution *sol = figure(f, &m);
+        /* x = X0(w) + X1(w) u, y = Y0 + Y1 v, z = Z(w): det J = X1 Y1 Z'. */
+        const pde_bterm *xb = &m.comp[0].bterms[1], *yb = &m.comp[1].bterms[1], *zb = &m.comp[2].bterms[0];
+        double dx[4] = { xb->w0, xb->dw0, xb->w1, xb->dw1 }, dy[4] = { yb->w0, yb->dw0, yb->w1, yb->dw1 };
+        double dz[4] = { zb->w0, zb->dw0, zb->w1, zb->dw1 };
+        int n = 200000;
+        double vol = 0, svol = 0;
+        for (int i = 0; i <= n; i++) {   /* Simpson */
+            double w = (double)i / n, wt = (i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2);
+            double dj = hermite(dx, w, 0) * hermite(dy, w, 0) * hermite(dz, w, 1);
+            vol += wt * fabs(dj);
+            svol += wt * dj;
+        }
+        vol /= 3.0 * n;
+        svol /= 3.0 * n;
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        assert_rel(p.volume, vol, 1e-6, 0);   /* |det J| has kinks, where Simpson is O(h^2) */
+        assert_rel(p.signed_volume, svol, 1e-10, 0);
+        pde_solution_free(sol);
+    }
+}
+
+static void props_should_flag_a_solid_that_folds(void **state)
+{
+    (void)state;
+    /* The cuboid, with z'(0) = -6: z goes down before it goes up, so det J = z' changes sign. */
+    pde_bterm bx = { F_pow(1), F_pow(0), 1, 0, 1, 0 }, by = { F_pow(0), F_pow(1), 1, 0, 1, 0 };
+    pde_bterm bz = { F_pow(0), F_pow(0), 0, -6, 1, 0 };
+    pde_model m = { { { 1, 1, -1, &bx, 1, NULL, 0 }, { 1, 1, -1, &by, 1, NULL, 0 }, { 1, 1, -1, &bz, 1, NULL, 0 } } };
+    pde_solution *sol = NULL;
+    assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    assert_true(p.folds);
+    /* z = -8w^3 + 15w^2 - 6w by hand, z' = -24w^2 + 30w - 6: least at w = 0, where det J = -6,
+     * greatest at w = 5/8, 3.375. */
+    assert_rel(p.detj_min, -6.0, 1e-9, 1);
+    assert_true(p.detj_min_at[2] < 1e-6);
+    assert_rel(p.detj_max, 3.375, 1e-9, 1);
+    assert_true(p.volume > p.signed_volume);
+    pde_props_opts bad = { 1 };
+    assert_int_equal(pde_properties(sol, &bad, &p), PDE_ERR_INVALID);
+    pde_solution_free(sol);
+}
+
+/* Per-axis rate of change of a model, to size the difference steps. */
+static double rate(const pde_model *m, const pde_solution *sol, int axis)
+{
+    double r = 1.0;
+    for (int c = 0; c < 3; c++) {
+        const pde_component *k = &m->comp[c];
+        for (size_t j = 0; j < k->nbterms + k->nfterms; j++) {
+            pde_factor f = j < k->nbterms ? (axis ? k->bterms[j].v : k->bterms[j].u)
+                                          : (axis ? k->fterms[j - k->nbterms].v : k->fterms[j - k->nbterms].u);
+            if (axis == 2 && j >= k->nbterms)
+                f = k->fterms[j - k->nbterms].w;
+            else if (axis == 2)
+                continue;
+            r = fmax(r, f.kind == PDE_SIN || f.kind == PDE_COS ? fabs(f.p) * M_PI : fabs(f.p));
+        }
+        if (axis == 2) {
+            size_t nm;
+            const pde_mode *md = pde_solution_modes(sol, c, &nm);
+            for (size_t i = 0; i < nm; i++)
+                r = fmax(r, pow(fabs(md[i].e), 0.25));
+        }
+    }
+    return r;
+}
+
+/* d4 x_comp along an axis: Richardson on the 5-point fourth difference. */
+static double d4(const pde_solution *sol, int comp, const double p[3], int axis, double h)
+{
+    double d[2];
+    for (int r = 0; r < 2; r++) {
+        double hh = r ? 2 * h : h, s = 0;
+        static const double st[5] = { 1, -4, 6, -4, 1 };
+        for (int i = 0; i < 5; i++) {
+            double q[3] = { p[0], p[1], p[2] }, x[3];
+            q[axis] += (i - 2) * hh;
+            pde_eval(sol, q[0], q[1], q[2], x);
+            s += st[i] * x[comp];
+        }
+        d[r] = s / (hh * hh * hh * hh);
+    }
+    return (4 * d[0] - d[1]) / 3;
+}
+
+static void check_accuracy(const pde_model *m, const pde_solution *sol, const char *name)
+{
+    /* Boundary conditions, against the model's terms evaluated here. */
+    for (int c = 0; c < 3; c++) {
+        double err = 0, scale = 0;
+        for (int i = 0; i <= 20; i++)
+            for (int j = 0; j <= 40; j++) {
+                double u = i / 20.0, v = j / 40.0, g[4] = { 0, 0, 0, 0 };
+                for (size_t t = 0; t < m->comp[c].nbterms; t++) {
+                    const pde_bterm *b = &m->comp[c].bterms[t];
+                    double f = tfactor(b->u, u, 0) * tfactor(b->v, v, 0);
+                    g[0] += b->w0 * f, g[1] += b->dw0 * f, g[2] += b->w1 * f, g[3] += b->dw1 * f;
+                }
+                for (int side = 0; side < 2; side++) {
+                    double x[3], xw[3];
+                    pde_eval_d(sol, u, v, side, x, NULL, NULL, xw);
+                    err = fmax(err, fmax(fabs(x[c] - g[2 * side]), fabs(xw[c] - g[2 * side + 1])));
+                    scale = fmax(scale, fmax(fabs(g[2 * side]), fabs(g[2 * side + 1])));
+                }
+            }
+        if (err > 1e-12 * fmax(scale, 1e-300))
+            fail_msg("%s: component %d boundary residual %.3g relative to %.3g", name, c, err, scale);
+    }
+    /* The PDE, by differences, inside the cube. */
+    double h[3], r4[3];
+    for (int a = 0; a < 3; a++) {
+        double r = rate(m, sol, a);
+        h[a] = 0.01 / r;
+        r4[a] = r * r * r * r;
+    }
+    for (int c = 0; c < 3; c++) {
+        const pde_component *k = &m->comp[c];
+        /* Differences resolve d4 x only to about eps |x| / h^4: measure against that scale too. */
+        double err = 0, scale = 0, size = 0;
+        for (int i = 0; i < 27; i++) {
+            const double p[3] = { 0.2 + 0.25 * (i % 3), 0.2 + 0.25 * (i / 3 % 3), 0.2 + 0.25 * (i / 9) };
+            double tu = k->a * d4(sol, c, p, 0, h[0]), tv = k->b * d4(sol, c, p, 1, h[1]);
+            double tw = k->c * d4(sol, c, p, 2, h[2]), f = 0;
+            for (size_t t = 0; t < k->nfterms; t++) {
+                const pde_fterm *ft = &k->fterms[t];
+                f += ft->coef * tfactor(ft->u, p[0], 0) * tfactor(ft->v, p[1], 0) * tfactor(ft->w, p[2], 0);
+            }
+            double x[3];
+            pde_eval(sol, p[0], p[1], p[2], x);
+            err = fmax(err, fabs(tu + tv + tw - f));
+            scale = fmax(scale, fabs(tu) + fabs(tv) + fabs(tw) + fabs(f));
+            size = fmax(size, (fabs(k->a) * r4[0] + fabs(k->b) * r4[1] + fabs(k->c) * r4[2]) * fabs(x[c]));
+        }
+        scale = fmax(scale, size);
+        if (err > 1e-5 * scale)
+            fail_msg("%s: component %d PDE residual %.3g relative to %.3g", name, c, err, scale);
+    }
+    /* And the solution's own certificate agrees. */
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    if (!(p.bc_residual <= 1e-12 && p.pde_residual <= 1e-10))
+        fail_msg("%s: certificate bc %.3g pde %.3g", name, p.bc_residual, p.pde_residual);
+}
+
+static void every_paper_figure_should_meet_its_boundary_conditions_and_the_pde(void **state)
+{
+    (void)state;
+    for (size_t i = 0; i < paper_figure_count(); i++) {
+        pde_model m;
+        pde_solution *sol = figure(i, &m);
+        check_accuracy(&m, sol, paper_figure_name(i));
+        pde_solution_free(sol);
+    }
+}
+
+static void stiff_models_should_meet_their_boundary_conditions_and_the_pde(void **state)
+{
+    (void)state;
+    const double k[3] = { 100, 200, 300 };
+    for (int i = 0; i < 3; i++) {
+        pde_bterm bt[2] = { { F_pow(1), F_sin(k[i]), 0.5, 1, 0.25, -1 }, { F_pow(0), F_pow(0), 1, 0, 2, 0 } };
+        pde_fterm ft = { 1e6, F_pow(1), F_cos(k[i]), F_sin(3) };
+        for (int sign = -1; sign <= 1; sign += 2) {
+            pde_model m = { { { 1, 1, sign, bt, 2, &ft, 1 }, { 1, 1, -1, &bt[1], 1, NULL, 0 },
+                              { 1, 1, -1, &bt[1], 1, NULL, 0 } } };
+            pde_solution *sol = NULL;
+            assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
+            check_accuracy(&m, sol, "stiff");
+            pde_solution_free(sol);
+        }
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(props_should_give_unit_volume_and_exact_bounds_for_the_cuboid),
+        cmocka_unit_test(props_should_match_the_hand_integrated_volume_of_figure_1),
+        cmocka_unit_test(props_should_flag_a_solid_that_folds),
+        cmocka_unit_test(every_paper_figure_should_meet_its_boundary_conditions_and_the_pde),
+        cmocka_unit_test(stiff_models_should_meet_their_boundary_conditions_and_the_pde),
+    };
+    return cmocka_run_group_tests_name("props", tests, NULL, NULL);
+}
