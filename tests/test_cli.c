@@ -1,0 +1,182 @@
+/*
+ * test_cli.c: build/pdesolid as a user runs it. eval agrees with the
+ * independent solver; solve prints the closed form and the properties; bad
+ * input exits 2 with the field's JSON pointer. $PDESOLID names the binary
+ * (build/pdesolid), $PDESOLID_SAN its sanitised twin for the error paths.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cJSON.h>
+#include <cmocka.h>
+
+#include "support.h"
+
+static char dir[] = "/tmp/pdesolid-cli-XXXXXX";
+static char bins[2][4096];   /* absolute paths of the plain and the sanitised binary */
+
+static int setup(void **state)
+{
+    (void)state;
+    const char *names[2] = { getenv("PDESOLID"), getenv("PDESOLID_SAN") };
+    const char *dflt[2] = { "build/pdesolid", "build/san/pdesolid" };
+    for (int i = 0; i < 2; i++)
+        if (!realpath(names[i] ? names[i] : dflt[i], bins[i])) {
+            fprintf(stderr, "test_cli: no %s; run `make test`\n", names[i] ? names[i] : dflt[i]);
+            return -1;
+        }
+    return mkdtemp(dir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static void write_text(const char *name, const char *text)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* Runs the tool; returns its exit status, with stdout and stderr in *out and *err (free them). */
+static int run(int sanitised, const char *args, char **out, char **err)
+{
+    char cmd[4096 + 1024];
+    snprintf(cmd, sizeof cmd, "cd %s && %s %s >out.txt 2>err.txt", dir, bins[sanitised], args);
+    int st = system(cmd);
+    char path[256];
+    snprintf(path, sizeof path, "%s/out.txt", dir);
+    *out = read_file(path, NULL);
+    snprintf(path, sizeof path, "%s/err.txt", dir);
+    *err = read_file(path, NULL);
+    assert_true(WIFEXITED(st));
+    return WEXITSTATUS(st);
+}
+
+static void q4a(double w, double *out, void *ctx)
+{
+    (void)ctx;
+    out[0] = 0.0;
+    out[1] = 3e4 * sin(3 * M_PI * w);
+}
+
+static void eval_should_agree_with_the_independent_solution(void **state)
+{
+    (void)state;
+    char *model = read_file("examples/fig4a.json", NULL);
+    assert_non_null(model);
+    write_text("fig4a.json", model);
+    free(model);
+    const double pts[][3] = { { 0.5, 0.25, 0 }, { 1, 0.125, 0.5 }, { 0.3, 0.7, 0.4 }, { 0.9, 0.05, 0.97 },
+                              { 0, 0.5, 0.5 }, { 1, 1, 1 }, { 0.61, 0.33, 0.02 } };
+    size_t np = sizeof pts / sizeof *pts;
+    char text[1024] = "[", *p = text + 1;
+    for (size_t i = 0; i < np; i++)
+        p += sprintf(p, "%s[%.17g,%.17g,%.17g]", i ? "," : "", pts[i][0], pts[i][1], pts[i][2]);
+    strcpy(p, "]");
+    write_text("pts.json", text);
+    char *out, *err;
+    assert_int_equal(run(0, "eval fig4a.json pts.json", &out, &err), 0);
+    cJSON *arr = cJSON_Parse(out);
+    assert_non_null(arr);
+    assert_int_equal(cJSON_GetArraySize(arr), (int)np);
+    /* x and y: modes u sin 2pi v (boundary) and u cos 2pi v (force), b = 1, c = -9.5, by
+     * multiple shooting; z: the Hermite cubic with z(1) = 3, z'(1) = 7.5. */
+    double mu = pow(2 * M_PI, 4), mus[2] = { mu, mu }, bc[8] = { 0.5, 0, 0.5, 0, 0, 0, 0, 0 };
+    indep_problem prob = { 2, -9.5, mus, NULL, bc, q4a, NULL, 3 * M_PI };
+    indep_solution *ind = indep_solve(&prob);
+    for (size_t i = 0; i < np; i++) {
+        double u = pts[i][0], v = pts[i][1], w = pts[i][2];
+        double h0 = indep_eval(ind, 0, 0, w), h1 = indep_eval(ind, 1, 0, w);
+        double want[3] = { h0 * u * sin(2 * M_PI * v) + h1 * u * cos(2 * M_PI * v),
+                           h0 * u * cos(2 * M_PI * v) + h1 * u * sin(2 * M_PI * v),
+                           3 * (3 * w * w - 2 * w * w * w) + 7.5 * (w * w * w - w * w) };
+        cJSON *row = cJSON_GetArrayItem(arr, (int)i);
+        for (int c = 0; c < 3; c++)
+            assert_rel(cJSON_GetArrayItem(row, c)->valuedouble, want[c], 1e-10, 1.0);
+    }
+    indep_free(ind);
+    cJSON_Delete(arr);
+    free(out);
+    free(err);
+}
+
+static void solve_should_print_the_closed_form_and_properties(void **state)
+{
+    (void)state;
+    char *out, *err;
+    assert_int_equal(run(0, "solve fig4a.json", &out, &err), 0);
+    const char *want[] = { "x(u,v,w) = sum over 2 modes", "u * sin(2*pi*v)", "t = e^(1/4) = 3.578895",
+                           "sin(9.424777961*w)", "z(u,v,w) = sum over 1 mode", "(1.5*w^2 + 1.5*w^3)",
+                           "bounding box:", "volume:", "det J: min", "folds:", "accuracy:" };
+    for (size_t i = 0; i < sizeof want / sizeof *want; i++)
+        if (!strstr(out, want[i]))
+            fail_msg("missing \"%s\" in:\n%s", want[i], out);
+    free(out);
+    free(err);
+}
+
+static void bad_input_should_exit_2_and_name_the_field(void **state)
+{
+    (void)state;
+    write_text("bad.json", "{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[-1,-1,-1]},"
+                           "\"boundary\":{\"x\":[{\"u\":{\"pow\":1.5}}]}}");
+    write_text("zero.json", "{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[-1,0,-1]}}");
+    write_text("pts.json", "[[0,0,0]]");
+    write_text("badpts.json", "[[0,0]]");
+    const struct {
+        const char *args, *words;
+        int status;
+    } cases[] = {
+        { "eval bad.json pts.json", "bad.json: /boundary/x/0/u/pow: the power must be a whole number", 2 },
+        { "solve bad.json", "/boundary/x/0/u/pow", 2 },
+        { "solve zero.json", "zero.json: /pde/c/1: c of component y is 0", 2 },
+        { "eval zero.json badpts.json", "badpts.json: /0: must be a point", 2 },
+        { "solve missing.json", "missing.json: No such file", 1 },
+        { "frobnicate", "unknown command", 2 },
+        { "", "usage:", 2 },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        char *out, *err;
+        int st = run(1, cases[i].args, &out, &err);
+        if (st != cases[i].status || !strstr(err, cases[i].words))
+            fail_msg("pdesolid %s: status %d, stderr: %s", cases[i].args, st, err);
+        free(out);
+        free(err);
+    }
+    char *out, *err;
+    assert_int_equal(run(1, "--help", &out, &err), 0);
+    assert_non_null(strstr(out, "eval MODEL.json POINTS.json"));
+    free(out);
+    free(err);
+    assert_int_equal(run(1, "eval - pts.json <bad.json", &out, &err), 2);
+    assert_non_null(strstr(err, "-: /boundary/x/0/u/pow"));
+    free(out);
+    free(err);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(eval_should_agree_with_the_independent_solution),
+        cmocka_unit_test(solve_should_print_the_closed_form_and_properties),
+        cmocka_unit_test(bad_input_should_exit_2_and_name_the_field),
+    };
+    return cmocka_run_group_tests_name("cli", tests, setup, teardown);
+}
