@@ -163,7 +163,7 @@ static int term_array(const cJSON *j, const char *ptr, size_t *n, api_error *err
 static int parse_bterms(const cJSON *j, const char *ptr, api_model *m, int ci, api_error *err)
 {
     static const char *const keys[] = { "u", "v", "w0", "dw0", "w1", "dw1", NULL };
-    size_t n;
+    size_t n = 0;
     if (term_array(j, ptr, &n, err))
         return -1;
     m->b[ci] = calloc(n ? n : 1, sizeof *m->b[ci]);
@@ -197,7 +197,7 @@ static int parse_bterms(const cJSON *j, const char *ptr, api_model *m, int ci, a
 static int parse_fterms(const cJSON *j, const char *ptr, api_model *m, int ci, api_error *err)
 {
     static const char *const keys[] = { "coef", "u", "v", "w", NULL };
-    size_t n;
+    size_t n = 0;
     if (term_array(j, ptr, &n, err))
         return -1;
     m->f[ci] = calloc(n ? n : 1, sizeof *m->f[ci]);

@@ -78,12 +78,13 @@ void pde_grid_free(pde_grid *g)
     if (!g)
         return;
     for (int c = 0; c < 3; c++) {
+        free(g->group[c]);
         free(g->phi[c]);
         free(g->psi[c]);
         free(g->h[c]);
+        free(g->k[c]);
     }
     free(g->row);
-    free(g->coef);
     free(g);
 }
 
@@ -98,31 +99,38 @@ pde_status pde_grid_create(const pde_solution *sol, const double *us, size_t nu,
     g->sol = sol;
     g->nu = nu;
     g->nv = nv;
-    g->maxm = 1;
-    for (int c = 0; c < 3; c++)
-        if (sol->comp[c].nmodes > g->maxm)
-            g->maxm = sol->comp[c].nmodes;
     g->row = malloc(12 * nu * sizeof *g->row);
-    g->coef = malloc(3 * g->maxm * sizeof *g->coef);
-    if (!g->row || !g->coef)
+    if (!g->row)
         goto nomem;
     for (int c = 0; c < 3; c++) {
-        size_t nm = sol->comp[c].nmodes, k = nm ? nm : 1;
+        const pde_mode *modes = sol->comp[c].modes;
+        size_t nm = sol->comp[c].nmodes, k = nm ? nm : 1, nd = 0;
         g->nm[c] = nm;
-        g->phi[c] = malloc(2 * k * nu * sizeof(double));
+        g->group[c] = malloc(k * sizeof *g->group[c]);
         g->psi[c] = malloc(2 * k * nv * sizeof(double));
         g->h[c] = malloc(2 * k * sizeof(double));
-        if (!g->phi[c] || !g->psi[c] || !g->h[c])
+        g->k[c] = malloc(3 * k * sizeof(double));
+        if (!g->group[c] || !g->psi[c] || !g->h[c] || !g->k[c])
             goto nomem;
-        g->dphi[c] = g->phi[c] + k * nu;
+        for (size_t m = 0; m < nm; m++) {
+            size_t d = 0;
+            while (d < m && !(modes[d].u.kind == modes[m].u.kind && modes[d].u.p == modes[m].u.p))
+                d++;
+            g->group[c][m] = d < m ? g->group[c][d] : nd++;
+        }
+        g->nd[c] = nd;
+        g->phi[c] = malloc(2 * (nd ? nd : 1) * nu * sizeof(double));
+        if (!g->phi[c])
+            goto nomem;
+        g->dphi[c] = g->phi[c] + (nd ? nd : 1) * nu;
         g->dpsi[c] = g->psi[c] + k * nv;
         g->dh[c] = g->h[c] + k;
         for (size_t m = 0; m < nm; m++) {
-            const pde_mode *md = &sol->comp[c].modes[m];
+            size_t d = g->group[c][m];
             for (size_t i = 0; i < nu; i++)
-                factor_eval(md->u, us[i], &g->phi[c][m * nu + i], &g->dphi[c][m * nu + i]);
+                factor_eval(modes[m].u, us[i], &g->phi[c][d * nu + i], &g->dphi[c][d * nu + i]);
             for (size_t j = 0; j < nv; j++)
-                factor_eval(md->v, vs[j], &g->psi[c][m * nv + j], &g->dpsi[c][m * nv + j]);
+                factor_eval(modes[m].v, vs[j], &g->psi[c][m * nv + j], &g->dpsi[c][m * nv + j]);
         }
     }
     *out = g;
@@ -132,27 +140,17 @@ nomem:
     return PDE_ERR_NOMEM;
 }
 
-/* row[i] = sum_m k_m tab[m][i]: the kernel of all sampling. */
+/* row[i] = sum_d k_d tab[d][i]. */
 static void combine(double *restrict row, const double *restrict tab, const double *restrict k,
-                    size_t nm, size_t n)
+                    size_t nd, size_t n)
 {
     for (size_t i = 0; i < n; i++)
         row[i] = 0.0;
-    for (size_t m = 0; m < nm; m++) {
-        const double km = k[m];
-        const double *restrict t = tab + m * n;
+    for (size_t d = 0; d < nd; d++) {
+        const double kd = k[d];
+        const double *restrict t = tab + d * n;
         for (size_t i = 0; i < n; i++)
-            row[i] += km * t[i];
-    }
-}
-
-static void interleave(float *restrict out, const double *restrict row, size_t n)
-{
-    const double *x = row, *y = row + n, *z = row + 2 * n;
-    for (size_t i = 0; i < n; i++) {
-        out[3 * i] = (float)x[i];
-        out[3 * i + 1] = (float)y[i];
-        out[3 * i + 2] = (float)z[i];
+            row[i] += kd * t[i];
     }
 }
 
@@ -163,43 +161,108 @@ void grid_set_w(pde_grid *g, double w)
             mode_h(&g->sol->comp[c].modes[m], w, &g->h[c][m], &g->dh[c][m]);
 }
 
+/* Each distinct u-factor's coefficient in row j: sums of h f_v over its modes. */
+static void grid_coefs(pde_grid *g, size_t j)
+{
+    for (int c = 0; c < 3; c++) {
+        const size_t nd = g->nd[c], nv = g->nv;
+        double *kx = g->k[c], *kv = kx + nd, *kw = kv + nd;
+        for (size_t d = 0; d < 3 * nd; d++)
+            kx[d] = 0.0;
+        for (size_t m = 0; m < g->nm[c]; m++) {
+            size_t d = g->group[c][m];
+            double p = g->psi[c][m * nv + j];
+            kx[d] += g->h[c][m] * p;
+            kv[d] += g->h[c][m] * g->dpsi[c][m * nv + j];
+            kw[d] += g->dh[c][m] * p;
+        }
+    }
+}
+
 void grid_row(pde_grid *g, size_t j, unsigned want)
 {
-    const size_t nu = g->nu, nv = g->nv;
-    double *kx = g->coef, *kv = g->coef + g->maxm, *kw = g->coef + 2 * g->maxm;
+    const size_t nu = g->nu;
+    grid_coefs(g, j);
     for (int c = 0; c < 3; c++) {
-        const size_t nm = g->nm[c];
-        for (size_t m = 0; m < nm; m++) {
-            double p = g->psi[c][m * nv + j];
-            kx[m] = g->h[c][m] * p;
-            kv[m] = g->h[c][m] * g->dpsi[c][m * nv + j];
-            kw[m] = g->dh[c][m] * p;
-        }
+        const size_t nd = g->nd[c];
+        const double *kx = g->k[c], *kv = kx + nd, *kw = kv + nd;
         if (want & GRID_X)
-            combine(g->row + c * nu, g->phi[c], kx, nm, nu);
+            combine(g->row + c * nu, g->phi[c], kx, nd, nu);
         if (want & GRID_XU)
-            combine(g->row + (3 + c) * nu, g->dphi[c], kx, nm, nu);
+            combine(g->row + (3 + c) * nu, g->dphi[c], kx, nd, nu);
         if (want & GRID_XV)
-            combine(g->row + (6 + c) * nu, g->phi[c], kv, nm, nu);
+            combine(g->row + (6 + c) * nu, g->phi[c], kv, nd, nu);
         if (want & GRID_XW)
-            combine(g->row + (9 + c) * nu, g->phi[c], kw, nm, nu);
+            combine(g->row + (9 + c) * nu, g->phi[c], kw, nd, nu);
     }
+}
+
+/*
+ * out[3i + c] = sum_d k[d] tab[d][i] for one component c, straight to float32:
+ * the hot loop of sampling. A row of output (12 nu bytes) stays in L1 while
+ * the three components are written into it, each by a loop specialised to its
+ * number of distinct u-factors.
+ */
+static void emit1(float *restrict out, size_t nu, const double *restrict tab, const double *restrict k,
+                  size_t nd)
+{
+    const double *restrict t0 = tab, *restrict t1 = tab + nu, *restrict t2 = tab + 2 * nu;
+    switch (nd) {
+    case 0:
+        for (size_t i = 0; i < nu; i++)
+            out[3 * i] = 0.0f;
+        return;
+    case 1:
+        for (size_t i = 0; i < nu; i++)
+            out[3 * i] = (float)(k[0] * t0[i]);
+        return;
+    case 2:
+        for (size_t i = 0; i < nu; i++)
+            out[3 * i] = (float)(k[0] * t0[i] + k[1] * t1[i]);
+        return;
+    case 3:
+        for (size_t i = 0; i < nu; i++)
+            out[3 * i] = (float)(k[0] * t0[i] + k[1] * t1[i] + k[2] * t2[i]);
+        return;
+    }
+    for (size_t i = 0; i < nu; i++) {
+        double s = 0.0;
+        for (size_t d = 0; d < nd; d++)
+            s += k[d] * tab[d * nu + i];
+        out[3 * i] = (float)s;
+    }
+}
+
+static void emit(float *out, size_t nu, const double *const tab[3], const double *const k[3],
+                 const size_t nd[3])
+{
+    for (int c = 0; c < 3; c++)
+        emit1(out + c, nu, tab[c], k[c], nd[c]);
 }
 
 void pde_grid_plane_d(pde_grid *g, double w, float *xyz, float *xu, float *xv, float *xw)
 {
     const size_t nu = g->nu;
-    float *outs[4] = { xyz, xu, xv, xw };
-    unsigned want = 0;
-    for (int q = 0; q < 4; q++)
-        if (outs[q])
-            want |= 1u << q;
+    const double *phi[3] = { g->phi[0], g->phi[1], g->phi[2] };
+    const double *dphi[3] = { g->dphi[0], g->dphi[1], g->dphi[2] };
+    const double *kx[3], *kv[3], *kw[3];
+    for (int c = 0; c < 3; c++) {
+        kx[c] = g->k[c];
+        kv[c] = g->k[c] + g->nd[c];
+        kw[c] = g->k[c] + 2 * g->nd[c];
+    }
     grid_set_w(g, w);
     for (size_t j = 0; j < g->nv; j++) {
-        grid_row(g, j, want);
-        for (int q = 0; q < 4; q++)
-            if (outs[q])
-                interleave(outs[q] + 3 * j * nu, g->row + 3 * nu * q, nu);
+        grid_coefs(g, j);
+        size_t off = 3 * j * nu;
+        if (xyz)
+            emit(xyz + off, nu, phi, kx, g->nd);
+        if (xu)
+            emit(xu + off, nu, dphi, kx, g->nd);
+        if (xv)
+            emit(xv + off, nu, phi, kv, g->nd);
+        if (xw)
+            emit(xw + off, nu, phi, kw, g->nd);
     }
 }
 

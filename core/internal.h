@@ -54,18 +54,21 @@ double wterm_deriv(const pde_wterm *t, double w, int n);
 /* h(w) and h'(w) of a mode. */
 void mode_h(const pde_mode *m, double w, double *h, double *dh);
 
-/* A sampling grid (pde.h). The rows hold, for row j of the current plane, x
- * then xu, xv, xw, each as three runs of nu doubles (x, y, z components). */
+/* A sampling grid (pde.h). Modes that share their u-factor share a row of the
+ * u table, so a point costs one multiply-add per distinct u-factor, not per
+ * mode. row holds, for row j of the current plane, x then xu, xv, xw, each as
+ * three runs of nu doubles (x, y, z components). */
 struct pde_grid {
     const pde_solution *sol;
     size_t nu, nv;
-    size_t nm[3];
-    double *phi[3], *dphi[3];   /* nm x nu: f_u and f_u' of each mode at each u */
+    size_t nm[3];               /* modes */
+    size_t nd[3];               /* distinct u-factors among them */
+    size_t *group[3];           /* nm: each mode's u-factor */
+    double *phi[3], *dphi[3];   /* nd x nu: f_u and f_u' at each u */
     double *psi[3], *dpsi[3];   /* nm x nv */
     double *h[3], *dh[3];       /* nm: h and h' at the current plane */
+    double *k[3];               /* 3 nd: a row's coefficients for x, xv and xw */
     double *row;                /* 12 nu */
-    double *coef;               /* 3 maxm: a row's coefficient of each mode */
-    size_t maxm;
 };
 
 enum { GRID_X = 1, GRID_XU = 2, GRID_XV = 4, GRID_XW = 8 };

@@ -23,6 +23,9 @@
 #include "ep.h"
 
 #define COND_LIMIT 1e12   /* boundary systems worse than this are singular */
+/* h'''' = e h with clamped ends is singular only at e = t^4 with cos t cosh t = 1; the
+ * first such t is 4.7300407, e = 500.5639. Below it no condition estimate is needed. */
+#define FIRST_EIGENVALUE 500.0
 
 const char *pde_strerror(pde_status status)
 {
@@ -246,69 +249,131 @@ static pde_status force_w(arena *s, ep *q, pde_factor f, double scale)
     return PDE_OK;
 }
 
-/* Solves the 4x4 complex system M c = b with partial pivoting; returns the 1-norm condition number. */
-static double solve4(cplx M[4][4], cplx b[4], cplx c[4])
+/*
+ * The boundary problem of one e: its homogeneous basis and the LU factors of
+ * the 4x4 system that fits it, with the derivative rows scaled by 1/|r| so
+ * that the entries are O(1). Modes of a chain, and sin/cos pairs, share e,
+ * and so do x and y of most models, so plans are kept in a small cache while
+ * a model is solved.
+ */
+typedef struct {
+    double e;
+    ep basis[4];
+    double dscale;
+    cplx LU[4][4];    /* L below the diagonal, U on and above it */
+    cplx inv_diag[4]; /* 1 / U[i][i] */
+    int piv[4];
+    double cond;      /* 1-norm condition number (|re| + |im| for the modulus); 0 when e < 500 */
+} bvp_plan;
+
+static double cabs1(cplx z)
 {
-    cplx A[4][4];
-    int piv[4] = { 0, 1, 2, 3 };
+    return fabs(creal(z)) + fabs(cimag(z));
+}
+
+static void lu_solve(const bvp_plan *p, const cplx b[4], cplx y[4])
+{
+    for (int i = 0; i < 4; i++) {
+        cplx rhs = b[p->piv[i]];
+        for (int j = 0; j < i; j++)
+            rhs -= p->LU[i][j] * y[j];
+        y[i] = rhs;
+    }
+    for (int i = 3; i >= 0; i--) {
+        for (int j = i + 1; j < 4; j++)
+            y[i] -= p->LU[i][j] * y[j];
+        y[i] *= p->inv_diag[i];
+    }
+}
+
+/* Factors M with partial pivoting and, if asked, estimates its condition from the explicit inverse. */
+static void lu_factor(bvp_plan *p, cplx M[4][4], int estimate)
+{
     double norm = 0.0;
     for (int j = 0; j < 4; j++) {
         double col = 0.0;
         for (int i = 0; i < 4; i++)
-            col += cabs(M[i][j]);
-        if (col > norm)
-            norm = col;
+            col += cabs1(M[i][j]);
+        norm = fmax(norm, col);
     }
-    memcpy(A, M, sizeof A);
+    memcpy(p->LU, M, sizeof p->LU);
+    for (int i = 0; i < 4; i++)
+        p->piv[i] = i;
     for (int k = 0; k < 4; k++) {
-        int p = k;
+        int q = k;
         for (int i = k + 1; i < 4; i++)
-            if (cabs(A[i][k]) > cabs(A[p][k]))
-                p = i;
-        if (A[p][k] == 0.0)
-            return INFINITY;
-        if (p != k) {
+            if (cabs1(p->LU[i][k]) > cabs1(p->LU[q][k]))
+                q = i;
+        if (p->LU[q][k] == 0.0) {
+            p->cond = INFINITY;
+            return;
+        }
+        if (q != k) {
             for (int j = 0; j < 4; j++) {
-                cplx t = A[k][j];
-                A[k][j] = A[p][j];
-                A[p][j] = t;
+                cplx t = p->LU[k][j];
+                p->LU[k][j] = p->LU[q][j];
+                p->LU[q][j] = t;
             }
-            int t = piv[k];
-            piv[k] = piv[p];
-            piv[p] = t;
+            int t = p->piv[k];
+            p->piv[k] = p->piv[q];
+            p->piv[q] = t;
         }
+        p->inv_diag[k] = 1.0 / p->LU[k][k];
         for (int i = k + 1; i < 4; i++) {
-            A[i][k] /= A[k][k];
+            p->LU[i][k] *= p->inv_diag[k];
             for (int j = k + 1; j < 4; j++)
-                A[i][j] -= A[i][k] * A[k][j];
+                p->LU[i][j] -= p->LU[i][k] * p->LU[k][j];
         }
     }
-    /* Columns 0..3 of the inverse, then column 4 is the solution. */
+    p->cond = 0.0;
+    if (!estimate)
+        return;
     double inorm = 0.0;
-    for (int col = 0; col < 5; col++) {
-        cplx y[4];
-        for (int i = 0; i < 4; i++) {
-            cplx rhs = col < 4 ? (piv[i] == col ? 1.0 : 0.0) : b[piv[i]];
-            for (int j = 0; j < i; j++)
-                rhs -= A[i][j] * y[j];
-            y[i] = rhs;
-        }
-        for (int i = 3; i >= 0; i--) {
-            for (int j = i + 1; j < 4; j++)
-                y[i] -= A[i][j] * y[j];
-            y[i] /= A[i][i];
-        }
-        if (col < 4) {
-            double s = 0.0;
-            for (int i = 0; i < 4; i++)
-                s += cabs(y[i]);
-            if (s > inorm)
-                inorm = s;
-        } else {
-            memcpy(c, y, sizeof y);
-        }
+    for (int col = 0; col < 4; col++) {
+        cplx unit[4] = { 0 }, y[4];
+        unit[col] = 1.0;
+        lu_solve(p, unit, y);
+        double s = 0.0;
+        for (int i = 0; i < 4; i++)
+            s += cabs1(y[i]);
+        inorm = fmax(inorm, s);
     }
-    return norm * inorm;
+    p->cond = norm * inorm;
+}
+
+#define PLAN_CACHE 4
+
+typedef struct {
+    bvp_plan plan[PLAN_CACHE];
+    int n, next;
+} plan_cache;
+
+static pde_status plan_for(arena *s, plan_cache *cache, double e, const bvp_plan **out)
+{
+    for (int i = 0; i < cache->n; i++)
+        if (cache->plan[i].e == e) {
+            *out = &cache->plan[i];
+            return PDE_OK;
+        }
+    bvp_plan *p = &cache->plan[cache->next];
+    cache->next = (cache->next + 1) % PLAN_CACHE;
+    if (cache->n < PLAN_CACHE)
+        cache->n++;
+    p->e = NAN;    /* invalid until complete */
+    pde_status st = ep_homogeneous(s, e, p->basis, &p->dscale);
+    if (st != PDE_OK)
+        return st;
+    cplx M[4][4];
+    for (int j = 0; j < 4; j++) {
+        cplx col[4];
+        ep_boundary(&p->basis[j], col);
+        for (int i = 0; i < 4; i++)
+            M[i][j] = col[i] * (i & 1 ? p->dscale : 1.0);
+    }
+    lu_factor(p, M, e >= FIRST_EIGENVALUE);
+    p->e = e;
+    *out = p;
+    return PDE_OK;
 }
 
 /* The real closed form of a complex ep: Re sum P e^{z(w-s)}, terms with equal (alpha, |beta|, s) merged. */
@@ -474,8 +539,8 @@ static pde_status collect(arena *s, const pde_component *c, int ci, mode **out, 
 }
 
 /* Solves one mode: forcing from its force terms and its chain parents, then the boundary fit. */
-static pde_status solve_mode(arena *s, const pde_component *c, int ci, mode *modes, size_t nmodes,
-                             mode *m, const long *next_force, pde_diag *diag)
+static pde_status solve_mode(arena *s, plan_cache *plans, const pde_component *c, int ci, mode *modes,
+                             size_t nmodes, mode *m, const long *next_force, pde_diag *diag)
 {
     double mu = c->a * factor_lambda(m->u) + c->b * factor_lambda(m->v);
     double e = -mu / c->c;                                   /* eq. (8) */
@@ -510,21 +575,15 @@ static pde_status solve_mode(arena *s, const pde_component *c, int ci, mode *mod
     if (q.n == 0 && m->bc[0] == 0.0 && m->bc[1] == 0.0 && m->bc[2] == 0.0 && m->bc[3] == 0.0)
         return PDE_OK;    /* h = 0 */
 
-    ep hp = { 0 }, basis[4];
-    double dscale;
-    if ((st = ep_particular(s, e, &q, &hp)) != PDE_OK || (st = ep_homogeneous(s, e, basis, &dscale)) != PDE_OK)
+    ep hp = { 0 };
+    const bvp_plan *plan;
+    if ((st = ep_particular(s, e, &q, &hp)) != PDE_OK || (st = plan_for(s, plans, e, &plan)) != PDE_OK)
         return st;
-    cplx bp[4], M[4][4], rhs[4], coef[4];
+    cplx bp[4], rhs[4], coef[4];
     ep_boundary(&hp, bp);
-    for (int j = 0; j < 4; j++) {
-        cplx col[4];
-        ep_boundary(&basis[j], col);
-        for (int i = 0; i < 4; i++)
-            M[i][j] = col[i] * (i & 1 ? dscale : 1.0);
-    }
     for (int i = 0; i < 4; i++)
-        rhs[i] = (m->bc[i] - bp[i]) * (i & 1 ? dscale : 1.0);
-    double cond = solve4(M, rhs, coef);
+        rhs[i] = (m->bc[i] - bp[i]) * (i & 1 ? plan->dscale : 1.0);
+    double cond = plan->cond;
     if (!(cond <= COND_LIMIT)) {
         char where[64];
         pde_factor fu = m->u, fv = m->v;
@@ -536,15 +595,16 @@ static pde_status solve_mode(arena *s, const pde_component *c, int ci, mode *mod
                     "conditions has no unique solution; change a, b or c of %s",
                     comp_name[ci], where, e, comp_name[ci]);
     }
+    lu_solve(plan, rhs, coef);
     m->h = hp;
     for (int j = 0; j < 4; j++)
-        if ((st = ep_add_ep(s, &m->h, &basis[j], coef[j])) != PDE_OK)
+        if ((st = ep_add_ep(s, &m->h, &plan->basis[j], coef[j])) != PDE_OK)
             return st;
     return PDE_OK;
 }
 
-static pde_status solve_component(arena *mem, arena *s, const pde_model *model, int ci,
-                                  comp_solution *out, pde_diag *diag)
+static pde_status solve_component(arena *mem, arena *s, plan_cache *plans, const pde_model *model,
+                                  int ci, comp_solution *out, pde_diag *diag)
 {
     const pde_component *c = &model->comp[ci];
     static const char *const abc[3] = { "a", "b", "c" };
@@ -570,7 +630,7 @@ static pde_status solve_component(arena *mem, arena *s, const pde_model *model, 
     if ((st = collect(s, c, ci, &modes, &n, &next_force, diag)) != PDE_OK)
         return st;
     for (size_t i = 0; i < n; i++)
-        if ((st = solve_mode(s, c, ci, modes, n, &modes[i], next_force, diag)) != PDE_OK)
+        if ((st = solve_mode(s, plans, c, ci, modes, n, &modes[i], next_force, diag)) != PDE_OK)
             return st;
 
     out->a = c->a;
@@ -612,10 +672,11 @@ pde_status pde_solve(const pde_model *model, pde_solution **out, pde_diag *diag)
     if (!model || !out)
         return fail(diag, PDE_ERR_INVALID, -1, -1, -1, "", "no model given");
     arena mem = { 0 }, scratch = { 0 };
+    plan_cache plans = { .n = 0 };   /* plans depend on e alone: x and y often share them */
     pde_solution *sol = arena_alloc(&mem, sizeof *sol);
     pde_status st = sol ? PDE_OK : PDE_ERR_NOMEM;
     for (int ci = 0; ci < 3 && st == PDE_OK; ci++)
-        st = solve_component(&mem, &scratch, model, ci, &sol->comp[ci], diag);
+        st = solve_component(&mem, &scratch, &plans, model, ci, &sol->comp[ci], diag);
     arena_free(&scratch);
     if (st != PDE_OK) {
         if (st == PDE_ERR_NOMEM && diag && !diag->message[0])

@@ -1,0 +1,162 @@
+/*
+ * bench_core: the core's speed, as medians on a noisy shared machine.
+ *
+ *   1. pde_solve() + pde_solution_free() of each paper figure's model, in
+ *      microseconds (goal: <= 5 us).
+ *   2. Grid sampling on one thread into float32 x, y, z: bytes per second as
+ *      a ratio of memcpy's bandwidth over the same number of bytes, both
+ *      measured in this run, interleaved (goal: >= 0.3).
+ *
+ * The figure models are read from examples/, the JSON the CLI reads.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "model.h"
+#include "pde.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static int cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static api_model *load(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    static char buf[1 << 16];
+    size_t n = fread(buf, 1, sizeof buf, f);
+    fclose(f);
+    api_error err;
+    api_model *m = api_model_parse(buf, n, &err);
+    if (!m)
+        fprintf(stderr, "%s: %s: %s\n", path, err.pointer, err.message);
+    return m;
+}
+
+static volatile double sink;
+
+/*
+ * Rounds over all figures, a batch of solves of each per round, so that the
+ * host's noisy stretches fall on every figure alike; median and minimum over
+ * the rounds.
+ */
+static void bench_solve(const char *dir, char **names, int nnames)
+{
+    enum { BATCH = 100, ROUNDS = 61, MAXF = 64 };
+    static double t[MAXF][ROUNDS];
+    api_model *models[MAXF];
+    size_t modes[MAXF] = { 0 };
+    for (int i = 0; i < nnames; i++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/%s.json", dir, names[i]);
+        if (!(models[i] = load(path)))
+            return;
+        pde_solution *s;
+        if (pde_solve(api_model_get(models[i]), &s, NULL) != PDE_OK)
+            return;
+        for (int c = 0; c < 3; c++) {
+            size_t n;
+            pde_solution_modes(s, c, &n);
+            modes[i] += n;
+        }
+        pde_solution_free(s);
+    }
+    for (int r = 0; r < ROUNDS; r++)
+        for (int i = 0; i < nnames; i++) {
+            const pde_model *pm = api_model_get(models[i]);
+            double t0 = now();
+            for (int k = 0; k < BATCH; k++) {
+                pde_solution *s;
+                pde_solve(pm, &s, NULL);
+                sink += (double)pde_solution_bytes(s);
+                pde_solution_free(s);
+            }
+            t[i][r] = (now() - t0) / BATCH * 1e6;
+        }
+    printf("| model | modes | solve + free, median us | min us |\n|---|---|---|---|\n");
+    double med[MAXF], worst = 0.0;
+    for (int i = 0; i < nnames; i++) {
+        double lo = t[i][0];
+        for (int r = 1; r < ROUNDS; r++)
+            lo = t[i][r] < lo ? t[i][r] : lo;
+        med[i] = median(t[i], ROUNDS);
+        worst = med[i] > worst ? med[i] : worst;
+        printf("| %s | %zu | %.2f | %.2f |\n", names[i], modes[i], med[i], lo);
+        api_model_free(models[i]);
+    }
+    printf("\nmedian over the %d figures: %.2f us; slowest figure's median: %.2f us\n\n", nnames,
+           median(med, nnames), worst);
+}
+
+static void bench_sample(const char *dir, const char *name, size_t n)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s.json", dir, name);
+    api_model *m = load(path);
+    pde_solution *s;
+    if (!m || pde_solve(api_model_get(m), &s, NULL) != PDE_OK)
+        return;
+    size_t bytes = 3 * sizeof(float) * n * n * n;
+    float *out = malloc(bytes);
+    char *src = malloc(bytes), *dst = malloc(bytes);
+    memset(src, 1, bytes);
+    memset(dst, 2, bytes);
+    memset(out, 0, bytes);
+    enum { RUNS = 11 };
+    double ts[RUNS], tm[RUNS], ratio[RUNS];
+    for (int r = 0; r < RUNS; r++) {
+        double t0 = now();
+        pde_sample(s, n, n, n, out);
+        double t1 = now();
+        memcpy(dst, src, bytes);
+        double t2 = now();
+        sink += out[r] + dst[r];
+        ts[r] = t1 - t0;
+        tm[r] = t2 - t1;
+        ratio[r] = tm[r] / ts[r];
+    }
+    double ms = median(ts, RUNS), mm = median(tm, RUNS);
+    printf("| %s | %zu^3 | %.1f MB | %.2f GB/s | %.2f GB/s | %.2f |\n", name, n, bytes / 1e6, bytes / ms / 1e9,
+           bytes / mm / 1e9, median(ratio, RUNS));
+    free(out);
+    free(src);
+    free(dst);
+    pde_solution_free(s);
+    api_model_free(m);
+}
+
+int main(int argc, char **argv)
+{
+    const char *dir = argc > 1 ? argv[1] : "examples";
+    char *names[] = { "fig1a", "fig1c", "fig1e", "fig1g", "fig2a", "fig2b", "fig2c", "fig3a", "fig3b",
+                      "fig3c", "fig3d", "fig4a", "fig4b", "fig4c", "fig4d", "fig4e", "fig4f", "fig4g",
+                      "fig4h", "fig4i", "fig4j", "fig4k", "fig4l", "fig4m", "fig4n", "fig4o", "fig4p",
+                      "fig4q", "fig4r", "fig4s", "fig4t", "fig4u", "fig4v", "fig4w", "fig4x" };
+    printf("## pde_solve\n\n");
+    bench_solve(dir, names, (int)(sizeof names / sizeof *names));
+    printf("## Grid sampling, one thread, float32 x,y,z\n\n");
+    printf("| model | grid | output | sampling | memcpy | ratio (median of per-run ratios) |\n|---|---|---|---|---|---|\n");
+    const char *grids[] = { "fig1a", "fig4a", "fig3d" };
+    for (int i = 0; i < 3; i++)
+        bench_sample(dir, grids[i], 128);
+    bench_sample(dir, "fig4a", 256);
+    return 0;
+}
