@@ -9,7 +9,7 @@ WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wmissing-prototyp
 CFLAGS  += $(STD) $(OPT) $(WARN) -Icore -Iapi
 LDLIBS  := -lm
 CJSON   := $(shell pkg-config --libs libcjson 2>/dev/null || echo -lcjson)
-CJSON_CFLAGS := $(shell pkg-config --cflags libcjson 2>/dev/null)
+CJSON_CFLAGS := $(shell pkg-config --cflags libcjson 2>/dev/null || echo -I/usr/include/cjson)
 CMOCKA  := $(shell pkg-config --libs cmocka 2>/dev/null || echo -lcmocka)
 SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 
@@ -33,14 +33,18 @@ BENCHES := $(patsubst bench/%.c,build/bench/%,$(BENCH_SRC))
 .PHONY: all test bench clean deps
 all: build/pdesolid
 
+# Installs missing Debian packages (a no-op when all are there).
+deps:
+	@bash .ci/deps
+
 # Complex division without C99's NaN and overflow recovery: the core's systems are scaled to O(1).
 build/obj/core/%.o build/san/core/%.o: CFLAGS += -fcx-fortran-rules
 
-build/obj/%.o: %.c
+build/obj/%.o: %.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(CJSON_CFLAGS) -MMD -MP -c $< -o $@
 
-build/san/%.o: %.c
+build/san/%.o: %.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(CJSON_CFLAGS) $(SAN) -MMD -MP -c $< -o $@
 

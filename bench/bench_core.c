@@ -8,6 +8,10 @@
  *      measured in this run, interleaved (goal: >= 0.3).
  *
  * The figure models are read from examples/, the JSON the CLI reads.
+ *
+ *   bench_core [DIR]              the tables for docs/BENCHMARKS.md
+ *   bench_core --solve FILE N     only N solves of FILE, for instruction counts:
+ *     valgrind --tool=callgrind build/bench/bench_core --solve examples/fig4a.json 1000
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -145,6 +149,19 @@ static void bench_sample(const char *dir, const char *name, size_t n)
 
 int main(int argc, char **argv)
 {
+    if (argc == 4 && strcmp(argv[1], "--solve") == 0) {
+        api_model *m = load(argv[2]);
+        if (!m)
+            return 1;
+        for (long k = atol(argv[3]); k > 0; k--) {
+            pde_solution *s;
+            if (pde_solve(api_model_get(m), &s, NULL) != PDE_OK)
+                return 1;
+            pde_solution_free(s);
+        }
+        api_model_free(m);
+        return 0;
+    }
     const char *dir = argc > 1 ? argv[1] : "examples";
     char *names[] = { "fig1a", "fig1c", "fig1e", "fig1g", "fig2a", "fig2b", "fig2c", "fig3a", "fig3b",
                       "fig3c", "fig3d", "fig4a", "fig4b", "fig4c", "fig4d", "fig4e", "fig4f", "fig4g",
