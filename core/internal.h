@@ -39,6 +39,20 @@ struct pde_solution {
     comp_solution comp[3];
 };
 
+extern const char *const pde_comp_name[3];   /* "x", "y", "z" */
+
+/* Fills d (if not NULL) and returns st. */
+pde_status pde_fail(pde_diag *d, pde_status st, int comp, int in_force, long term, const char *field,
+                    const char *fmt, ...) __attribute__((format(printf, 7, 8)));
+
+/* Checks a component's numbers and factors; names the field at fault in d. */
+pde_status model_check_component(const pde_component *c, int ci, pde_diag *d);
+
+/* The basis function f is a multiple of: key and sign with f = sign key; 0 if f is identically 0. */
+int factor_normalise(pde_factor f, pde_factor *key, double *sign);
+int factor_compare(pde_factor a, pde_factor b);
+const char *factor_name(pde_factor_kind k);
+
 /* f^(n)(t) of one factor, for any order n >= 0. */
 double factor_deriv(pde_factor f, double t, int n);
 

@@ -58,6 +58,7 @@ const char *pde_strerror(pde_status status);
 /* Limits that keep one solve bounded in time and memory. */
 #define PDE_MAX_POW   100    /* largest n of a t^n factor */
 #define PDE_MAX_ARG   700.0  /* largest |alpha| of exp, sinh, cosh: e^700 < DBL_MAX */
+#define PDE_MAX_FREQ  1e6    /* largest |k| of sin, cos: beyond, k pi t has no digits left */
 #define PDE_MAX_MODES 4096   /* separated (u, v) modes per component */
 
 /* A one-variable factor f(t). A zeroed factor is {PDE_POW, 0}, the constant 1. */
@@ -119,6 +120,17 @@ typedef struct pde_solution pde_solution;
 pde_status pde_solve(const pde_model *model, pde_solution **out, pde_diag *diag);
 
 void pde_solution_free(pde_solution *sol);
+
+/*
+ * The canonical form of a model, which equal models share however they are
+ * written: factors normalised (sin(-k) -> -sin(k), cos 0 -> 1, ...), terms
+ * with equal factors merged (sums independent of the order of the terms),
+ * terms that vanish dropped, terms sorted, -0 made +0. It solves to the same
+ * solution. Validates like pde_solve(). On success *out owns new term arrays:
+ * free them with pde_model_canonical_free(), which accepts a zeroed model.
+ */
+pde_status pde_model_canonical(const pde_model *model, pde_model *out, pde_diag *diag);
+void pde_model_canonical_free(pde_model *model);
 
 /* Bytes held by the solution, for a cache's accounting. Cannot fail. */
 size_t pde_solution_bytes(const pde_solution *sol);

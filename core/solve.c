@@ -15,7 +15,6 @@
  * skips this step, so its tangents at w = 0, 1 are not met.
  */
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -41,8 +40,6 @@ const char *pde_strerror(pde_status status)
     return "unknown status";
 }
 
-static const char *const comp_name[3] = { "x", "y", "z" };
-
 typedef struct {
     pde_factor u, v;
     int level;            /* total degree of the power factors */
@@ -52,88 +49,6 @@ typedef struct {
     long first_force;     /* head of this mode's list of force terms, -1 if none */
     ep h;                 /* the solved h(w), complex */
 } mode;
-
-static pde_status fail(pde_diag *d, pde_status st, int comp, int in_force, long term,
-                       const char *field, const char *fmt, ...)
-    __attribute__((format(printf, 7, 8)));
-
-static pde_status fail(pde_diag *d, pde_status st, int comp, int in_force, long term,
-                       const char *field, const char *fmt, ...)
-{
-    if (!d)
-        return st;
-    d->component = comp;
-    d->in_force = in_force;
-    d->term = term;
-    snprintf(d->field, sizeof d->field, "%s", field);
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(d->message, sizeof d->message, fmt, ap);
-    va_end(ap);
-    return st;
-}
-
-/* Checks a factor; returns NULL if valid, else what is wrong with it. */
-static const char *factor_problem(pde_factor f)
-{
-    if (!isfinite(f.p))
-        return "is not a finite number";
-    switch (f.kind) {
-    case PDE_POW:
-        if (f.p != floor(f.p) || f.p < 0 || f.p > PDE_MAX_POW)
-            return "must be an integer power from 0 to 100";
-        return NULL;
-    case PDE_SIN:
-    case PDE_COS:
-        if (fabs(f.p) > 1e6)
-            return "has a frequency k beyond 1e6";
-        return NULL;
-    case PDE_EXP:
-    case PDE_SINH:
-    case PDE_COSH:
-        if (fabs(f.p) > PDE_MAX_ARG)
-            return "has |alpha| > 700, so its values overflow a double";
-        return NULL;
-    }
-    return "has an unknown kind";
-}
-
-/* The basis function a factor is a multiple of: returns 0 if f is identically 0. */
-static int normalise(pde_factor f, pde_factor *key, double *sign)
-{
-    static const pde_factor one = { PDE_POW, 0.0 };
-    *key = f;
-    *sign = 1.0;
-    switch (f.kind) {
-    case PDE_POW:
-        break;
-    case PDE_SIN:
-    case PDE_SINH:
-        if (f.p == 0.0)
-            return 0;
-        if (f.p < 0.0) {
-            key->p = -f.p;
-            *sign = -1.0;
-        }
-        break;
-    case PDE_COS:
-    case PDE_COSH:
-    case PDE_EXP:
-        if (f.p == 0.0)
-            *key = one;
-        else if (f.kind != PDE_EXP)
-            key->p = fabs(f.p);
-        break;
-    }
-    return 1;
-}
-
-static int factor_cmp(pde_factor a, pde_factor b)
-{
-    if (a.kind != b.kind)
-        return a.kind < b.kind ? -1 : 1;
-    return a.p < b.p ? -1 : a.p > b.p;
-}
 
 static int level_of(pde_factor u, pde_factor v)
 {
@@ -146,8 +61,8 @@ static int mode_cmp_key(const void *pa, const void *pb)
     const mode *a = pa, *b = pb;
     if (a->level != b->level)
         return a->level > b->level ? -1 : 1;
-    int c = factor_cmp(a->u, b->u);
-    return c ? c : factor_cmp(a->v, b->v);
+    int c = factor_compare(a->u, b->u);
+    return c ? c : factor_compare(a->v, b->v);
 }
 
 static int mode_cmp(const void *pa, const void *pb)
@@ -436,46 +351,6 @@ static int wterms_finite(const pde_mode *m)
     return 1;
 }
 
-static const char *factor_word(pde_factor_kind k)
-{
-    static const char *const w[] = { "pow", "sin", "cos", "exp", "sinh", "cosh" };
-    return (unsigned)k < 6 ? w[k] : "?";
-}
-
-static pde_status check_terms(const pde_component *c, int ci, pde_diag *diag)
-{
-    static const char *const bf[4] = { "w0", "dw0", "w1", "dw1" };
-    static const char *const uvw[3] = { "u", "v", "w" };
-    for (size_t j = 0; j < c->nbterms; j++) {
-        const pde_bterm *t = &c->bterms[j];
-        const double d[4] = { t->w0, t->dw0, t->w1, t->dw1 };
-        for (int k = 0; k < 4; k++)
-            if (!isfinite(d[k]))
-                return fail(diag, PDE_ERR_INVALID, ci, 0, (long)j, bf[k],
-                            "%s is not a finite number", bf[k]);
-        const pde_factor f[2] = { t->u, t->v };
-        for (int k = 0; k < 2; k++) {
-            const char *why = factor_problem(f[k]);
-            if (why)
-                return fail(diag, PDE_ERR_INVALID, ci, 0, (long)j, uvw[k], "the %s factor %s %s",
-                            uvw[k], factor_word(f[k].kind), why);
-        }
-    }
-    for (size_t j = 0; j < c->nfterms; j++) {
-        const pde_fterm *t = &c->fterms[j];
-        if (!isfinite(t->coef))
-            return fail(diag, PDE_ERR_INVALID, ci, 1, (long)j, "coef", "coef is not a finite number");
-        const pde_factor f[3] = { t->u, t->v, t->w };
-        for (int k = 0; k < 3; k++) {
-            const char *why = factor_problem(f[k]);
-            if (why)
-                return fail(diag, PDE_ERR_INVALID, ci, 1, (long)j, uvw[k], "the %s factor %s %s",
-                            uvw[k], factor_word(f[k].kind), why);
-        }
-    }
-    return PDE_OK;
-}
-
 /* Collects the modes of one component, sorted, with their data attached. */
 static pde_status collect(arena *s, const pde_component *c, int ci, mode **out, size_t *nout,
                           long **next_force, pde_diag *diag)
@@ -488,12 +363,12 @@ static pde_status collect(arena *s, const pde_component *c, int ci, mode **out, 
         for (size_t j = 0; j < nt; j++) {
             pde_factor fu = in_force ? c->fterms[j].u : c->bterms[j].u;
             pde_factor fv = in_force ? c->fterms[j].v : c->bterms[j].v;
-            if (!normalise(fu, &ku, &su) || !normalise(fv, &kv, &sv))
+            if (!factor_normalise(fu, &ku, &su) || !factor_normalise(fv, &kv, &sv))
                 continue;
             pde_status st = push_chain(s, &l, ku, kv, in_force, (long)j);
             if (st == PDE_ERR_LIMIT)
-                return fail(diag, st, ci, in_force, (long)j, "",
-                            "component %s needs more than %d separated modes", comp_name[ci],
+                return pde_fail(diag, st, ci, in_force, (long)j, "",
+                            "component %s needs more than %d separated modes", pde_comp_name[ci],
                             PDE_MAX_MODES);
             if (st != PDE_OK)
                 return st;
@@ -506,14 +381,14 @@ static pde_status collect(arena *s, const pde_component *c, int ci, mode **out, 
         if (n == 0 || mode_cmp_key(&l.m[n - 1], &l.m[i]) != 0)
             l.m[n++] = l.m[i];
     if (n > PDE_MAX_MODES)
-        return fail(diag, PDE_ERR_LIMIT, ci, -1, -1, "", "component %s needs %zu separated modes, more than %d",
-                    comp_name[ci], n, PDE_MAX_MODES);
+        return pde_fail(diag, PDE_ERR_LIMIT, ci, -1, -1, "", "component %s needs %zu separated modes, more than %d",
+                    pde_comp_name[ci], n, PDE_MAX_MODES);
     long *next = arena_alloc(s, (c->nfterms ? c->nfterms : 1) * sizeof *next);
     if (!next)
         return PDE_ERR_NOMEM;
     for (size_t j = 0; j < c->nbterms; j++) {
         const pde_bterm *t = &c->bterms[j];
-        if (!normalise(t->u, &ku, &su) || !normalise(t->v, &kv, &sv))
+        if (!factor_normalise(t->u, &ku, &su) || !factor_normalise(t->v, &kv, &sv))
             continue;
         mode *m = find_mode(l.m, n, ku, kv);
         double sg = su * sv;
@@ -526,7 +401,7 @@ static pde_status collect(arena *s, const pde_component *c, int ci, mode **out, 
     for (size_t j = c->nfterms; j-- > 0;) {
         const pde_fterm *t = &c->fterms[j];
         next[j] = -1;
-        if (!normalise(t->u, &ku, &su) || !normalise(t->v, &kv, &sv))
+        if (!factor_normalise(t->u, &ku, &su) || !factor_normalise(t->v, &kv, &sv))
             continue;
         mode *m = find_mode(l.m, n, ku, kv);
         next[j] = m->first_force;
@@ -545,17 +420,17 @@ static pde_status solve_mode(arena *s, plan_cache *plans, const pde_component *c
     double mu = c->a * factor_lambda(m->u) + c->b * factor_lambda(m->v);
     double e = -mu / c->c;                                   /* eq. (8) */
     if (!isfinite(e))
-        return fail(diag, PDE_ERR_RANGE, ci, m->src_force, m->src_term, "",
+        return pde_fail(diag, PDE_ERR_RANGE, ci, m->src_force, m->src_term, "",
                     "component %s: the separation constant e = -(a lu + b lv)/c overflows",
-                    comp_name[ci]);
+                    pde_comp_name[ci]);
     ep q = { 0 };
     pde_status st;
     for (long j = m->first_force; j >= 0; j = next_force[j]) {
         const pde_fterm *t = &c->fterms[j];
         pde_factor ku, kv;
         double su, sv;
-        normalise(t->u, &ku, &su);
-        normalise(t->v, &kv, &sv);
+        factor_normalise(t->u, &ku, &su);
+        factor_normalise(t->v, &kv, &sv);
         if ((st = force_w(s, &q, t->w, t->coef * su * sv / c->c)) != PDE_OK)
             return st;
     }
@@ -587,13 +462,13 @@ static pde_status solve_mode(arena *s, plan_cache *plans, const pde_component *c
     if (!(cond <= COND_LIMIT)) {
         char where[64];
         pde_factor fu = m->u, fv = m->v;
-        snprintf(where, sizeof where, "%s(%g)*%s(%g)", factor_word(fu.kind), fu.p,
-                 factor_word(fv.kind), fv.p);
-        return fail(diag, PDE_ERR_SINGULAR, ci, m->src_force, m->src_term, "",
+        snprintf(where, sizeof where, "%s(%g)*%s(%g)", factor_name(fu.kind), fu.p,
+                 factor_name(fv.kind), fv.p);
+        return pde_fail(diag, PDE_ERR_SINGULAR, ci, m->src_force, m->src_term, "",
                     "component %s, mode %s: e = %.17g is an eigenvalue of the clamped problem "
                     "(cos t cosh t = 1 with t = e^(1/4)), so h'''' = e h with these boundary "
                     "conditions has no unique solution; change a, b or c of %s",
-                    comp_name[ci], where, e, comp_name[ci]);
+                    pde_comp_name[ci], where, e, pde_comp_name[ci]);
     }
     lu_solve(plan, rhs, coef);
     m->h = hp;
@@ -607,20 +482,7 @@ static pde_status solve_component(arena *mem, arena *s, plan_cache *plans, const
                                   int ci, comp_solution *out, pde_diag *diag)
 {
     const pde_component *c = &model->comp[ci];
-    static const char *const abc[3] = { "a", "b", "c" };
-    const double v[3] = { c->a, c->b, c->c };
-    for (int k = 0; k < 3; k++)
-        if (!isfinite(v[k]))
-            return fail(diag, PDE_ERR_INVALID, ci, -1, -1, abc[k], "%s of component %s is not a finite number",
-                        abc[k], comp_name[ci]);
-    if (c->c == 0.0)
-        return fail(diag, PDE_ERR_ILLPOSED, ci, -1, -1, "c",
-                    "c of component %s is 0: the equation is then not fourth order in w and "
-                    "the four boundary conditions cannot all hold", comp_name[ci]);
-    if ((c->nbterms && !c->bterms) || (c->nfterms && !c->fterms))
-        return fail(diag, PDE_ERR_INVALID, ci, -1, -1, "", "component %s has a NULL term list",
-                    comp_name[ci]);
-    pde_status st = check_terms(c, ci, diag);
+    pde_status st = model_check_component(c, ci, diag);
     if (st != PDE_OK)
         return st;
 
@@ -656,8 +518,8 @@ static pde_status solve_component(arena *mem, arena *s, plan_cache *plans, const
         if ((st = to_real(mem, &modes[i].h, pm)) != PDE_OK)
             return st;
         if (!wterms_finite(pm))
-            return fail(diag, PDE_ERR_RANGE, ci, modes[i].src_force, modes[i].src_term, "",
-                        "component %s: the solution's coefficients overflow a double", comp_name[ci]);
+            return pde_fail(diag, PDE_ERR_RANGE, ci, modes[i].src_force, modes[i].src_term, "",
+                        "component %s: the solution's coefficients overflow a double", pde_comp_name[ci]);
         if (pm->nterms)
             kept++;
     }
@@ -670,7 +532,7 @@ pde_status pde_solve(const pde_model *model, pde_solution **out, pde_diag *diag)
     if (diag)
         memset(diag, 0, sizeof *diag), diag->component = -1, diag->term = -1;
     if (!model || !out)
-        return fail(diag, PDE_ERR_INVALID, -1, -1, -1, "", "no model given");
+        return pde_fail(diag, PDE_ERR_INVALID, -1, -1, -1, "", "no model given");
     arena mem = { 0 }, scratch = { 0 };
     plan_cache plans = { .n = 0 };   /* plans depend on e alone: x and y often share them */
     pde_solution *sol = arena_alloc(&mem, sizeof *sol);
