@@ -14,11 +14,13 @@
 #include <cJSON.h>
 
 #include "model.h"
+#include "template.h"
 
 struct api_model {
     pde_model m;
     pde_bterm *b[3];
     pde_fterm *f[3];
+    int from_params;    /* expanded from a preset or template: errors point into /params */
 };
 
 static const char *const comp_key[3] = { "x", "y", "z" };
@@ -270,6 +272,78 @@ static int parse_model(const cJSON *root, api_model *m, api_error *err)
     return 0;
 }
 
+/* {"preset": NAME, "params": {...}} or {"template": NAME, "params": {...}}. */
+static api_model *parse_request(const cJSON *root, api_error *err)
+{
+    static const char *const keys[] = { "preset", "template", "params", NULL };
+    const cJSON *k[3];
+    if (check_object(root, "", keys, k, err))
+        return NULL;
+    if (k[0] && k[1]) {
+        api_fail(err, "", "give either \"preset\" or \"template\", not both");
+        return NULL;
+    }
+    const cJSON *name = k[0] ? k[0] : k[1];
+    const char *ptr = k[0] ? "/preset" : "/template";
+    if (!cJSON_IsString(name)) {
+        api_fail(err, ptr, "must be a string, not %s", type_name(name));
+        return NULL;
+    }
+    const api_template *t;
+    api_params p;
+    if (k[0]) {
+        const api_preset *ps = api_preset_find(name->valuestring);
+        if (!ps) {
+            api_fail(err, ptr, "no preset \"%.60s\"; GET /presets (or `pdesolid presets`) lists them", name->valuestring);
+            return NULL;
+        }
+        t = api_preset_template(ps);
+        api_preset_params(ps, &p);
+    } else {
+        if (!(t = api_template_find(name->valuestring))) {
+            api_fail(err, ptr, "no template \"%.60s\"; the templates are example1, example2, example3, example4",
+                     name->valuestring);
+            return NULL;
+        }
+        api_template_defaults(t, &p);
+    }
+    if (k[2]) {
+        if (!cJSON_IsObject(k[2])) {
+            api_fail(err, "/params", "must be an object of parameter values, not %s", type_name(k[2]));
+            return NULL;
+        }
+        for (const cJSON *c = k[2]->child; c; c = c->next) {
+            for (const cJSON *d = k[2]->child; d != c; d = d->next)
+                if (strcmp(d->string, c->string) == 0) {
+                    api_fail(err, "/params", "the key \"%.60s\" appears twice", c->string);
+                    return NULL;
+                }
+            double v[3];
+            int n = 0;
+            char q[96];
+            snprintf(q, sizeof q, "/params/%.80s", c->string);
+            if (cJSON_IsNumber(c)) {
+                v[n++] = c->valuedouble;
+            } else if (cJSON_IsArray(c) && cJSON_GetArraySize(c) == 3) {
+                for (const cJSON *x = c->child; x; x = x->next) {
+                    char qi[112];
+                    snprintf(qi, sizeof qi, "%s/%d", q, n);
+                    if (get_number(x, qi, &v[n++], err))
+                        return NULL;
+                }
+            } else {
+                api_fail(err, q, "must be a number, or an array of three for a, b and c; not %s", type_name(c));
+                return NULL;
+            }
+            if (n == 1 && get_number(c, q, &v[0], err))
+                return NULL;
+            if (api_params_set(t, &p, c->string, v, n, err))
+                return NULL;
+        }
+    }
+    return api_template_expand(t, &p, err);
+}
+
 /* cJSON over a private NUL-terminated copy: 1.7.15 may read past a buffer without one. */
 static cJSON *parse_json(const char *text, size_t len, api_error *err)
 {
@@ -314,14 +388,45 @@ api_model *api_model_parse(const char *text, size_t len, api_error *err)
     cJSON *root = parse_json(text, len, err);
     if (!root)
         return NULL;
-    api_model *m = calloc(1, sizeof *m);
-    if (!m) {
+    api_model *m = NULL;
+    if (cJSON_IsObject(root) && (cJSON_GetObjectItemCaseSensitive(root, "preset") ||
+                                 cJSON_GetObjectItemCaseSensitive(root, "template"))) {
+        m = parse_request(root, err);
+    } else if (!(m = calloc(1, sizeof *m))) {
         api_fail(err, "", "out of memory");
     } else if (parse_model(root, m, err)) {
         api_model_free(m);
         m = NULL;
     }
     cJSON_Delete(root);
+    return m;
+}
+
+api_model *api_model_build(const pde_model *src, int from_params, api_error *err)
+{
+    api_model *m = calloc(1, sizeof *m);
+    if (!m) {
+        api_fail(err, "", "out of memory");
+        return NULL;
+    }
+    m->m = *src;
+    m->from_params = from_params;
+    for (int c = 0; c < 3; c++) {
+        size_t nb = src->comp[c].nbterms, nf = src->comp[c].nfterms;
+        m->b[c] = malloc((nb ? nb : 1) * sizeof *m->b[c]);
+        m->f[c] = malloc((nf ? nf : 1) * sizeof *m->f[c]);
+        if (!m->b[c] || !m->f[c]) {
+            api_model_free(m);
+            api_fail(err, "", "out of memory");
+            return NULL;
+        }
+        if (nb)
+            memcpy(m->b[c], src->comp[c].bterms, nb * sizeof *m->b[c]);
+        if (nf)
+            memcpy(m->f[c], src->comp[c].fterms, nf * sizeof *m->f[c]);
+        m->m.comp[c].bterms = m->b[c];
+        m->m.comp[c].fterms = m->f[c];
+    }
     return m;
 }
 
@@ -348,7 +453,9 @@ int api_solve(const api_model *m, pde_solution **out, api_error *err)
     if (st == PDE_OK)
         return 0;
     char ptr[160] = "";
-    if (d.component >= 0 && d.term < 0 && d.field[0])
+    if (m->from_params)
+        snprintf(ptr, sizeof ptr, d.term < 0 && d.field[0] ? "/params/%s/%d" : "/params", d.field, d.component);
+    else if (d.component >= 0 && d.term < 0 && d.field[0])
         snprintf(ptr, sizeof ptr, "/pde/%s/%d", d.field, d.component);
     else if (d.component >= 0 && d.term >= 0)
         snprintf(ptr, sizeof ptr, "/%s/%s/%ld%s%s", d.in_force ? "force" : "boundary",

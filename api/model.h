@@ -42,8 +42,20 @@ typedef struct {
 
 typedef struct api_model api_model;
 
-/* Parses len bytes (no NUL needed). Returns NULL and fills err on failure. */
+/*
+ * Parses a request of len bytes (no NUL needed): a model, or
+ * {"preset": NAME, "params": {...}} or {"template": NAME, "params": {...}},
+ * where params override the preset's or the template's values (template.h).
+ * Returns NULL and fills err on failure.
+ */
 api_model *api_model_parse(const char *text, size_t len, api_error *err);
+
+/*
+ * A model owning a deep copy of m's terms (not validated: pde_solve does
+ * that). from_params: m was expanded from a template's parameters, so errors
+ * of api_solve() point into /params. NULL if out of memory.
+ */
+api_model *api_model_build(const pde_model *m, int from_params, api_error *err);
 void api_model_free(api_model *m);
 const pde_model *api_model_get(const api_model *m);
 

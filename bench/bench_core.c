@@ -7,11 +7,12 @@
  *      a ratio of memcpy's bandwidth over the same number of bytes, both
  *      measured in this run, interleaved (goal: >= 0.3).
  *
- * The figure models are read from examples/, the JSON the CLI reads.
+ * The figure models are the presets (api/template.c), built as a client's
+ * {"preset": NAME} request would build them.
  *
- *   bench_core [DIR]              the tables for docs/BENCHMARKS.md
- *   bench_core --solve FILE N     only N solves of FILE, for instruction counts:
- *     valgrind --tool=callgrind build/bench/bench_core --solve examples/fig4a.json 1000
+ *   bench_core                    the tables for docs/BENCHMARKS.md
+ *   bench_core --solve NAME N     only N solves of the preset NAME, for instruction counts:
+ *     valgrind --tool=callgrind build/bench/bench_core --solve fig4a 1000
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,6 +21,7 @@
 
 #include "model.h"
 #include "pde.h"
+#include "template.h"
 
 static double now(void)
 {
@@ -40,19 +42,17 @@ static double median(double *v, int n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-static api_model *load(const char *path)
+static api_model *load(const char *name)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
+    const api_preset *ps = api_preset_find(name);
+    if (!ps) {
+        fprintf(stderr, "no preset %s\n", name);
         return NULL;
-    static char buf[1 << 16];
-    size_t n = fread(buf, 1, sizeof buf, f);
-    fclose(f);
+    }
+    api_params p;
     api_error err;
-    api_model *m = api_model_parse(buf, n, &err);
-    if (!m)
-        fprintf(stderr, "%s: %s: %s\n", path, err.pointer, err.message);
-    return m;
+    api_preset_params(ps, &p);
+    return api_template_expand(api_preset_template(ps), &p, &err);
 }
 
 static volatile double sink;
@@ -62,16 +62,14 @@ static volatile double sink;
  * host's noisy stretches fall on every figure alike; median and minimum over
  * the rounds.
  */
-static void bench_solve(const char *dir, char **names, int nnames)
+static void bench_solve(char **names, int nnames)
 {
     enum { BATCH = 100, ROUNDS = 61, MAXF = 64 };
     static double t[MAXF][ROUNDS];
     api_model *models[MAXF];
     size_t modes[MAXF] = { 0 };
     for (int i = 0; i < nnames; i++) {
-        char path[512];
-        snprintf(path, sizeof path, "%s/%s.json", dir, names[i]);
-        if (!(models[i] = load(path)))
+        if (!(models[i] = load(names[i])))
             return;
         pde_solution *s;
         if (pde_solve(api_model_get(models[i]), &s, NULL) != PDE_OK)
@@ -110,11 +108,9 @@ static void bench_solve(const char *dir, char **names, int nnames)
            median(med, nnames), worst);
 }
 
-static void bench_sample(const char *dir, const char *name, size_t n)
+static void bench_sample(const char *name, size_t n)
 {
-    char path[512];
-    snprintf(path, sizeof path, "%s/%s.json", dir, name);
-    api_model *m = load(path);
+    api_model *m = load(name);
     pde_solution *s;
     if (!m || pde_solve(api_model_get(m), &s, NULL) != PDE_OK)
         return;
@@ -162,18 +158,17 @@ int main(int argc, char **argv)
         api_model_free(m);
         return 0;
     }
-    const char *dir = argc > 1 ? argv[1] : "examples";
     char *names[] = { "fig1a", "fig1c", "fig1e", "fig1g", "fig2a", "fig2b", "fig2c", "fig3a", "fig3b",
                       "fig3c", "fig3d", "fig4a", "fig4b", "fig4c", "fig4d", "fig4e", "fig4f", "fig4g",
                       "fig4h", "fig4i", "fig4j", "fig4k", "fig4l", "fig4m", "fig4n", "fig4o", "fig4p",
                       "fig4q", "fig4r", "fig4s", "fig4t", "fig4u", "fig4v", "fig4w", "fig4x" };
     printf("## pde_solve\n\n");
-    bench_solve(dir, names, (int)(sizeof names / sizeof *names));
+    bench_solve(names, (int)(sizeof names / sizeof *names));
     printf("## Grid sampling, one thread, float32 x,y,z\n\n");
     printf("| model | grid | output | sampling | memcpy | ratio (median of per-run ratios) |\n|---|---|---|---|---|---|\n");
     const char *grids[] = { "fig1a", "fig4a", "fig3d" };
     for (int i = 0; i < 3; i++)
-        bench_sample(dir, grids[i], 128);
-    bench_sample(dir, "fig4a", 256);
+        bench_sample(grids[i], 128);
+    bench_sample("fig4a", 256);
     return 0;
 }

@@ -99,6 +99,7 @@ pde_status pde_grid_create(const pde_solution *sol, const double *us, size_t nu,
     g->sol = sol;
     g->nu = nu;
     g->nv = nv;
+    g->w = NAN;
     g->row = malloc(12 * nu * sizeof *g->row);
     if (!g->row)
         goto nomem;
@@ -156,6 +157,9 @@ static void combine(double *restrict row, const double *restrict tab, const doub
 
 void grid_set_w(pde_grid *g, double w)
 {
+    if (w == g->w)
+        return;
+    g->w = w;
     for (int c = 0; c < 3; c++)
         for (size_t m = 0; m < g->nm[c]; m++)
             mode_h(&g->sol->comp[c].modes[m], w, &g->h[c][m], &g->dh[c][m]);
@@ -240,7 +244,8 @@ static void emit(float *out, size_t nu, const double *const tab[3], const double
         emit1(out + c, nu, tab[c], k[c], nd[c]);
 }
 
-void pde_grid_plane_d(pde_grid *g, double w, float *xyz, float *xu, float *xv, float *xw)
+void pde_grid_rows(pde_grid *g, double w, size_t j0, size_t j1, float *xyz, float *xu, float *xv,
+                   float *xw)
 {
     const size_t nu = g->nu;
     const double *phi[3] = { g->phi[0], g->phi[1], g->phi[2] };
@@ -252,9 +257,9 @@ void pde_grid_plane_d(pde_grid *g, double w, float *xyz, float *xu, float *xv, f
         kw[c] = g->k[c] + 2 * g->nd[c];
     }
     grid_set_w(g, w);
-    for (size_t j = 0; j < g->nv; j++) {
+    for (size_t j = j0; j < j1 && j < g->nv; j++) {
         grid_coefs(g, j);
-        size_t off = 3 * j * nu;
+        size_t off = 3 * (j - j0) * nu;
         if (xyz)
             emit(xyz + off, nu, phi, kx, g->nd);
         if (xu)
@@ -264,6 +269,11 @@ void pde_grid_plane_d(pde_grid *g, double w, float *xyz, float *xu, float *xv, f
         if (xw)
             emit(xw + off, nu, phi, kw, g->nd);
     }
+}
+
+void pde_grid_plane_d(pde_grid *g, double w, float *xyz, float *xu, float *xv, float *xw)
+{
+    pde_grid_rows(g, w, 0, g->nv, xyz, xu, xv, xw);
 }
 
 void pde_grid_plane(pde_grid *g, double w, float *xyz)

@@ -81,6 +81,7 @@ struct pde_grid {
     double *phi[3], *dphi[3];   /* nd x nu: f_u and f_u' at each u */
     double *psi[3], *dpsi[3];   /* nm x nv */
     double *h[3], *dh[3];       /* nm: h and h' at the current plane */
+    double w;                   /* the current plane, NaN before the first */
     double *k[3];               /* 3 nd: a row's coefficients for x, xv and xw */
     double *row;                /* 12 nu */
 };

@@ -188,6 +188,10 @@ void pde_grid_free(pde_grid *grid);
 void pde_grid_plane(pde_grid *grid, double w, float *xyz);
 /* The same plane with dx/du, dx/dv, dx/dw (each 3 nu nv floats; may be NULL). */
 void pde_grid_plane_d(pde_grid *grid, double w, float *xyz, float *xu, float *xv, float *xw);
+/* Rows j0 <= j < j1 of the plane w only (3 nu (j1 - j0) floats each), for streaming in bounded
+ * memory; h(w) is kept from the previous call when w repeats. */
+void pde_grid_rows(pde_grid *grid, double w, size_t j0, size_t j1, float *xyz, float *xu, float *xv,
+                   float *xw);
 
 /* Samples i/(n-1) on each axis (0.5 when n = 1) into out, 3 nu nv nw floats. */
 pde_status pde_sample(const pde_solution *sol, size_t nu, size_t nv, size_t nw, float *out);

@@ -160,6 +160,28 @@ static void bad_input_should_exit_2_and_name_the_field(void **state)
         free(out);
         free(err);
     }
+    const struct {
+        const char *args, *words;
+    } more[] = {
+        { "solve --preset fig9", "fig9: /preset: no preset \"fig9\"" },
+        { "solve --preset fig4a --param p0", "--param p0: write NAME=VALUE" },
+        { "solve --preset fig4a --param p0=lots", "\"lots\" is not a number" },
+        { "solve --preset fig4a --param q=1", "/params/q: example4 has no parameter \"q\"" },
+        { "solve --preset fig4a --param c=-1,-1,0", "/params/c/2: c of component z is 0" },
+        { "solve --preset fig4a --format obj -o x", "\"obj\" is not a format" },
+        { "solve --preset fig4a --format grid --res 9999", "limit of 4096" },
+        { "solve fig4a.json --param p0=1", "--param goes with --preset" },
+        { "solve --res", "--res needs a value" },
+        { "solve --bogus fig4a.json", "unknown option --bogus" },
+    };
+    for (size_t i = 0; i < sizeof more / sizeof *more; i++) {
+        char *out, *err;
+        int st = run(1, more[i].args, &out, &err);
+        if (st != 2 || !strstr(err, more[i].words))
+            fail_msg("pdesolid %s: status %d, stderr: %s", more[i].args, st, err);
+        free(out);
+        free(err);
+    }
     char *out, *err;
     assert_int_equal(run(1, "--help", &out, &err), 0);
     assert_non_null(strstr(out, "eval MODEL.json POINTS.json"));
@@ -171,9 +193,56 @@ static void bad_input_should_exit_2_and_name_the_field(void **state)
     free(err);
 }
 
+static void presets_and_formats_should_work_from_the_command_line(void **state)
+{
+    (void)state;
+    char *out, *err;
+    assert_int_equal(run(0, "presets", &out, &err), 0);
+    assert_non_null(strstr(out, "fig1a"));
+    assert_non_null(strstr(out, "fig4x  example4  Fig. 4:"));
+    free(out);
+    free(err);
+    /* The preset with a parameter equals the same request given as a file. */
+    write_text("req.json", "{\"preset\":\"fig4b\",\"params\":{\"p0\":12345,\"c\":[-11,-11,-10]}}");
+    write_text("p.json", "[[0.3,0.6,0.7]]");
+    char *a, *b;
+    assert_int_equal(run(0, "eval --preset fig4b --param p0=12345 --param c=-11,-11,-10 p.json", &a, &err), 0);
+    free(err);
+    assert_int_equal(run(0, "eval req.json p.json", &b, &err), 0);
+    free(err);
+    assert_string_equal(a, b);
+    free(a);
+    free(b);
+    assert_int_equal(run(0, "solve req.json", &out, &err), 0);
+    assert_non_null(strstr(out, "solid "));
+    free(out);
+    free(err);
+    /* Every format to a file, of the size the format implies. */
+    assert_int_equal(run(0, "solve --preset fig2a --format f32 --res 4,5,6 -o g.f32", &out, &err), 0);
+    free(out);
+    free(err);
+    char path[256];
+    snprintf(path, sizeof path, "%s/g.f32", dir);
+    size_t len;
+    free(read_file(path, &len));
+    assert_int_equal(len, 12 * 4 * 5 * 6);
+    const char *fmts[] = { "json", "grid", "gltf", "glb", "vts", "stl" };
+    for (size_t i = 0; i < 6; i++) {
+        char args[128];
+        snprintf(args, sizeof args, "solve --preset fig3d --format %s --res 8 -o s.%s", fmts[i], fmts[i]);
+        assert_int_equal(run(0, args, &out, &err), 0);
+        free(out);
+        free(err);
+        snprintf(path, sizeof path, "%s/s.%s", dir, fmts[i]);
+        free(read_file(path, &len));
+        assert_true(len > 100);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(presets_and_formats_should_work_from_the_command_line),
         cmocka_unit_test(eval_should_agree_with_the_independent_solution),
         cmocka_unit_test(solve_should_print_the_closed_form_and_properties),
         cmocka_unit_test(bad_input_should_exit_2_and_name_the_field),

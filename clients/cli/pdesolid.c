@@ -1,38 +1,60 @@
 /*
- * pdesolid: the command-line tool. Solves models offline and prints their
- * closed form, properties, or values at given points.
+ * pdesolid: the command-line tool. Solves models offline and writes their
+ * closed form, properties, values at points, sampled grids and meshes.
  */
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "describe.h"
+#include "id.h"
 #include "model.h"
+#include "output.h"
+#include "template.h"
 
-#define VERSION "0.1.0"
+#define VERSION "0.2.0"
 #define MAX_INPUT (64u << 20)
 
 static const char usage[] =
-    "usage: pdesolid COMMAND [ARGS]\n"
+    "usage: pdesolid COMMAND [ARGS] [OPTIONS]\n"
     "\n"
     "Solves a solid of the fourth-order PDE a x_uuuu + b x_vvvv + c x_wwww = p\n"
     "in closed form (You, Comninos and Zhang), offline.\n"
     "\n"
     "commands:\n"
-    "  solve MODEL.json          print the closed form of each component and the\n"
-    "                            solid's properties (bounds, volume, det J, residuals)\n"
+    "  solve MODEL.json          the closed form and the solid's properties, or with\n"
+    "                            --format the solid in that format\n"
     "  eval MODEL.json POINTS.json\n"
-    "                            print [[x,y,z], ...] at each [u,v,w] of POINTS.json,\n"
-    "                            with 17 significant digits\n"
+    "                            [[x,y,z], ...] at each [u,v,w] of POINTS.json, with\n"
+    "                            17 significant digits\n"
+    "  presets                   the paper's solids: name, template and caption\n"
     "\n"
-    "Either file may be - for standard input. The model format is in docs/API.md.\n"
+    "MODEL.json is a model or a request ({\"preset\": \"fig4a\", \"params\": {...}});\n"
+    "either file may be - for standard input. docs/API.md describes the format.\n"
+    "\n"
     "options:\n"
-    "  -h, --help       this text\n"
-    "  --version        the version\n"
+    "  --preset NAME        instead of MODEL.json: a preset (see `pdesolid presets`)\n"
+    "  --param NAME=VALUE   with --preset, a parameter; VALUE is a number, or x,y,z for\n"
+    "                       a, b and c; repeatable\n"
+    "  --format F           solve: json, grid, f32, gltf, glb, vts or stl\n"
+    "  --res N|NU,NV,NW     samples per axis (grid, f32, vts; default 33) or per face\n"
+    "                       edge (gltf, glb, stl; default 64)\n"
+    "  -o FILE              write to FILE instead of standard output\n"
+    "  -h, --help           this text\n"
+    "  --version            the version\n"
     "\n"
     "exit status: 0 success, 2 bad input (the message names the field as a JSON\n"
     "pointer), 1 anything else.\n";
+
+typedef struct {
+    const char *preset, *format, *res, *out;
+    const char *params[64];
+    int nparams;
+    const char *args[3];
+    int nargs;
+} options;
 
 /* Reads a whole file (or stdin for "-"); NULL with a message on failure. */
 static char *slurp(const char *path, size_t *len)
@@ -70,40 +92,132 @@ static char *slurp(const char *path, size_t *len)
     return buf;
 }
 
-static int report(const char *path, const api_error *err)
+static int report(const char *what, const api_error *err)
 {
-    fprintf(stderr, "pdesolid: %s: %s: %s\n", path, err->pointer[0] ? err->pointer : "(document)",
-            err->message);
+    fprintf(stderr, "pdesolid: %s: %s%s%s\n", what, err->pointer, err->pointer[0] ? ": " : "", err->message);
     return 2;
 }
 
-/* Loads and solves a model; returns 0 or the exit status. */
-static int load(const char *path, pde_solution **sol)
+/* The model of --preset and --param. */
+static api_model *preset_model(const options *o, api_error *err)
 {
-    size_t len;
-    char *text = slurp(path, &len);
-    if (!text)
-        return 1;
+    const api_preset *ps = api_preset_find(o->preset);
+    if (!ps) {
+        api_fail(err, "/preset", "no preset \"%s\"; `pdesolid presets` lists them", o->preset);
+        return NULL;
+    }
+    const api_template *t = api_preset_template(ps);
+    api_params p;
+    api_preset_params(ps, &p);
+    for (int i = 0; i < o->nparams; i++) {
+        char name[64];
+        const char *eq = strchr(o->params[i], '=');
+        if (!eq || eq == o->params[i] || (size_t)(eq - o->params[i]) >= sizeof name) {
+            api_fail(err, "", "--param %s: write NAME=VALUE", o->params[i]);
+            return NULL;
+        }
+        snprintf(name, sizeof name, "%.*s", (int)(eq - o->params[i]), o->params[i]);
+        double v[3];
+        int n = 0;
+        const char *s = eq + 1;
+        char *end;
+        do {
+            v[n++] = strtod(s, &end);
+            if (end == s) {
+                api_fail(err, "", "--param %s: \"%s\" is not a number", name, s);
+                return NULL;
+            }
+            s = end + (*end == ',');
+        } while (*end == ',' && n < 3);
+        if (*end) {
+            api_fail(err, "", "--param %s: \"%s\" is not a number or x,y,z", name, eq + 1);
+            return NULL;
+        }
+        if (api_params_set(t, &p, name, v, n, err))
+            return NULL;
+    }
+    return api_template_expand(t, &p, err);
+}
+
+/* Loads and solves the model; returns 0 or the exit status. id may be NULL. */
+static int load(const options *o, const char *path, pde_solution **sol, char *id)
+{
     api_error err;
-    api_model *m = api_model_parse(text, len, &err);
-    free(text);
+    api_model *m;
+    const char *what = path;
+    if (o->preset) {
+        what = o->preset;
+        m = preset_model(o, &err);
+    } else {
+        size_t len;
+        char *text = slurp(path, &len);
+        if (!text)
+            return 1;
+        m = api_model_parse(text, len, &err);
+        free(text);
+    }
     if (!m)
-        return report(path, &err);
+        return report(what, &err);
     int st = api_solve(m, sol, &err);
+    if (!st && id)
+        api_model_id(api_model_get(m), id, NULL);
     api_model_free(m);
     if (st == PDE_ERR_NOMEM) {
         fprintf(stderr, "pdesolid: out of memory\n");
         return 1;
     }
-    return st ? report(path, &err) : 0;
+    return st ? report(what, &err) : 0;
 }
 
-static int cmd_solve(const char *path)
+static int write_output(const options *o, const pde_solution *sol, const char *id)
+{
+    api_error err;
+    api_format f;
+    unsigned res[3];
+    if (api_format_parse(o->format, &f, &err) || api_res_parse(o->res, f, res, &err))
+        return report("option", &err);
+    if (!o->out && isatty(STDOUT_FILENO) && (f == API_FMT_F32 || f == API_FMT_GLB || f == API_FMT_STL ||
+                                             f == API_FMT_VTS)) {
+        fprintf(stderr, "pdesolid: %s is binary; give -o FILE, or redirect standard output\n", o->format);
+        return 2;
+    }
+    FILE *out = o->out ? fopen(o->out, "wb") : stdout;
+    if (!out) {
+        fprintf(stderr, "pdesolid: %s: %s\n", o->out, strerror(errno));
+        return 1;
+    }
+    api_output *w = api_output_open(sol, id, f, res, &err);
+    if (!w) {
+        if (out != stdout)
+            fclose(out);
+        return report("output", &err);
+    }
+    static char buf[1 << 16];
+    long n;
+    while ((n = api_output_read(w, buf, sizeof buf)) > 0)
+        if (fwrite(buf, 1, (size_t)n, out) != (size_t)n)
+            break;
+    int bad = n != 0 || ferror(out);
+    api_output_free(w);
+    if ((out != stdout ? fclose(out) : fflush(out)) != 0 || bad) {
+        fprintf(stderr, "pdesolid: %s: %s\n", o->out ? o->out : "standard output", n < 0 ? "out of memory" : strerror(errno));
+        return 1;
+    }
+    return 0;
+}
+
+static int cmd_solve(const options *o)
 {
     pde_solution *sol;
-    int rc = load(path, &sol);
+    char id[API_ID_LEN + 1] = "";
+    int rc = load(o, o->nargs ? o->args[0] : NULL, &sol, id);
     if (rc)
         return rc;
+    if (o->format) {
+        rc = write_output(o, sol, id);
+        pde_solution_free(sol);
+        return rc;
+    }
     pde_props props;
     pde_status st = pde_properties(sol, NULL, &props);
     if (st != PDE_OK) {
@@ -111,13 +225,15 @@ static int cmd_solve(const char *path)
         pde_solution_free(sol);
         return 1;
     }
+    printf("solid %s\n", id);
     api_describe(stdout, sol, &props);
     pde_solution_free(sol);
     return 0;
 }
 
-static int cmd_eval(const char *model_path, const char *points_path)
+static int cmd_eval(const options *o)
 {
+    const char *points_path = o->args[o->nargs - 1];
     size_t len, n;
     char *text = slurp(points_path, &len);
     if (!text)
@@ -129,7 +245,7 @@ static int cmd_eval(const char *model_path, const char *points_path)
     if (rc)
         return report(points_path, &err);
     pde_solution *sol;
-    if ((rc = load(model_path, &sol)) != 0) {
+    if ((rc = load(o, o->nargs == 2 ? o->args[0] : NULL, &sol, NULL)) != 0) {
         free(pts);
         return rc;
     }
@@ -145,21 +261,77 @@ static int cmd_eval(const char *model_path, const char *points_path)
     return fflush(stdout) == 0 ? 0 : 1;
 }
 
+static int cmd_presets(void)
+{
+    for (size_t i = 0; i < api_preset_count(); i++) {
+        const api_preset *p = api_preset_at(i);
+        printf("%-6s %-9s %s\n", p->name, p->template, p->caption);
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
-    if (argc < 2 || strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0 ||
-        strcmp(argv[1], "help") == 0) {
-        fputs(usage, argc < 2 ? stderr : stdout);
-        return argc < 2 ? 2 : 0;
+    options o = { 0 };
+    const char *cmd = NULL;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char **val = NULL;
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0 || strcmp(a, "help") == 0) {
+            fputs(usage, stdout);
+            return 0;
+        } else if (strcmp(a, "--version") == 0) {
+            printf("pdesolid %s\n", VERSION);
+            return 0;
+        } else if (strcmp(a, "--preset") == 0) {
+            val = &o.preset;
+        } else if (strcmp(a, "--format") == 0) {
+            val = &o.format;
+        } else if (strcmp(a, "--res") == 0) {
+            val = &o.res;
+        } else if (strcmp(a, "-o") == 0) {
+            val = &o.out;
+        } else if (strcmp(a, "--param") == 0) {
+            if (i + 1 >= argc || o.nparams == 64) {
+                fprintf(stderr, "pdesolid: --param needs NAME=VALUE (at most 64)\n");
+                return 2;
+            }
+            o.params[o.nparams++] = argv[++i];
+            continue;
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "pdesolid: unknown option %s\n\n%s", a, usage);
+            return 2;
+        } else if (!cmd) {
+            cmd = a;
+            continue;
+        } else if (o.nargs < 3) {
+            o.args[o.nargs++] = a;
+            continue;
+        } else {
+            fprintf(stderr, "pdesolid: too many arguments\n");
+            return 2;
+        }
+        if (i + 1 >= argc) {
+            fprintf(stderr, "pdesolid: %s needs a value\n", a);
+            return 2;
+        }
+        *val = argv[++i];
     }
-    if (strcmp(argv[1], "--version") == 0) {
-        printf("pdesolid %s\n", VERSION);
-        return 0;
+    if (!cmd) {
+        fputs(usage, stderr);
+        return 2;
     }
-    if (strcmp(argv[1], "solve") == 0 && argc == 3)
-        return cmd_solve(argv[2]);
-    if (strcmp(argv[1], "eval") == 0 && argc == 4)
-        return cmd_eval(argv[2], argv[3]);
-    fprintf(stderr, "pdesolid: unknown command or wrong arguments: %s\n\n%s", argv[1], usage);
+    if (o.nparams && !o.preset) {
+        fprintf(stderr, "pdesolid: --param goes with --preset\n");
+        return 2;
+    }
+    int model_args = o.preset ? 0 : 1;
+    if (strcmp(cmd, "solve") == 0 && o.nargs == model_args)
+        return cmd_solve(&o);
+    if (strcmp(cmd, "eval") == 0 && o.nargs == model_args + 1)
+        return cmd_eval(&o);
+    if (strcmp(cmd, "presets") == 0 && o.nargs == 0)
+        return cmd_presets();
+    fprintf(stderr, "pdesolid: unknown command or wrong arguments: %s\n\n%s", cmd, usage);
     return 2;
 }

@@ -1,0 +1,78 @@
+/*
+ * id.c: SHA-256 (nettle, from Debian) of the canonical model's exact bytes:
+ * every double by its bit pattern, little-endian, after a version tag, so the
+ * id changes only when the model does, or when the format version is raised.
+ */
+#include <stdint.h>
+#include <string.h>
+
+#include <nettle/sha2.h>
+
+#include "id.h"
+
+static void put_u64(struct sha256_ctx *h, uint64_t v)
+{
+    uint8_t b[8];
+    for (int i = 0; i < 8; i++)
+        b[i] = (uint8_t)(v >> (8 * i));
+    sha256_update(h, sizeof b, b);
+}
+
+static void put_f64(struct sha256_ctx *h, double d)
+{
+    uint64_t v;
+    memcpy(&v, &d, sizeof v);
+    put_u64(h, v);
+}
+
+static void put_factor(struct sha256_ctx *h, pde_factor f)
+{
+    put_u64(h, (uint64_t)f.kind);
+    put_f64(h, f.p);
+}
+
+pde_status api_model_id(const pde_model *m, char id[API_ID_LEN + 1], pde_diag *diag)
+{
+    pde_model c;
+    pde_status st = pde_model_canonical(m, &c, diag);
+    if (st != PDE_OK)
+        return st;
+    struct sha256_ctx h;
+    sha256_init(&h);
+    static const char tag[] = "pdesolid model v1";
+    sha256_update(&h, sizeof tag, (const uint8_t *)tag);
+    for (int i = 0; i < 3; i++) {
+        const pde_component *k = &c.comp[i];
+        put_f64(&h, k->a);
+        put_f64(&h, k->b);
+        put_f64(&h, k->c);
+        put_u64(&h, k->nbterms);
+        for (size_t j = 0; j < k->nbterms; j++) {
+            const pde_bterm *t = &k->bterms[j];
+            put_factor(&h, t->u);
+            put_factor(&h, t->v);
+            put_f64(&h, t->w0);
+            put_f64(&h, t->dw0);
+            put_f64(&h, t->w1);
+            put_f64(&h, t->dw1);
+        }
+        put_u64(&h, k->nfterms);
+        for (size_t j = 0; j < k->nfterms; j++) {
+            const pde_fterm *t = &k->fterms[j];
+            put_f64(&h, t->coef);
+            put_factor(&h, t->u);
+            put_factor(&h, t->v);
+            put_factor(&h, t->w);
+        }
+    }
+    pde_model_canonical_free(&c);
+    uint8_t digest[SHA256_DIGEST_SIZE];
+    sha256_digest(&h, sizeof digest, digest);
+    static const char hex[] = "0123456789abcdef";
+    for (int i = 0; i < API_ID_LEN / 2; i++) {
+        id[2 * i] = hex[digest[i] >> 4];
+        id[2 * i + 1] = hex[digest[i] & 15];
+    }
+    id[API_ID_LEN] = '\0';
+    return PDE_OK;
+}

@@ -1,0 +1,34 @@
+/*
+ * mesh.h: the skin of a solid as a triangle mesh: the six isoparametric
+ * faces u, v, w = 0, 1 that the paper draws, made into one closed surface.
+ *
+ * Faces that collapse to a line or a point (u = 0 of the circular examples)
+ * vanish, faces that coincide (v = 0 and v = 1 of a closed loop) cancel, seams
+ * are welded, and triangles are wound so that normals point outward (the
+ * enclosed volume is positive). Vertices are shared within a face, so normals
+ * are smooth across a face and sharp at the creases between faces; weld[]
+ * gives each vertex's position id across faces, for formats without normals.
+ */
+#ifndef API_MESH_H
+#define API_MESH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "model.h"
+#include "pde.h"
+
+typedef struct {
+    size_t nverts, ntris, npos;
+    float *pos;        /* 3 nverts */
+    float *nrm;        /* 3 nverts, unit length */
+    uint32_t *tri;     /* 3 ntris, counter-clockwise seen from outside */
+    uint32_t *weld;    /* nverts: position id in [0, npos) */
+    float min[3], max[3];   /* of pos, exactly */
+} api_mesh;
+
+/* res[0..2]: samples along u, v and w on the faces. Returns 0, or -1 with err. */
+int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out, api_error *err);
+void api_mesh_free(api_mesh *m);
+
+#endif

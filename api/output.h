@@ -1,0 +1,71 @@
+/*
+ * output.h: a solution as bytes for a client, in any of the formats, as a
+ * stream that is read in pieces of any size in bounded memory (the server
+ * hands it to libmicrohttpd's content callback; the CLI to a file).
+ *
+ *   json  the closed form per component and mode, the properties and the id
+ *   grid  {"resolution": [nu, nv, nw], "x": [...], "y": [...], "z": [...]},
+ *         u fastest, then v, then w, sampled at i/(n-1), float32 digits
+ *   f32   little-endian float32 x, y, z per point, in the same order
+ *   gltf  glTF 2.0 of the closed skin, the buffer in a base64 data URI
+ *   glb   the same as binary glTF
+ *   vts   the volume as a VTK XML StructuredGrid with det J as a point field
+ *   stl   binary STL of the closed skin
+ *
+ * USAGE
+ *
+ *   api_output *o = api_output_open(sol, id, API_FMT_GLB, &res, &err);
+ *   long n;
+ *   while ((n = api_output_read(o, buf, sizeof buf)) > 0) fwrite(buf, 1, n, f);
+ *   api_output_free(o);
+ *
+ * The output reads the solution, which must outlive it. Outputs are
+ * independent of one another and may be read on different threads.
+ */
+#ifndef API_OUTPUT_H
+#define API_OUTPUT_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "model.h"
+#include "pde.h"
+
+typedef enum { API_FMT_JSON, API_FMT_GRID, API_FMT_F32, API_FMT_GLTF, API_FMT_GLB, API_FMT_VTS, API_FMT_STL } api_format;
+#define API_FMT_COUNT 7
+
+typedef struct {
+    const char *name;      /* as in ?format= and --format */
+    const char *mime;
+    const char *ext;       /* file extension, with the dot */
+    int mesh;              /* resolution per face edge rather than per volume axis */
+} api_format_info;
+
+const api_format_info *api_format_info_of(api_format f);
+/* Returns 0, or -1 with err listing the formats. */
+int api_format_parse(const char *name, api_format *f, api_error *err);
+
+#define API_RES_GRID_DEFAULT 33
+#define API_RES_MESH_DEFAULT 64
+#define API_RES_GRID_MAX 4096          /* samples per axis */
+#define API_RES_GRID_POINTS (1u << 25) /* samples in all: 400 MB of f32 */
+#define API_RES_MESH_MAX 512           /* samples per face edge */
+
+/* "N" or "NU,NV,NW"; NULL or "" gives the format's default. Returns 0, or -1 with err naming the limit. */
+int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *err);
+
+typedef struct api_output api_output;
+
+/* id: the model's id (id.h), or NULL. NULL and err on failure (out of memory, a mesh out of range). */
+api_output *api_output_open(const pde_solution *sol, const char *id, api_format f, const unsigned res[3],
+                            api_error *err);
+/* The total size in bytes, or -1 when it is known only at the end (json, grid). */
+long long api_output_size(const api_output *o);
+/* Up to max bytes into buf; returns the count, 0 at the end, or -1 out of memory. */
+long api_output_read(api_output *o, char *buf, size_t max);
+void api_output_free(api_output *o);
+
+/* The properties as JSON text (for asset.extras and the json format); malloc'd, NULL if out of memory. */
+char *api_props_json(const pde_props *p);
+
+#endif

@@ -1,0 +1,499 @@
+/*
+ * test_output.c: presets, templates, ids and every output format. Presets
+ * against the paper's text and the tests' own transcription; glTF and GLB
+ * through the Khronos glTF-Validator; grids read back against f32; the STL
+ * skin closed and enclosing the computed volume; VTS offsets and det J.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cJSON.h>
+#include <cmocka.h>
+
+#include "id.h"
+#include "output.h"
+#include "support.h"
+#include "template.h"
+
+static char dir[] = "/tmp/pdesolid-out-XXXXXX";
+
+static int setup(void **state)
+{
+    (void)state;
+    return mkdtemp(dir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[96];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+static api_model *preset_model(const char *name)
+{
+    const api_preset *ps = api_preset_find(name);
+    if (!ps)
+        fail_msg("no preset %s", name);
+    api_params p;
+    api_error err;
+    api_preset_params(ps, &p);
+    api_model *m = api_template_expand(api_preset_template(ps), &p, &err);
+    assert_non_null(m);
+    return m;
+}
+
+static pde_solution *solve_preset(const char *name, char id[API_ID_LEN + 1])
+{
+    api_model *m = preset_model(name);
+    pde_solution *sol;
+    api_error err;
+    if (api_solve(m, &sol, &err))
+        fail_msg("%s: %s", name, err.message);
+    if (id)
+        assert_int_equal(api_model_id(api_model_get(m), id, NULL), PDE_OK);
+    api_model_free(m);
+    return sol;
+}
+
+/* The whole output in memory; checks the declared size. */
+static unsigned char *render(const pde_solution *sol, const char *id, api_format f, const unsigned res[3], size_t *len)
+{
+    api_error err;
+    api_output *o = api_output_open(sol, id, f, res, &err);
+    if (!o)
+        fail_msg("%s: %s", api_format_info_of(f)->name, err.message);
+    size_t cap = 1 << 16, n = 0;
+    unsigned char *buf = malloc(cap);
+    long got;
+    /* Odd read sizes, to cross every internal boundary. */
+    while ((got = api_output_read(o, (char *)buf + n, cap - n < 7777 ? cap - n : 7777)) > 0) {
+        n += (size_t)got;
+        if (cap - n < 8192)
+            buf = realloc(buf, cap *= 2);
+    }
+    assert_int_equal(got, 0);
+    if (api_output_size(o) >= 0)
+        assert_int_equal((long long)n, api_output_size(o));
+    api_output_free(o);
+    *len = n;
+    return buf;
+}
+
+static void presets_should_carry_the_papers_values(void **state)
+{
+    (void)state;
+    struct {
+        const char *preset, *param;
+        double value;
+    } cases[] = {
+        { "fig1a", "a0", -0.5 }, { "fig1a", "h1", 1 },     { "fig1c", "a3", 2 },     { "fig1c", "b2", -1 },
+        { "fig1e", "a1", 1.5 },  { "fig1e", "b2", -0.4 },  { "fig1e", "h0p", 2 },    { "fig1e", "h1p", 4 },
+        { "fig1g", "a3p", -6 },  { "fig1g", "b1p", -7.5 }, { "fig1g", "h1p", 2 },    { "fig1g", "b2p", -0.4 },
+        { "fig2a", "r0p", 0.5 }, { "fig2a", "b0", 1 },     { "fig2c", "h1", 2 },     { "fig3a", "n_xy", 20 },
+        { "fig3b", "n_xy", 30 }, { "fig3c", "r2", 0.8 },   { "fig3c", "n_z", 10 },   { "fig3d", "n_xy", 14 },
+        { "fig3d", "h3", -0.1 }, { "fig4a", "h1p", 7.5 },  { "fig4a", "p0", 3e4 },   { "fig4c", "p0", 1.8e6 },
+        { "fig4c", "xi", 7 },    { "fig4e", "p0", -3e5 },  { "fig4n", "r0", 1.5 },   { "fig4o", "xi", 11 },
+        { "fig4p", "h1p", 4.5 }, { "fig4w", "h1p", 10.5 }, { "fig4x", "r1p", -2.4 },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        const api_preset *ps = api_preset_find(cases[i].preset);
+        api_params p;
+        api_preset_params(ps, &p);
+        double v[3];
+        assert_int_equal(api_params_get(api_preset_template(ps), &p, cases[i].param, v), 1);
+        if (v[0] != cases[i].value)
+            fail_msg("%s %s = %g, the paper says %g", cases[i].preset, cases[i].param, v[0], cases[i].value);
+    }
+    struct {
+        const char *preset;
+        double b, c;
+    } pde[] = { { "fig2a", 4, -100 }, { "fig2b", 2.5, -10 }, { "fig2c", 4, -10 }, { "fig4a", 1, -9.5 },
+                { "fig4c", 4, -100 }, { "fig4p", 15, -40 } };
+    for (size_t i = 0; i < sizeof pde / sizeof *pde; i++) {
+        const api_preset *ps = api_preset_find(pde[i].preset);
+        api_params p;
+        double b[3], c[3];
+        api_preset_params(ps, &p);
+        api_params_get(api_preset_template(ps), &p, "b", b);
+        api_params_get(api_preset_template(ps), &p, "c", c);
+        assert_true(b[0] == pde[i].b && b[1] == pde[i].b && c[0] == pde[i].c && c[1] == pde[i].c);
+    }
+    assert_int_equal(api_preset_count(), 35);
+    assert_null(api_preset_find("fig5a"));
+}
+
+static void presets_should_be_the_tests_own_transcription(void **state)
+{
+    (void)state;
+    for (size_t i = 0; i < paper_figure_count(); i++) {
+        pde_solution *a = solve_preset(paper_figure_name(i), NULL), *b;
+        pde_model ref;
+        paper_figure_model(i, &ref);
+        assert_int_equal(pde_solve(&ref, &b, NULL), PDE_OK);
+        for (int k = 0; k < 64; k++) {
+            double p[3] = { (k % 4) / 3.0, (k / 4 % 4) / 3.0 + 0.01, (k / 16) / 3.0 }, x[3], y[3];
+            pde_eval(a, p[0], p[1], p[2], x);
+            pde_eval(b, p[0], p[1], p[2], y);
+            for (int c = 0; c < 3; c++)
+                if (!close_rel(x[c], y[c], 1e-14, 1e-12))
+                    fail_msg("%s differs at (%g,%g,%g): %.17g %.17g", paper_figure_name(i), p[0], p[1], p[2], x[c],
+                             y[c]);
+        }
+        pde_solution_free(a);
+        pde_solution_free(b);
+    }
+}
+
+static void every_preset_should_give_gltf_and_glb_that_the_khronos_validator_passes(void **state)
+{
+    (void)state;
+    char cmd[16384];
+    int n = snprintf(cmd, sizeof cmd, "node tests/node/validate_gltf.mjs");
+    const unsigned res[3] = { 24, 24, 24 };
+    for (size_t i = 0; i < api_preset_count(); i++) {
+        const char *name = api_preset_at(i)->name;
+        char id[API_ID_LEN + 1];
+        pde_solution *sol = solve_preset(name, id);
+        for (int g = 0; g < 2; g++) {
+            size_t len;
+            unsigned char *bytes = render(sol, id, g ? API_FMT_GLB : API_FMT_GLTF, res, &len);
+            char path[128];
+            snprintf(path, sizeof path, "%s/%s.%s", dir, name, g ? "glb" : "gltf");
+            FILE *f = fopen(path, "wb");
+            assert_non_null(f);
+            fwrite(bytes, 1, len, f);
+            fclose(f);
+            free(bytes);
+            n += snprintf(cmd + n, sizeof cmd - (size_t)n, " %s", path);
+        }
+        pde_solution_free(sol);
+    }
+    snprintf(cmd + n, sizeof cmd - (size_t)n, " > %s/validator.txt 2>&1", dir);
+    int st = system(cmd);
+    if (st != 0) {
+        char path[96];
+        snprintf(path, sizeof path, "%s/validator.txt", dir);
+        char *report = read_file(path, NULL);
+        fail_msg("glTF-Validator (status %d):\n%s", st, report ? report : "(no report)");
+    }
+}
+
+static void gltf_should_carry_the_id_properties_and_exact_bounds(void **state)
+{
+    (void)state;
+    char id[API_ID_LEN + 1];
+    pde_solution *sol = solve_preset("fig4a", id);
+    const unsigned res[3] = { 32, 32, 32 };
+    size_t len;
+    unsigned char *bytes = render(sol, id, API_FMT_GLB, res, &len);
+    /* GLB: 12-byte header, JSON chunk, BIN chunk. */
+    uint32_t jlen;
+    memcpy(&jlen, bytes + 12, 4);
+    char *json = strndup((char *)bytes + 20, jlen);
+    cJSON *g = cJSON_Parse(json);
+    assert_non_null(g);
+    cJSON *extras = cJSON_GetObjectItem(cJSON_GetObjectItem(g, "asset"), "extras");
+    assert_string_equal(cJSON_GetObjectItem(extras, "id")->valuestring, id);
+    assert_true(cJSON_IsTrue(cJSON_GetObjectItem(cJSON_GetObjectItem(extras, "properties"), "folds")));
+    cJSON *pos = cJSON_GetArrayItem(cJSON_GetObjectItem(g, "accessors"), 0);
+    int count = cJSON_GetObjectItem(pos, "count")->valueint;
+    const float *p = (const float *)(bytes + 20 + jlen + 8);
+    for (int c = 0; c < 3; c++) {
+        float lo = INFINITY, hi = -INFINITY;
+        for (int i = 0; i < count; i++)
+            lo = fminf(lo, p[3 * i + c]), hi = fmaxf(hi, p[3 * i + c]);
+        assert_true((float)cJSON_GetArrayItem(cJSON_GetObjectItem(pos, "min"), c)->valuedouble == lo);
+        assert_true((float)cJSON_GetArrayItem(cJSON_GetObjectItem(pos, "max"), c)->valuedouble == hi);
+        assert_true(cJSON_GetArrayItem(cJSON_GetObjectItem(pos, "min"), c)->valuedouble == (double)lo);
+    }
+    cJSON_Delete(g);
+    free(json);
+    free(bytes);
+    pde_solution_free(sol);
+}
+
+static void grid_json_should_read_back_as_the_f32_output(void **state)
+{
+    (void)state;
+    const char *names[3] = { "fig3c", "fig4a", "fig1g" };
+    const unsigned res[3] = { 7, 11, 5 };
+    for (int f = 0; f < 3; f++) {
+        pde_solution *sol = solve_preset(names[f], NULL);
+        size_t jl, bl;
+        char *json = (char *)render(sol, NULL, API_FMT_GRID, res, &jl);
+        float *bin = (float *)render(sol, NULL, API_FMT_F32, res, &bl);
+        json = realloc(json, jl + 1);
+        json[jl] = '\0';
+        cJSON *g = cJSON_Parse(json);
+        assert_non_null(g);
+        cJSON *r = cJSON_GetObjectItem(g, "resolution");
+        for (int k = 0; k < 3; k++)
+            assert_int_equal(cJSON_GetArrayItem(r, k)->valueint, (int)res[k]);
+        size_t n = res[0] * res[1] * res[2];
+        assert_int_equal(bl, 12 * n);
+        static const char *const comp[3] = { "x", "y", "z" };
+        for (int c = 0; c < 3; c++) {
+            cJSON *a = cJSON_GetObjectItem(g, comp[c]);
+            assert_int_equal((size_t)cJSON_GetArraySize(a), n);
+            size_t i = 0;
+            for (cJSON *e = a->child; e; e = e->next, i++)
+                if ((float)e->valuedouble != bin[3 * i + c])
+                    fail_msg("%s %s[%zu]: %.9g in JSON, %.9g in f32", names[f], comp[c], i, e->valuedouble,
+                             (double)bin[3 * i + c]);
+        }
+        /* And the f32 is the solution at i/(n-1). */
+        double x[3];
+        pde_eval(sol, 0.5, 1.0, 0.25, x);
+        size_t at = 3 * ((1 * res[1] + 10) * res[0] + 3);
+        for (int c = 0; c < 3; c++)
+            assert_rel(bin[at + c], x[c], 1e-6, 1.0);
+        cJSON_Delete(g);
+        free(json);
+        free(bin);
+        pde_solution_free(sol);
+    }
+}
+
+/* Directed edges (two float triples) ordered by their bytes. */
+static int cmp(const void *pa, const void *pb)
+{
+    return memcmp(pa, pb, 24);
+}
+
+/* Reads binary STL triangles; checks that every edge is used once in each direction. */
+static double stl_closed_volume(const unsigned char *b, size_t len, size_t *ntri)
+{
+    uint32_t n;
+    memcpy(&n, b + 80, 4);
+    assert_int_equal(len, 84 + 50 * (size_t)n);
+    *ntri = n;
+    typedef struct {
+        float a[3], b[3];
+    } edge;
+    edge *e = malloc(3 * n * sizeof *e);
+    double vol = 0;
+    for (uint32_t t = 0; t < n; t++) {
+        float v[3][3];
+        memcpy(v, b + 84 + 50 * (size_t)t + 12, sizeof v);
+        for (int i = 0; i < 3; i++) {
+            memcpy(e[3 * t + i].a, v[i], 12);
+            memcpy(e[3 * t + i].b, v[(i + 1) % 3], 12);
+        }
+        double c[3] = { (double)v[1][1] * v[2][2] - (double)v[1][2] * v[2][1],
+                        (double)v[1][2] * v[2][0] - (double)v[1][0] * v[2][2],
+                        (double)v[1][0] * v[2][1] - (double)v[1][1] * v[2][0] };
+        vol += (v[0][0] * c[0] + v[0][1] * c[1] + v[0][2] * c[2]) / 6;
+    }
+    /* Sort the directed edges; each needs its reverse exactly once. */
+    qsort(e, 3 * (size_t)n, sizeof *e, cmp);
+    for (size_t i = 0; i < 3 * (size_t)n; i++) {
+        edge r;
+        memcpy(r.a, e[i].b, 12);
+        memcpy(r.b, e[i].a, 12);
+        edge *hit = bsearch(&r, e, 3 * (size_t)n, sizeof *e, cmp);
+        if (!hit)
+            fail_msg("edge (%g,%g,%g)-(%g,%g,%g) has no twin: the skin is open", e[i].a[0], e[i].a[1], e[i].a[2],
+                     e[i].b[0], e[i].b[1], e[i].b[2]);
+        if ((hit > e && cmp(hit - 1, &r) == 0) || (hit + 1 < e + 3 * n && cmp(hit + 1, &r) == 0))
+            fail_msg("an edge is shared by more than two triangles");
+    }
+    free(e);
+    return vol;
+}
+
+
+static void stl_skin_should_be_closed_and_enclose_the_computed_volume(void **state)
+{
+    (void)state;
+    const char *names[] = { "fig1a", "fig1e", "fig2b", "fig3a", "fig3d", "fig4b", "fig4h" };
+    for (size_t f = 0; f < sizeof names / sizeof *names; f++) {
+        pde_solution *sol = solve_preset(names[f], NULL);
+        const unsigned res[3] = { 48, 160, 64 };
+        size_t len, nt;
+        unsigned char *b = render(sol, NULL, API_FMT_STL, res, &len);
+        double vol = stl_closed_volume(b, len, &nt);
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        if (!close_rel(vol, fabs(p.signed_volume), 2e-3, 0))
+            fail_msg("%s: the skin encloses %.9g, the solid's volume is %.9g", names[f], vol, p.signed_volume);
+        assert_true(vol > 0);
+        free(b);
+        pde_solution_free(sol);
+    }
+}
+
+static void vts_should_hold_the_points_and_det_j(void **state)
+{
+    (void)state;
+    pde_solution *sol = solve_preset("fig2b", NULL);
+    const unsigned res[3] = { 5, 9, 4 };
+    size_t len;
+    unsigned char *b = render(sol, "abc", API_FMT_VTS, res, &len);
+    const char *text = (const char *)b;
+    assert_non_null(strstr(text, "WholeExtent=\"0 4 0 8 0 3\""));
+    const char *mark = strstr(text, "<AppendedData encoding=\"raw\">\n   _");
+    assert_non_null(mark);
+    const unsigned char *data = (const unsigned char *)mark + strlen("<AppendedData encoding=\"raw\">\n   _");
+    size_t n = 5 * 9 * 4;
+    uint64_t nbytes;
+    memcpy(&nbytes, data, 8);
+    assert_int_equal(nbytes, 12 * n);
+    const char *off = strstr(text, "Name=\"detJ\" NumberOfComponents=\"1\" format=\"appended\" offset=\"");
+    assert_non_null(off);
+    assert_int_equal(atoll(off + strlen("Name=\"detJ\" NumberOfComponents=\"1\" format=\"appended\" offset=\"")),
+                     (long long)(8 + 12 * n));
+    const float *pts = (const float *)(data + 8), *dj = (const float *)(data + 8 + 12 * n + 8);
+    for (size_t k = 0; k < 4; k++)
+        for (size_t j = 0; j < 9; j++)
+            for (size_t i = 0; i < 5; i++) {
+                size_t at = (k * 9 + j) * 5 + i;
+                double u = i / 4.0, v = j / 8.0, w = k / 3.0, x[3], a[3], bb[3], c[3];
+                pde_eval_d(sol, u, v, w, x, a, bb, c);
+                double d = a[0] * (bb[1] * c[2] - bb[2] * c[1]) - a[1] * (bb[0] * c[2] - bb[2] * c[0]) +
+                           a[2] * (bb[0] * c[1] - bb[1] * c[0]);
+                for (int q = 0; q < 3; q++)
+                    assert_rel(pts[3 * at + q], x[q], 1e-6, 1);
+                assert_rel(dj[at], d, 1e-5, 1);
+            }
+    assert_non_null(strstr((const char *)dj + 4 * n, "</AppendedData>\n</VTKFile>\n"));
+    free(b);
+    pde_solution_free(sol);
+}
+
+static void json_should_hold_the_closed_form_properties_and_id(void **state)
+{
+    (void)state;
+    char id[API_ID_LEN + 1];
+    pde_solution *sol = solve_preset("fig4a", id);
+    const unsigned res[3] = { 2, 2, 2 };
+    size_t len;
+    char *text = (char *)render(sol, id, API_FMT_JSON, res, &len);
+    text = realloc(text, len + 1);
+    text[len] = '\0';
+    cJSON *j = cJSON_Parse(text);
+    assert_non_null(j);
+    assert_string_equal(cJSON_GetObjectItem(j, "id")->valuestring, id);
+    cJSON *modes = cJSON_GetObjectItem(cJSON_GetObjectItem(cJSON_GetObjectItem(j, "components"), "x"), "modes");
+    assert_int_equal(cJSON_GetArraySize(modes), 2);
+    /* Rebuild x at a point from the JSON's closed form alone. */
+    double u = 0.7, v = 0.2, w = 0.35, x = 0;
+    for (cJSON *m = modes->child; m; m = m->next) {
+        double fu = u;   /* both modes have u^1 */
+        cJSON *fv = cJSON_GetObjectItem(m, "v");
+        double k = fv->child->valuedouble * M_PI;
+        double g = strcmp(fv->child->string, "sin") == 0 ? sin(k * v) : cos(k * v), h = 0;
+        for (cJSON *t = cJSON_GetObjectItem(m, "h")->child; t; t = t->next) {
+            double al = cJSON_GetObjectItem(t, "alpha")->valuedouble, be = cJSON_GetObjectItem(t, "beta")->valuedouble;
+            double sh = cJSON_GetObjectItem(t, "shift")->valuedouble, A = 0, B = 0, wp = 1;
+            cJSON *ca = cJSON_GetObjectItem(t, "A")->child, *cb = cJSON_GetObjectItem(t, "B")->child;
+            for (; ca; ca = ca->next, cb = cb->next, wp *= w)
+                A += ca->valuedouble * wp, B += cb->valuedouble * wp;
+            h += exp(al * (w - sh)) * (A * cos(be * w) + B * sin(be * w));
+        }
+        x += h * fu * g;
+    }
+    double want[3];
+    pde_eval(sol, u, v, w, want);
+    assert_rel(x, want[0], 1e-13, 1);
+    assert_non_null(strstr(cJSON_GetObjectItem(j, "closed_form")->valuestring, "x(u,v,w) = sum over 2 modes"));
+    cJSON *props = cJSON_GetObjectItem(j, "properties");
+    assert_true(cJSON_GetObjectItem(props, "volume")->valuedouble > 0);
+    assert_true(cJSON_GetObjectItem(cJSON_GetObjectItem(props, "residuals"), "boundary")->valuedouble < 1e-12);
+    cJSON_Delete(j);
+    free(text);
+    pde_solution_free(sol);
+}
+
+static void id_should_not_depend_on_how_the_model_is_spelled(void **state)
+{
+    (void)state;
+    const char *a = "{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[-9.5,-9.5,-10]},"
+                    "\"boundary\":{\"x\":[{\"u\":{\"pow\":1},\"v\":{\"sin\":2},\"w0\":0.5,\"w1\":0.5}],"
+                    "\"y\":[{\"u\":{\"pow\":1},\"v\":{\"cos\":2},\"w0\":0.5,\"w1\":0.5}],"
+                    "\"z\":[{\"w1\":3,\"dw1\":7.5}]},"
+                    "\"force\":{\"x\":[{\"coef\":30000,\"u\":{\"pow\":1},\"v\":{\"cos\":2},\"w\":{\"sin\":3}}],"
+                    "\"y\":[{\"coef\":30000,\"u\":{\"pow\":1},\"v\":{\"sin\":2},\"w\":{\"sin\":3}}]}}";
+    /* The same solid: keys reordered, a term split in two, sin(-2) for -sin(2), a zero term, 3e4. */
+    const char *b = "{\"force\":{\"y\":[{\"w\":{\"sin\":3},\"coef\":3e4,\"v\":{\"sin\":2},\"u\":{\"pow\":1}}],"
+                    "\"x\":[{\"coef\":10000,\"u\":{\"pow\":1},\"v\":{\"cos\":2},\"w\":{\"sin\":3}},"
+                    "{\"coef\":20000,\"u\":{\"pow\":1},\"v\":{\"cos\":-2},\"w\":{\"sin\":3}}]},"
+                    "\"boundary\":{\"z\":[{\"dw1\":7.5,\"w1\":3},{\"u\":{\"sin\":5}}],"
+                    "\"x\":[{\"u\":{\"pow\":1},\"v\":{\"sin\":-2},\"w0\":-0.5,\"w1\":-0.5}],"
+                    "\"y\":[{\"u\":{\"pow\":1},\"v\":{\"cos\":2},\"w1\":0.5,\"w0\":0.5}]},"
+                    "\"pde\":{\"c\":[-9.5,-9.5,-10],\"b\":[1,1,1],\"a\":[1,1,1]}}";
+    const char *c = "{\"preset\":\"fig4a\"}";
+    const char *d = "{\"preset\":\"fig4a\",\"params\":{\"p0\":30001}}";
+    const char *texts[4] = { a, b, c, d };
+    char ids[4][API_ID_LEN + 1];
+    for (int i = 0; i < 4; i++) {
+        api_error err;
+        api_model *m = api_model_parse(texts[i], strlen(texts[i]), &err);
+        if (!m)
+            fail_msg("%d: %s: %s", i, err.pointer, err.message);
+        assert_int_equal(api_model_id(api_model_get(m), ids[i], NULL), PDE_OK);
+        assert_int_equal(strlen(ids[i]), API_ID_LEN);
+        api_model_free(m);
+    }
+    assert_string_equal(ids[0], ids[1]);
+    assert_string_equal(ids[0], ids[2]);
+    assert_string_not_equal(ids[0], ids[3]);
+}
+
+static void bad_formats_and_resolutions_should_name_the_limit(void **state)
+{
+    (void)state;
+    const struct {
+        const char *res, *format, *words;
+    } cases[] = {
+        { "0", "grid", "too few" },        { "1", "f32", "too few" },
+        { "5000", "grid", "limit of 4096" }, { "600", "glb", "limit of 512" },
+        { "1024", "f32", "points in all" }, { "a,b,c", "grid", "NU,NV,NW" },
+        { "3,3", "grid", "NU,NV,NW" },      { "-4", "grid", "NU,NV,NW" },
+        { "4,4,4,", "grid", "NU,NV,NW" },   { "99999999999999999999", "grid", "limit" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        api_format f;
+        api_error err;
+        unsigned res[3];
+        assert_int_equal(api_format_parse(cases[i].format, &f, &err), 0);
+        assert_int_equal(api_res_parse(cases[i].res, f, res, &err), -1);
+        if (!strstr(err.message, cases[i].words))
+            fail_msg("res %s: %s", cases[i].res, err.message);
+    }
+    api_format f;
+    api_error err;
+    unsigned res[3];
+    assert_int_equal(api_format_parse("obj", &f, &err), -1);
+    assert_non_null(strstr(err.message, "json, grid, f32, gltf, glb, vts, stl"));
+    assert_int_equal(api_format_parse("glb", &f, &err), 0);
+    assert_int_equal(api_res_parse(NULL, f, res, &err), 0);
+    assert_int_equal(res[0], API_RES_MESH_DEFAULT);
+    assert_int_equal(api_res_parse("8,16,32", f, res, &err), 0);
+    assert_true(res[0] == 8 && res[1] == 16 && res[2] == 32);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(presets_should_carry_the_papers_values),
+        cmocka_unit_test(presets_should_be_the_tests_own_transcription),
+        cmocka_unit_test(every_preset_should_give_gltf_and_glb_that_the_khronos_validator_passes),
+        cmocka_unit_test(gltf_should_carry_the_id_properties_and_exact_bounds),
+        cmocka_unit_test(grid_json_should_read_back_as_the_f32_output),
+        cmocka_unit_test(stl_skin_should_be_closed_and_enclose_the_computed_volume),
+        cmocka_unit_test(vts_should_hold_the_points_and_det_j),
+        cmocka_unit_test(json_should_hold_the_closed_form_properties_and_id),
+        cmocka_unit_test(id_should_not_depend_on_how_the_model_is_spelled),
+        cmocka_unit_test(bad_formats_and_resolutions_should_name_the_limit),
+    };
+    return cmocka_run_group_tests_name("output", tests, setup, teardown);
+}
