@@ -8,7 +8,7 @@ STD     := -std=c11 -D_DEFAULT_SOURCE
 WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wmissing-prototypes
 CFLAGS  += $(STD) $(OPT) $(WARN) -Icore -Iapi
 LDLIBS  := -lm
-CJSON   := $(shell pkg-config --libs libcjson 2>/dev/null || echo -lcjson) -lnettle
+LIBS    := $(shell pkg-config --libs libcjson 2>/dev/null || echo -lcjson) -lnettle
 CJSON_CFLAGS := $(shell pkg-config --cflags libcjson 2>/dev/null || echo -I/usr/include/cjson)
 CMOCKA  := $(shell pkg-config --libs cmocka 2>/dev/null || echo -lcmocka)
 SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
@@ -55,21 +55,21 @@ build/libpdeapi.a: $(API_OBJ)
 	$(AR) rcs $@ $^
 
 build/pdesolid: $(CLI_OBJ) build/libpdeapi.a build/libpdecore.a
-	$(CC) $(CFLAGS) $^ $(CJSON) $(LDLIBS) -o $@
+	$(CC) $(CFLAGS) $^ $(LIBS) $(LDLIBS) -o $@
 
 # The sanitised CLI, which the CLI tests drive alongside build/pdesolid.
 build/san/pdesolid: $(call san,$(CLI_SRC) $(API_SRC) $(CORE_SRC))
-	$(CC) $(CFLAGS) $(SAN) $^ $(CJSON) $(LDLIBS) -o $@
+	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(LDLIBS) -o $@
 
 build/san/tests/%: build/san/tests/%.o build/san/tests/support.o $(call san,$(API_SRC) $(CORE_SRC))
-	$(CC) $(CFLAGS) $(SAN) $^ $(CJSON) $(CMOCKA) $(LDLIBS) -lpthread -o $@
+	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(LDLIBS) -lpthread -o $@
 
 test: build/pdesolid build/san/pdesolid $(TESTS)
 	@set -e; for t in $(TESTS); do echo "== $$t"; PDESOLID=build/pdesolid PDESOLID_SAN=build/san/pdesolid ./$$t; done
 
 build/bench/%: bench/%.c build/libpdeapi.a build/libpdecore.a
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $^ $(CJSON) $(LDLIBS) -o $@
+	$(CC) $(CFLAGS) $(CJSON_CFLAGS) $^ $(LIBS) $(LDLIBS) -o $@
 
 bench: $(BENCHES)
 	@for b in $(BENCHES); do ./$$b; done

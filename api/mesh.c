@@ -119,6 +119,12 @@ static int sample_face(const pde_solution *sol, const face *f, const unsigned re
 
 #define DEAD 0xff    /* rface mark of a dropped triangle */
 
+/* A cell's key: 21 bits of each coordinate (cells wrap around far apart, which only costs a probe). */
+static uint64_t cell_key(int64_t x, int64_t y, int64_t z)
+{
+    return ((uint64_t)(x & 0x1fffff) << 42) | ((uint64_t)(y & 0x1fffff) << 21) | (uint64_t)(z & 0x1fffff);
+}
+
 /* The triple in increasing order; returns the parity of the sorting permutation. */
 static int sorted(const uint32_t t[3], uint32_t s[3])
 {
@@ -196,7 +202,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out
     uint32_t *wid = malloc(nraw * sizeof *wid);
     double *wpos = malloc(3 * nraw * sizeof *wpos);
     uint32_t *chain = malloc(nraw * sizeof *chain);
-    u64map cells = { 0 }, verts = { 0 }, tris = { 0 };
+    u64map cells = { 0 }, tris = { 0 };
     memset(out, 0, sizeof *out);
     int rc = -1;
     const char *why = "out of memory building the mesh";
@@ -243,27 +249,32 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out
     for (size_t i = 0; i < nraw; i++) {
         const float *p = raw + 3 * i;
         int64_t c[3];
-        for (int k = 0; k < 3; k++)
-            c[k] = (int64_t)floor((p[k] - lo[k]) / cell);
-        uint32_t hit = UINT32_MAX;
-        for (int d = 0; d < 27 && hit == UINT32_MAX; d++) {
-            int64_t q[3] = { c[0] + d % 3 - 1, c[1] + d / 3 % 3 - 1, c[2] + d / 9 - 1 };
-            uint64_t key = ((uint64_t)(q[0] & 0x1fffff) << 42) | ((uint64_t)(q[1] & 0x1fffff) << 21) |
-                           (uint64_t)(q[2] & 0x1fffff);
-            size_t s = slot(&cells, key);
-            if (cells.keys[s] != key)
-                continue;
-            for (uint32_t w = cells.vals[s]; w != UINT32_MAX && hit == UINT32_MAX; w = chain[w])
-                if (fabs(wpos[3 * w] - p[0]) <= eps && fabs(wpos[3 * w + 1] - p[1]) <= eps &&
-                    fabs(wpos[3 * w + 2] - p[2]) <= eps)
-                    hit = w;
+        int span[3][2];     /* neighbouring cells worth a look: only within eps of a side */
+        for (int k = 0; k < 3; k++) {
+            double f = (p[k] - lo[k]) / cell;
+            c[k] = (int64_t)floor(f);
+            double frac = (f - (double)c[k]) * cell;
+            span[k][0] = frac < eps ? -1 : 0;
+            span[k][1] = cell - frac < eps ? 1 : 0;
         }
+        uint32_t hit = UINT32_MAX;
+        for (int dx = span[0][0]; dx <= span[0][1] && hit == UINT32_MAX; dx++)
+            for (int dy = span[1][0]; dy <= span[1][1] && hit == UINT32_MAX; dy++)
+                for (int dz = span[2][0]; dz <= span[2][1] && hit == UINT32_MAX; dz++) {
+                    uint64_t key = cell_key(c[0] + dx, c[1] + dy, c[2] + dz);
+                    size_t s = slot(&cells, key);
+                    if (cells.keys[s] != key)
+                        continue;
+                    for (uint32_t w = cells.vals[s]; w != UINT32_MAX && hit == UINT32_MAX; w = chain[w])
+                        if (fabs(wpos[3 * w] - p[0]) <= eps && fabs(wpos[3 * w + 1] - p[1]) <= eps &&
+                            fabs(wpos[3 * w + 2] - p[2]) <= eps)
+                            hit = w;
+                }
         if (hit == UINT32_MAX) {
             hit = (uint32_t)npos++;
             for (int k = 0; k < 3; k++)
                 wpos[3 * hit + k] = p[k];
-            uint64_t key = ((uint64_t)(c[0] & 0x1fffff) << 42) | ((uint64_t)(c[1] & 0x1fffff) << 21) |
-                           (uint64_t)(c[2] & 0x1fffff);
+            uint64_t key = cell_key(c[0], c[1], c[2]);
             int found;
             uint32_t head = map_get_or_put(&cells, key, hit, &found);
             chain[hit] = found ? head : UINT32_MAX;
@@ -284,10 +295,31 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out
             sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) <= 1e-12 * extent * extent)
             rface[t] = DEAD;
     }
-    if (map_init(&tris, nt))
+    /* Only a triangle whose three positions all lie on a second face can have a coincident twin. */
+    uint8_t *mask = calloc(npos + 1, 1);
+    if (!mask)
         goto done;
+    size_t ncand = 0;
+    for (size_t t = 0; t < nt; t++)
+        if (rface[t] != DEAD)
+            for (int i = 0; i < 3; i++)
+                mask[rtri[3 * t + i]] |= (uint8_t)(1u << rface[t]);
     for (size_t t = 0; t < nt; t++) {
         if (rface[t] == DEAD)
+            continue;
+        uint8_t m = mask[rtri[3 * t]] & mask[rtri[3 * t + 1]] & mask[rtri[3 * t + 2]];
+        if (m & (m - 1))     /* two faces or more */
+            ncand++;
+    }
+    if (map_init(&tris, ncand)) {
+        free(mask);
+        goto done;
+    }
+    for (size_t t = 0; t < nt; t++) {
+        if (rface[t] == DEAD)
+            continue;
+        uint8_t m = mask[rtri[3 * t]] & mask[rtri[3 * t + 1]] & mask[rtri[3 * t + 2]];
+        if (!(m & (m - 1)))
             continue;
         uint32_t s3[3];
         int parity = sorted(&rtri[3 * t], s3);
@@ -307,6 +339,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out
         if (found)
             tris.vals[slot(&tris, key)] = (uint32_t)t;
     }
+    free(mask);
 
     /* 4. Outward: the enclosed volume must be positive. */
     double vol = 0.0;
@@ -325,21 +358,31 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out
     for (size_t t = 0; t < nt; t++)
         ntri += rface[t] != DEAD;
     out->tri = malloc((3 * ntri + 1) * sizeof *out->tri);
-    if (!out->tri || map_init(&verts, 3 * ntri + 1))
+    uint32_t *vof = malloc((npos + 1) * sizeof *vof);   /* this face's vertex at each position */
+    if (!out->tri || !vof) {
+        free(vof);
         goto done;
-    size_t nv = 0, k = 0;
-    for (size_t t = 0; t < nt; t++) {
-        if (rface[t] == DEAD)
-            continue;
-        uint32_t w[3] = { rtri[3 * t], rtri[3 * t + (flip ? 2 : 1)], rtri[3 * t + (flip ? 1 : 2)] };
-        for (int i = 0; i < 3; i++) {
-            int found;
-            uint32_t v = map_get_or_put(&verts, ((uint64_t)w[i] << 3) | rface[t], (uint32_t)nv, &found);
-            if (!found)
-                chain[nv++] = w[i];                     /* chain now maps vertex -> position id */
-            out->tri[k++] = v;
-        }
     }
+    memset(vof, 0xff, (npos + 1) * sizeof *vof);
+    size_t nv = 0, k = 0, first = 0;
+    for (int fi = 0; fi < 6; fi++) {
+        for (size_t t = 0; t < nt; t++) {
+            if (rface[t] != fi)
+                continue;
+            uint32_t w[3] = { rtri[3 * t], rtri[3 * t + (flip ? 2 : 1)], rtri[3 * t + (flip ? 1 : 2)] };
+            for (int i = 0; i < 3; i++) {
+                if (vof[w[i]] == UINT32_MAX) {
+                    vof[w[i]] = (uint32_t)nv;
+                    chain[nv++] = w[i];                 /* chain now maps vertex -> position id */
+                }
+                out->tri[k++] = vof[w[i]];
+            }
+        }
+        for (size_t v = first; v < nv; v++)             /* the next face starts afresh */
+            vof[chain[v]] = UINT32_MAX;
+        first = nv;
+    }
+    free(vof);
     out->pos = malloc((3 * nv + 1) * sizeof *out->pos);
     out->nrm = malloc((3 * nv + 1) * sizeof *out->nrm);
     out->weld = malloc((nv ? nv : 1) * sizeof *out->weld);
@@ -388,7 +431,6 @@ done:
     free(wpos);
     free(chain);
     map_free(&cells);
-    map_free(&verts);
     map_free(&tris);
     return rc;
 }

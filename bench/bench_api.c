@@ -1,0 +1,158 @@
+/*
+ * bench_api: the writers of api/, as medians on a noisy shared machine.
+ *
+ *   1. The grid JSON number writer against cJSON_PrintUnformatted of the same
+ *      numbers (tree and print, as a cJSON user would) and against
+ *      snprintf("%.9g"), all in this run (goals: >= 10x and >= 3x).
+ *   2. The whole grid JSON output (sampling and writing) in bytes per second.
+ *   3. glb of fig4a at 256 x 256 per face, in milliseconds (mesh, weld, write).
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <cJSON.h>
+
+#include "numfmt.h"
+#include "output.h"
+#include "template.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static int cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static pde_solution *solve_preset(const char *name)
+{
+    const api_preset *ps = api_preset_find(name);
+    api_params p;
+    api_error err;
+    api_preset_params(ps, &p);
+    api_model *m = api_template_expand(api_preset_template(ps), &p, &err);
+    pde_solution *s = NULL;
+    if (!m || api_solve(m, &s, &err))
+        fprintf(stderr, "%s: %s\n", name, err.message);
+    api_model_free(m);
+    return s;
+}
+
+static volatile size_t sink;
+
+int main(void)
+{
+    pde_solution *sol = solve_preset("fig4a");
+    if (!sol)
+        return 1;
+    /* The numbers: x, y, z of fig4a on a 64^3 grid, 786,432 floats. */
+    enum { N = 64, RUNS = 11 };
+    size_t count = 3 * (size_t)N * N * N;
+    float *v = malloc(count * sizeof *v);
+    pde_sample(sol, N, N, N, v);
+    char *buf = malloc(count * 20 + 64);
+
+    double tf[RUNS], tc[RUNS], ts[RUNS], rc[RUNS], rs[RUNS];
+    size_t bf = 0, bc = 0, bs = 0;
+    for (int r = 0; r < RUNS; r++) {
+        double t0 = now();
+        char *p = buf;
+        *p++ = '[';
+        for (size_t i = 0; i < count; i++) {
+            if (i)
+                *p++ = ',';
+            p += api_fmt_f32(p, v[i]);
+        }
+        *p++ = ']';
+        bf = (size_t)(p - buf);
+        double t1 = now();
+        cJSON *a = cJSON_CreateArray();
+        for (size_t i = 0; i < count; i++)
+            cJSON_AddItemToArray(a, cJSON_CreateNumber(v[i]));
+        char *s = cJSON_PrintUnformatted(a);
+        bc = strlen(s);
+        free(s);
+        cJSON_Delete(a);
+        double t2 = now();
+        p = buf;
+        *p++ = '[';
+        for (size_t i = 0; i < count; i++) {
+            if (i)
+                *p++ = ',';
+            p += snprintf(p, 20, "%.9g", (double)v[i]);
+        }
+        *p++ = ']';
+        bs = (size_t)(p - buf);
+        double t3 = now();
+        tf[r] = t1 - t0;
+        tc[r] = t2 - t1;
+        ts[r] = t3 - t2;
+        rc[r] = tc[r] / tf[r];
+        rs[r] = ts[r] / tf[r];
+        sink += bf + bc + bs;
+    }
+    printf("## Grid JSON numbers: %zu float32 values (fig4a, 64^3, x y z)\n\n", count);
+    printf("| writer | output | median time | numbers/s | bytes/s | time relative to api_fmt_f32 |\n|---|---|---|---|---|---|\n");
+    double mf = median(tf, RUNS), mc = median(tc, RUNS), ms = median(ts, RUNS);
+    printf("| api_fmt_f32 loop | %.1f MB | %.1f ms | %.0f M | %.0f MB/s | 1 |\n", bf / 1e6, mf * 1e3, count / mf / 1e6,
+           bf / mf / 1e6);
+    printf("| cJSON tree + cJSON_PrintUnformatted | %.1f MB | %.1f ms | %.1f M | %.0f MB/s | %.1f |\n", bc / 1e6,
+           mc * 1e3, count / mc / 1e6, bc / mc / 1e6, median(rc, RUNS));
+    printf("| snprintf(\"%%.9g\") loop | %.1f MB | %.1f ms | %.1f M | %.0f MB/s | %.1f |\n\n", bs / 1e6, ms * 1e3,
+           count / ms / 1e6, bs / ms / 1e6, median(rs, RUNS));
+
+    /* The whole grid JSON stream, sampling included. */
+    unsigned res[3] = { 128, 128, 128 };
+    double tg[RUNS];
+    size_t bytes = 0;
+    static char chunk[1 << 16];
+    for (int r = 0; r < RUNS; r++) {
+        double t0 = now();
+        api_error err;
+        api_output *o = api_output_open(sol, NULL, API_FMT_GRID, res, &err);
+        long n;
+        bytes = 0;
+        while ((n = api_output_read(o, chunk, sizeof chunk)) > 0)
+            bytes += (size_t)n;
+        api_output_free(o);
+        tg[r] = now() - t0;
+    }
+    double mg = median(tg, RUNS);
+    printf("## Grid JSON output, fig4a at 128^3, sampled and written\n\n%.1f MB in %.1f ms: %.0f MB/s\n\n", bytes / 1e6,
+           mg * 1e3, bytes / mg / 1e6);
+
+    /* glb of fig4a at 256 per face. */
+    unsigned mres[3] = { 256, 256, 256 };
+    double tm[RUNS];
+    for (int r = 0; r < RUNS; r++) {
+        double t0 = now();
+        api_error err;
+        api_output *o = api_output_open(sol, "bench", API_FMT_GLB, mres, &err);
+        long n;
+        bytes = 0;
+        while ((n = api_output_read(o, chunk, sizeof chunk)) > 0)
+            bytes += (size_t)n;
+        api_output_free(o);
+        tm[r] = now() - t0;
+    }
+    double mm = median(tm, RUNS);   /* sorts tm: tm[0] is then the least */
+    printf("## glb of fig4a at 256 x 256 per face\n\n%.1f MB, median %.1f ms (min %.1f ms) over %d runs\n", bytes / 1e6,
+           mm * 1e3, tm[0] * 1e3, RUNS);
+    free(v);
+    free(buf);
+    pde_solution_free(sol);
+    return 0;
+}
