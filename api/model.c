@@ -29,6 +29,7 @@ int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
 {
     if (!err)
         return -1;
+    err->status = 422;
     snprintf(err->pointer, sizeof err->pointer, "%s", pointer);
     va_list ap;
     va_start(ap, fmt);
@@ -156,8 +157,11 @@ static int term_array(const cJSON *j, const char *ptr, size_t *n, api_error *err
         return api_fail(err, ptr, "must be an array of terms, not %s", type_name(j));
     size_t k = 0;
     for (const cJSON *c = j->child; c; c = c->next)
-        if (++k > API_MAX_TERMS)
-            return api_fail(err, ptr, "has more than %d terms, the limit", API_MAX_TERMS);
+        if (++k > API_MAX_TERMS) {
+            api_fail(err, ptr, "has more than %d terms, the limit", API_MAX_TERMS);
+            err->status = 413;
+            return -1;
+        }
     *n = k;
     return 0;
 }
@@ -344,9 +348,37 @@ static api_model *parse_request(const cJSON *root, api_error *err)
     return api_template_expand(t, &p, err);
 }
 
+/* The deepest nesting of arrays and objects outside strings. */
+static int nesting(const char *s, size_t len)
+{
+    int depth = 0, most = 0, in_str = 0;
+    for (size_t i = 0; i < len; i++) {
+        char c = s[i];
+        if (in_str) {
+            if (c == '\\')
+                i++;
+            else if (c == '"')
+                in_str = 0;
+        } else if (c == '"') {
+            in_str = 1;
+        } else if (c == '[' || c == '{') {
+            if (++depth > most)
+                most = depth;
+        } else if (c == ']' || c == '}') {
+            depth--;
+        }
+    }
+    return most;
+}
+
 /* cJSON over a private NUL-terminated copy: 1.7.15 may read past a buffer without one. */
 static cJSON *parse_json(const char *text, size_t len, api_error *err)
 {
+    if (nesting(text, len) > API_MAX_DEPTH) {
+        api_fail(err, "", "the document nests arrays and objects deeper than %d levels, the limit", API_MAX_DEPTH);
+        err->status = 413;
+        return NULL;
+    }
     char *copy = malloc(len + 1);
     if (!copy) {
         api_fail(err, "", "out of memory");
@@ -366,7 +398,8 @@ static cJSON *parse_json(const char *text, size_t len, api_error *err)
             api_fail(err, "", "the document is empty; it must be a JSON object");
         else
             api_fail(err, "", "not valid JSON: syntax error at line %zu, column %zu (byte %zu)%s", line,
-                     col, at, at >= len ? ", the end of the text, or nesting deeper than 1000" : "");
+                     col, at, at >= len ? ", the end of the text" : "");
+        err->status = 400;
     } else {
         /* Anything but white space after the value is an error too. */
         const char *rest = end ? end : copy + len;
@@ -375,6 +408,7 @@ static cJSON *parse_json(const char *text, size_t len, api_error *err)
         if (rest < copy + len) {
             api_fail(err, "", "not valid JSON: text after the end of the value, at byte %zu",
                      (size_t)(rest - copy));
+            err->status = 400;
             cJSON_Delete(root);
             root = NULL;
         }
@@ -464,53 +498,71 @@ int api_solve(const api_model *m, pde_solution **out, api_error *err)
     return (int)st;
 }
 
+/* Reads an array of [u, v, w] at ptr into a new array; at most max points (over it: 413). */
+static int points_from(const cJSON *arr, const char *ptr, size_t max, double **out, size_t *count, api_error *err)
+{
+    if (!cJSON_IsArray(arr))
+        return api_fail(err, ptr, "must be an array of [u, v, w] points, not %s", type_name(arr));
+    size_t k = 0;
+    for (const cJSON *c = arr->child; c; c = c->next)
+        if (++k > max) {
+            api_fail(err, ptr, "has more than %zu points, the limit", max);
+            err->status = 413;
+            return -1;
+        }
+    double *pts = malloc((k ? k : 1) * 3 * sizeof *pts);
+    if (!pts)
+        return api_fail(err, ptr, "out of memory");
+    size_t i = 0;
+    for (const cJSON *c = arr->child; c; c = c->next, i++) {
+        char p[64];
+        snprintf(p, sizeof p, "%.40s/%zu", ptr, i);
+        if (!cJSON_IsArray(c) || cJSON_GetArraySize(c) != 3) {
+            free(pts);
+            return api_fail(err, p, "must be a point [u, v, w] of three numbers");
+        }
+        int q = 0;
+        for (const cJSON *x = c->child; x; x = x->next, q++) {
+            char pq[80];
+            snprintf(pq, sizeof pq, "%s/%d", p, q);
+            if (get_number(x, pq, &pts[3 * i + q], err)) {
+                free(pts);
+                return -1;
+            }
+        }
+    }
+    *out = pts;
+    *count = k;
+    return 0;
+}
+
 int api_points_parse(const char *text, size_t len, double **out, size_t *n, api_error *err)
 {
     cJSON *root = parse_json(text, len, err);
     if (!root)
         return -1;
-    int rc = 0;
-    double *pts = NULL;
-    size_t k = 0;
-    if (!cJSON_IsArray(root)) {
-        rc = api_fail(err, "", "must be an array of [u, v, w] points, not %s", type_name(root));
-        goto done;
-    }
-    for (const cJSON *c = root->child; c; c = c->next)
-        if (++k > API_MAX_POINTS) {
-            rc = api_fail(err, "", "has more than %d points, the limit", API_MAX_POINTS);
-            goto done;
-        }
-    pts = malloc((k ? k : 1) * 3 * sizeof *pts);
-    if (!pts) {
-        rc = api_fail(err, "", "out of memory");
-        goto done;
-    }
-    size_t i = 0;
-    for (const cJSON *c = root->child; c; c = c->next, i++) {
-        char p[40];
-        snprintf(p, sizeof p, "/%zu", i);
-        if (!cJSON_IsArray(c) || cJSON_GetArraySize(c) != 3) {
-            rc = api_fail(err, p, "must be a point [u, v, w] of three numbers");
-            goto done;
-        }
-        int q = 0;
-        for (const cJSON *x = c->child; x; x = x->next, q++) {
-            char pq[64];
-            snprintf(pq, sizeof pq, "%.40s/%d", p, q);
-            if (get_number(x, pq, &pts[3 * i + q], err)) {
-                rc = -1;
-                goto done;
-            }
-        }
-    }
-done:
+    int rc = points_from(root, "", API_MAX_POINTS, out, n, err);
     cJSON_Delete(root);
-    if (rc) {
-        free(pts);
-        return rc;
-    }
-    *out = pts;
-    *n = k;
-    return 0;
+    return rc;
+}
+
+int api_eval_parse(const char *text, size_t len, size_t max_points, double **out, size_t *n, int *derivatives,
+                   api_error *err)
+{
+    static const char *const keys[] = { "points", "derivatives", NULL };
+    cJSON *root = parse_json(text, len, err);
+    if (!root)
+        return -1;
+    const cJSON *k[2];
+    int rc = check_object(root, "", keys, k, err);
+    if (!rc && !k[0])
+        rc = api_fail(err, "/points", "is required: an array of [u, v, w] points");
+    if (!rc && k[1] && !cJSON_IsBool(k[1]))
+        rc = api_fail(err, "/derivatives", "must be true or false, not %s", type_name(k[1]));
+    if (!rc)
+        rc = points_from(k[0], "/points", max_points, out, n, err);
+    if (!rc)
+        *derivatives = k[1] && cJSON_IsTrue(k[1]);
+    cJSON_Delete(root);
+    return rc;
 }

@@ -31,14 +31,20 @@
 
 #include "pde.h"
 
-/* A JSON pointer (RFC 6901) to the field at fault, "" for the whole document, and a sentence. */
+/*
+ * A JSON pointer (RFC 6901) to the field at fault, "" for the whole document,
+ * a sentence, and the HTTP status it calls for: 400 for text that is not
+ * JSON, 413 for a document over a size limit, 422 for anything else wrong.
+ */
 typedef struct {
     char pointer[160];
     char message[320];
+    int status;
 } api_error;
 
 #define API_MAX_TERMS 4096    /* terms in one component's boundary or force list */
 #define API_MAX_POINTS 1000000
+#define API_MAX_DEPTH 64      /* nesting of arrays and objects; the format needs 6 */
 
 typedef struct api_model api_model;
 
@@ -68,7 +74,14 @@ int api_solve(const api_model *m, pde_solution **out, api_error *err);
  */
 int api_points_parse(const char *text, size_t len, double **out, size_t *n, api_error *err);
 
-/* Sets err from a printf format; returns -1, for one-line error returns. */
+/*
+ * Parses an eval request {"points": [[u, v, w], ...], "derivatives": false}
+ * with at most max_points points (over it: status 413). Returns 0, or -1.
+ */
+int api_eval_parse(const char *text, size_t len, size_t max_points, double **out, size_t *n, int *derivatives,
+                   api_error *err);
+
+/* Sets err from a printf format, with status 422; returns -1, for one-line error returns. */
 int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 

@@ -104,6 +104,8 @@ struct api_output {
     api_mesh mesh;
     unsigned char *blob;
     size_t blob_len, blob_pos;
+    pde_props props;
+    int have_props;
     char *text;           /* mesh formats: the JSON (glTF, GLB) */
     size_t text_len, split;   /* gltf: the base64 goes at text[split] */
 };
@@ -230,10 +232,19 @@ static cJSON *numbers(const double *v, int n)
     return a;
 }
 
+/* The caller's properties, or computed now. */
+static const pde_props *props_of(api_output *o)
+{
+    if (!o->have_props && pde_properties(o->sol, NULL, &o->props) != PDE_OK)
+        return NULL;
+    o->have_props = 1;
+    return &o->props;
+}
+
 static int json_document(api_output *o)
 {
-    pde_props props;
-    if (pde_properties(o->sol, NULL, &props) != PDE_OK)
+    const pde_props *props = props_of(o);
+    if (!props)
         return -1;
     cJSON *root = cJSON_CreateObject(), *comps = cJSON_AddObjectToObject(root, "components");
     if (o->id[0])
@@ -273,7 +284,7 @@ static int json_document(api_output *o)
         cJSON_AddStringToObject(root, "closed_form", text ? text : "");
         free(text);
     }
-    cJSON_AddItemToObject(root, "properties", props_tree(&props));
+    cJSON_AddItemToObject(root, "properties", props_tree(props));
     char *s = cJSON_PrintUnformatted(root);
     cJSON_Delete(root);
     if (!s)
@@ -457,10 +468,10 @@ static int mesh_open(api_output *o, api_error *err)
     memcpy(o->blob, o->mesh.pos, 12 * nv);
     memcpy(o->blob + 12 * nv, o->mesh.nrm, 12 * nv);
     memcpy(o->blob + 24 * nv, o->mesh.tri, 12 * nt);
-    pde_props props;
-    if (pde_properties(o->sol, NULL, &props) != PDE_OK)
+    const pde_props *props = props_of(o);
+    if (!props)
         return -1;
-    char *pj = api_props_json(&props);
+    char *pj = api_props_json(props);
     if (!pj)
         return -1;
     /* min and max as the exact float32 values (17 digits of the double they widen to). */
@@ -621,8 +632,8 @@ static int fill_stl(api_output *o)
 
 /* ---- the stream ---- */
 
-api_output *api_output_open(const pde_solution *sol, const char *id, api_format f, const unsigned res[3],
-                            api_error *err)
+api_output *api_output_open(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
+                            const unsigned res[3], api_error *err)
 {
     api_error local;
     if (!err)
@@ -634,6 +645,10 @@ api_output *api_output_open(const pde_solution *sol, const char *id, api_format 
     }
     o->fmt = f;
     o->sol = sol;
+    if (props) {
+        o->props = *props;
+        o->have_props = 1;
+    }
     o->size = -1;
     snprintf(o->id, sizeof o->id, "%s", id ? id : "");
     memcpy(o->res, res, sizeof o->res);

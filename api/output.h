@@ -14,7 +14,7 @@
  *
  * USAGE
  *
- *   api_output *o = api_output_open(sol, id, API_FMT_GLB, &res, &err);
+ *   api_output *o = api_output_open(sol, id, NULL, API_FMT_GLB, res, &err);
  *   long n;
  *   while ((n = api_output_read(o, buf, sizeof buf)) > 0) fwrite(buf, 1, n, f);
  *   api_output_free(o);
@@ -56,9 +56,13 @@ int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *er
 
 typedef struct api_output api_output;
 
-/* id: the model's id (id.h), or NULL. NULL and err on failure (out of memory, a mesh out of range). */
-api_output *api_output_open(const pde_solution *sol, const char *id, api_format f, const unsigned res[3],
-                            api_error *err);
+/*
+ * id: the model's id (id.h), or NULL. props: the solution's properties if the
+ * caller has them (json, gltf and glb carry them), or NULL to compute them.
+ * NULL and err on failure (out of memory, a mesh out of range).
+ */
+api_output *api_output_open(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
+                            const unsigned res[3], api_error *err);
 /* The total size in bytes, or -1 when it is known only at the end (json, grid). */
 long long api_output_size(const api_output *o);
 /* Up to max bytes into buf; returns the count, 0 at the end, or -1 out of memory. */

@@ -166,8 +166,15 @@ static void model_should_refuse_deep_nesting_and_huge_documents(void **state)
     deep[n] = '\0';
     assert_null(parse(deep, &err));
     assert_string_equal(err.pointer, "");
-    assert_non_null(strstr(err.message, "not valid JSON"));
+    assert_non_null(strstr(err.message, "deeper than 64 levels"));
+    assert_int_equal(err.status, 413);
     free(deep);
+    /* Depth inside strings does not count; 64 levels parse (and fail the schema, 422). */
+    char nest[200] = "{\"pde\":\"[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[\"}";
+    assert_null(parse(nest, &err));
+    assert_int_equal(err.status, 422);
+    assert_null(parse("{\"pde\": ", &err));
+    assert_int_equal(err.status, 400);
     /* 6000 terms, over 2 MB with padding: over the term limit. */
     size_t cap = 3 << 20, len = 0;
     char *big = malloc(cap);
@@ -179,6 +186,7 @@ static void model_should_refuse_deep_nesting_and_huge_documents(void **state)
     assert_null(parse(big, &err));
     assert_string_equal(err.pointer, "/boundary/x");
     assert_non_null(strstr(err.message, "limit"));
+    assert_int_equal(err.status, 413);
     free(big);
 }
 
@@ -206,6 +214,30 @@ static void solve_errors_should_point_at_the_term_or_coefficient(void **state)
     assert_non_null(strstr(err.message, "eigenvalue"));
     assert_null(sol);
     api_model_free(m);
+}
+
+static void eval_requests_should_parse_and_name_bad_entries(void **state)
+{
+    (void)state;
+    api_error err;
+    double *p;
+    size_t n;
+    int d = -1;
+    const char *ok = "{\"points\":[[0,0.5,1]],\"derivatives\":true}";
+    assert_int_equal(api_eval_parse(ok, strlen(ok), 10, &p, &n, &d, &err), 0);
+    assert_true(n == 1 && d == 1 && p[1] == 0.5);
+    free(p);
+    const char *cases[][3] = { { "{}", "/points", "required" },
+                               { "{\"points\":[],\"extra\":1}", "", "unknown key \"extra\"" },
+                               { "{\"points\":[[1,2,3]],\"derivatives\":1}", "/derivatives", "true or false" },
+                               { "{\"points\":[[1,2]]}", "/points/0", "three numbers" },
+                               { "{\"points\":[[1,2,3],[1,2,3],[1,2,3]]}", "/points", "more than 2 points" } };
+    for (size_t i = 0; i < 5; i++) {
+        assert_int_equal(api_eval_parse(cases[i][0], strlen(cases[i][0]), 2, &p, &n, &d, &err), -1);
+        assert_string_equal(err.pointer, cases[i][1]);
+        assert_non_null(strstr(err.message, cases[i][2]));
+        assert_int_equal(err.status, i == 4 ? 413 : 422);
+    }
 }
 
 static void points_should_parse_and_name_bad_entries(void **state)
@@ -239,6 +271,7 @@ int main(void)
         cmocka_unit_test(model_should_refuse_deep_nesting_and_huge_documents),
         cmocka_unit_test(solve_errors_should_point_at_the_term_or_coefficient),
         cmocka_unit_test(points_should_parse_and_name_bad_entries),
+        cmocka_unit_test(eval_requests_should_parse_and_name_bad_entries),
     };
     return cmocka_run_group_tests_name("model_json", tests, NULL, NULL);
 }

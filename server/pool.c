@@ -1,0 +1,111 @@
+/*
+ * pool.c: a fixed set of threads over a bounded FIFO of jobs (pool.h).
+ * The lock is released while a job runs.
+ */
+#include <pthread.h>
+#include <stdlib.h>
+
+#include "pool.h"
+
+typedef struct {
+    srv_job_fn fn;
+    void *arg;
+} job;
+
+struct srv_pool {
+    pthread_mutex_t lock;
+    pthread_cond_t work;
+    job *ring;
+    size_t cap, head, count, reserved, running;
+    int stopping, nthreads;
+    pthread_t *threads;
+};
+
+static void *worker(void *arg)
+{
+    srv_pool *p = arg;
+    pthread_mutex_lock(&p->lock);
+    for (;;) {
+        while (p->count == 0 && !p->stopping)
+            pthread_cond_wait(&p->work, &p->lock);
+        if (p->count == 0)
+            break;     /* stopping and drained */
+        job j = p->ring[p->head];
+        p->head = (p->head + 1) % p->cap;
+        p->count--;
+        p->running++;
+        pthread_mutex_unlock(&p->lock);
+        j.fn(j.arg);
+        pthread_mutex_lock(&p->lock);
+        p->running--;
+    }
+    pthread_mutex_unlock(&p->lock);
+    return NULL;
+}
+
+srv_pool *srv_pool_create(int threads, size_t queue)
+{
+    srv_pool *p = calloc(1, sizeof *p);
+    if (!p)
+        return NULL;
+    p->cap = queue ? queue : 1;
+    p->ring = malloc(p->cap * sizeof *p->ring);
+    p->threads = malloc((size_t)threads * sizeof *p->threads);
+    if (!p->ring || !p->threads || pthread_mutex_init(&p->lock, NULL) || pthread_cond_init(&p->work, NULL)) {
+        free(p->ring);
+        free(p->threads);
+        free(p);
+        return NULL;
+    }
+    for (p->nthreads = 0; p->nthreads < threads; p->nthreads++)
+        if (pthread_create(&p->threads[p->nthreads], NULL, worker, p)) {
+            srv_pool_destroy(p);
+            return NULL;
+        }
+    return p;
+}
+
+int srv_pool_reserve(srv_pool *p)
+{
+    pthread_mutex_lock(&p->lock);
+    int ok = !p->stopping && p->count + p->reserved < p->cap;
+    if (ok)
+        p->reserved++;
+    pthread_mutex_unlock(&p->lock);
+    return ok ? 0 : -1;
+}
+
+void srv_pool_submit(srv_pool *p, srv_job_fn fn, void *arg)
+{
+    pthread_mutex_lock(&p->lock);
+    p->reserved--;
+    p->ring[(p->head + p->count) % p->cap] = (job){ fn, arg };
+    p->count++;
+    pthread_cond_signal(&p->work);
+    pthread_mutex_unlock(&p->lock);
+}
+
+size_t srv_pool_depth(srv_pool *p)
+{
+    pthread_mutex_lock(&p->lock);
+    size_t d = p->count + p->running;
+    pthread_mutex_unlock(&p->lock);
+    return d;
+}
+
+void srv_pool_destroy(srv_pool *p)
+{
+    if (!p)
+        return;
+    pthread_mutex_lock(&p->lock);
+    p->stopping = 1;
+    pthread_cond_broadcast(&p->work);
+    pthread_mutex_unlock(&p->lock);
+    for (int i = 0; i < p->nthreads; i++)
+        pthread_join(p->threads[i], NULL);
+    pthread_cond_destroy(&p->work);
+    pthread_mutex_destroy(&p->lock);
+    free(p->ring);
+    free(p->threads);
+    free(p);
+}

@@ -1,0 +1,26 @@
+/*
+ * pool.h: the solver threads. A bounded queue (a mutex and a condition
+ * variable, as Redis's bio.c) feeds N threads. A job's slot is reserved
+ * before the job exists, so that the HTTP layer can answer 503 while it still
+ * can, and only then suspend the connection and hand the job over.
+ */
+#ifndef SRV_POOL_H
+#define SRV_POOL_H
+
+#include <stddef.h>
+
+typedef struct srv_pool srv_pool;
+typedef void (*srv_job_fn)(void *arg);
+
+/* NULL if out of memory or a thread cannot start. */
+srv_pool *srv_pool_create(int threads, size_t queue);
+/* Takes a place in the queue; 0, or -1 when the queue is full or the pool is stopping. */
+int srv_pool_reserve(srv_pool *p);
+/* Queues a job in a reserved place. Cannot fail. */
+void srv_pool_submit(srv_pool *p, srv_job_fn fn, void *arg);
+/* Jobs waiting or running now. */
+size_t srv_pool_depth(srv_pool *p);
+/* Runs every queued job to the end, then stops the threads and frees the pool. */
+void srv_pool_destroy(srv_pool *p);
+
+#endif
