@@ -16,6 +16,7 @@ SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fram
 CORE_SRC := $(wildcard core/*.c)
 API_SRC  := $(wildcard api/*.c)
 CLI_SRC  := $(wildcard clients/cli/*.c)
+SRV_SRC  := $(wildcard server/*.c)
 TEST_SRC := $(filter-out tests/support.c,$(wildcard tests/test_*.c))
 BENCH_SRC := $(wildcard bench/*.c)
 
@@ -26,12 +27,15 @@ san = $(patsubst %.c,build/san/%.o,$(1))
 CORE_OBJ := $(call obj,$(CORE_SRC))
 API_OBJ  := $(call obj,$(API_SRC))
 CLI_OBJ  := $(call obj,$(CLI_SRC))
+SRV_OBJ  := $(call obj,$(SRV_SRC))
+MHD      := $(shell pkg-config --libs libmicrohttpd 2>/dev/null || echo -lmicrohttpd)
+CURL     := $(shell pkg-config --libs libcurl 2>/dev/null || echo -lcurl)
 
 TESTS := $(patsubst tests/%.c,build/san/tests/%,$(TEST_SRC))
 BENCHES := $(patsubst bench/%.c,build/bench/%,$(BENCH_SRC))
 
 .PHONY: all test bench clean deps
-all: build/pdesolid
+all: build/pdesolid build/pdesolidd
 
 # Installs missing Debian packages (a no-op when all are there).
 deps:
@@ -57,15 +61,23 @@ build/libpdeapi.a: $(API_OBJ)
 build/pdesolid: $(CLI_OBJ) build/libpdeapi.a build/libpdecore.a
 	$(CC) $(CFLAGS) $^ $(LIBS) $(LDLIBS) -o $@
 
+build/pdesolidd: $(SRV_OBJ) build/libpdeapi.a build/libpdecore.a
+	$(CC) $(CFLAGS) $^ $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@
+
+# The sanitised daemon, which the integration tests start.
+build/san/pdesolidd: $(call san,$(SRV_SRC) $(API_SRC) $(CORE_SRC))
+	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@
+
 # The sanitised CLI, which the CLI tests drive alongside build/pdesolid.
 build/san/pdesolid: $(call san,$(CLI_SRC) $(API_SRC) $(CORE_SRC))
 	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(LDLIBS) -o $@
 
 build/san/tests/%: build/san/tests/%.o build/san/tests/support.o $(call san,$(API_SRC) $(CORE_SRC))
-	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(LDLIBS) -lpthread -o $@
+	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(CURL) $(LDLIBS) -lpthread -o $@
 
-test: build/pdesolid build/san/pdesolid $(TESTS)
-	@set -e; for t in $(TESTS); do echo "== $$t"; PDESOLID=build/pdesolid PDESOLID_SAN=build/san/pdesolid ./$$t; done
+test: build/pdesolid build/pdesolidd build/san/pdesolid build/san/pdesolidd $(TESTS)
+	@set -e; for t in $(TESTS); do echo "== $$t"; PDESOLID=build/pdesolid PDESOLID_SAN=build/san/pdesolid \
+	    PDESOLIDD_SAN=build/san/pdesolidd ./$$t; done
 
 build/bench/%: bench/%.c build/libpdeapi.a build/libpdecore.a
 	@mkdir -p $(dir $@)

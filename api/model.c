@@ -566,3 +566,64 @@ int api_eval_parse(const char *text, size_t len, size_t max_points, double **out
     cJSON_Delete(root);
     return rc;
 }
+
+static void add_factor(cJSON *o, const char *key, pde_factor f)
+{
+    static const char *const kinds[] = { "pow", "sin", "cos", "exp", "sinh", "cosh" };
+    if (f.kind == PDE_POW && f.p == 0)
+        return;     /* 1, the default */
+    cJSON *x = cJSON_AddObjectToObject(o, key);
+    if (x)
+        cJSON_AddNumberToObject(x, kinds[f.kind], f.p);
+}
+
+char *api_model_json(const pde_model *m)
+{
+    cJSON *root = cJSON_CreateObject(), *pde = cJSON_AddObjectToObject(root, "pde");
+    cJSON *bd = cJSON_AddObjectToObject(root, "boundary"), *fo = cJSON_AddObjectToObject(root, "force");
+    if (!pde || !bd || !fo) {
+        cJSON_Delete(root);
+        return NULL;
+    }
+    double abc[3][3];
+    for (int c = 0; c < 3; c++) {
+        abc[0][c] = m->comp[c].a;
+        abc[1][c] = m->comp[c].b;
+        abc[2][c] = m->comp[c].c;
+    }
+    static const char *const names[3] = { "a", "b", "c" };
+    for (int k = 0; k < 3; k++)
+        cJSON_AddItemToObject(pde, names[k], cJSON_CreateDoubleArray(abc[k], 3));
+    for (int c = 0; c < 3; c++) {
+        const pde_component *k = &m->comp[c];
+        if (k->nbterms) {
+            cJSON *list = cJSON_AddArrayToObject(bd, comp_key[c]);
+            for (size_t j = 0; list && j < k->nbterms; j++) {
+                const pde_bterm *t = &k->bterms[j];
+                cJSON *o = cJSON_CreateObject();
+                cJSON_AddItemToArray(list, o);
+                add_factor(o, "u", t->u);
+                add_factor(o, "v", t->v);
+                cJSON_AddNumberToObject(o, "w0", t->w0);
+                cJSON_AddNumberToObject(o, "dw0", t->dw0);
+                cJSON_AddNumberToObject(o, "w1", t->w1);
+                cJSON_AddNumberToObject(o, "dw1", t->dw1);
+            }
+        }
+        if (k->nfterms) {
+            cJSON *list = cJSON_AddArrayToObject(fo, comp_key[c]);
+            for (size_t j = 0; list && j < k->nfterms; j++) {
+                const pde_fterm *t = &k->fterms[j];
+                cJSON *o = cJSON_CreateObject();
+                cJSON_AddItemToArray(list, o);
+                cJSON_AddNumberToObject(o, "coef", t->coef);
+                add_factor(o, "u", t->u);
+                add_factor(o, "v", t->v);
+                add_factor(o, "w", t->w);
+            }
+        }
+    }
+    char *s = cJSON_PrintUnformatted(root);
+    cJSON_Delete(root);
+    return s;
+}

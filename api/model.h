@@ -81,6 +81,9 @@ int api_points_parse(const char *text, size_t len, double **out, size_t *n, api_
 int api_eval_parse(const char *text, size_t len, size_t max_points, double **out, size_t *n, int *derivatives,
                    api_error *err);
 
+/* The model in the general JSON format (malloc'd, unformatted); NULL if out of memory. */
+char *api_model_json(const pde_model *m);
+
 /* Sets err from a printf format, with status 422; returns -1, for one-line error returns. */
 int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));

@@ -1,0 +1,267 @@
+/*
+ * cache.c: the solution cache (cache.h).
+ *
+ * DESIGN
+ * One mutex guards a chained hash of entries and an LRU list. A miss inserts
+ * a SOLVING entry at once, so that requests for the same id that arrive
+ * meanwhile wait on its condition variable instead of solving again; the
+ * solve itself runs outside the lock. Eviction unlinks entries from the hash
+ * and the list; an unlinked entry is freed when its last reference goes.
+ */
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cache.h"
+
+enum { SOLVING, READY, FAILED };
+
+struct srv_entry {
+    char id[API_ID_LEN + 1];
+    pde_solution *sol;
+    size_t bytes;
+    int state, refs, linked;
+    api_error err;                 /* FAILED: why */
+    pthread_cond_t done;           /* SOLVING -> READY or FAILED */
+    srv_entry *hnext, *prev, *next;
+    pthread_once_t props_once;
+    pde_props props;
+    int props_ok;
+};
+
+#define BUCKETS 4096
+
+struct srv_cache {
+    pthread_mutex_t lock;
+    size_t max_bytes, bytes, entries;
+    unsigned long long hits, misses, evictions;
+    srv_entry *bucket[BUCKETS];
+    srv_entry *head, *tail;        /* most recently used first */
+};
+
+static size_t bucket_of(const char *id)
+{
+    size_t h = 14695981039346656037ull;
+    for (; *id; id++)
+        h = (h ^ (unsigned char)*id) * 1099511628211ull;
+    return h % BUCKETS;
+}
+
+srv_cache *srv_cache_create(size_t max_bytes)
+{
+    srv_cache *c = calloc(1, sizeof *c);
+    if (!c)
+        return NULL;
+    if (pthread_mutex_init(&c->lock, NULL)) {
+        free(c);
+        return NULL;
+    }
+    c->max_bytes = max_bytes;
+    return c;
+}
+
+static void entry_free(srv_entry *e)
+{
+    pde_solution_free(e->sol);
+    pthread_cond_destroy(&e->done);
+    free(e);
+}
+
+static void lru_unlink(srv_cache *c, srv_entry *e)
+{
+    if (e->prev)
+        e->prev->next = e->next;
+    else
+        c->head = e->next;
+    if (e->next)
+        e->next->prev = e->prev;
+    else
+        c->tail = e->prev;
+    e->prev = e->next = NULL;
+}
+
+static void lru_front(srv_cache *c, srv_entry *e)
+{
+    e->prev = NULL;
+    e->next = c->head;
+    if (c->head)
+        c->head->prev = e;
+    c->head = e;
+    if (!c->tail)
+        c->tail = e;
+}
+
+/* Takes e out of the hash and the list; frees it if no one holds it. */
+static void unlink_entry(srv_cache *c, srv_entry *e)
+{
+    srv_entry **p = &c->bucket[bucket_of(e->id)];
+    while (*p && *p != e)
+        p = &(*p)->hnext;
+    if (*p)
+        *p = e->hnext;
+    if (e->state == READY) {
+        lru_unlink(c, e);
+        c->bytes -= e->bytes;
+    }
+    c->entries--;
+    e->linked = 0;
+    if (e->refs == 0)
+        entry_free(e);
+}
+
+void srv_cache_destroy(srv_cache *c)
+{
+    if (!c)
+        return;
+    for (size_t b = 0; b < BUCKETS; b++)
+        while (c->bucket[b])
+            unlink_entry(c, c->bucket[b]);    /* every request has ended: no references are left */
+    pthread_mutex_destroy(&c->lock);
+    free(c);
+}
+
+static srv_entry *lookup(srv_cache *c, const char *id)
+{
+    for (srv_entry *e = c->bucket[bucket_of(id)]; e; e = e->hnext)
+        if (strcmp(e->id, id) == 0)
+            return e;
+    return NULL;
+}
+
+/* Waits while e is being solved; returns e referenced, or NULL (with err) if its solve failed. */
+static srv_entry *await(srv_cache *c, srv_entry *e, api_error *err)
+{
+    e->refs++;
+    while (e->state == SOLVING)
+        pthread_cond_wait(&e->done, &c->lock);
+    if (e->state == READY) {
+        if (e->linked) {
+            lru_unlink(c, e);
+            lru_front(c, e);
+        }
+        return e;
+    }
+    if (err)
+        *err = e->err;
+    if (--e->refs == 0 && !e->linked)
+        entry_free(e);
+    return NULL;
+}
+
+srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void *arg, int *hit, api_error *err)
+{
+    pthread_mutex_lock(&c->lock);
+    srv_entry *e = lookup(c, id);
+    if (e) {
+        c->hits++;
+        *hit = 1;
+        e = await(c, e, err);
+        pthread_mutex_unlock(&c->lock);
+        return e;
+    }
+    *hit = 0;
+    c->misses++;
+    e = calloc(1, sizeof *e);
+    if (!e || pthread_cond_init(&e->done, NULL)) {
+        free(e);
+        pthread_mutex_unlock(&c->lock);
+        api_fail(err, "", "out of memory");
+        err->status = 500;
+        return NULL;
+    }
+    memcpy(e->id, id, sizeof e->id);
+    e->id[API_ID_LEN] = '\0';
+    e->state = SOLVING;
+    e->refs = 1;
+    e->linked = 1;
+    e->props_once = (pthread_once_t)PTHREAD_ONCE_INIT;
+    size_t b = bucket_of(e->id);
+    e->hnext = c->bucket[b];
+    c->bucket[b] = e;
+    c->entries++;
+    pthread_mutex_unlock(&c->lock);
+
+    pde_solution *sol = NULL;
+    int rc = solve(arg, &sol, &e->err);
+
+    pthread_mutex_lock(&c->lock);
+    if (rc) {
+        e->state = FAILED;
+        if (err)
+            *err = e->err;
+        pthread_cond_broadcast(&e->done);
+        e->refs--;
+        unlink_entry(c, e);     /* failures are not cached: the next request tries again */
+        pthread_mutex_unlock(&c->lock);
+        return NULL;
+    }
+    e->sol = sol;
+    e->bytes = pde_solution_bytes(sol) + sizeof *e;
+    e->state = READY;
+    c->bytes += e->bytes;
+    lru_front(c, e);
+    pthread_cond_broadcast(&e->done);
+    while (c->bytes > c->max_bytes && c->tail) {
+        c->evictions++;
+        unlink_entry(c, c->tail);   /* may be e itself, when it alone exceeds the bound: it lives on its reference */
+    }
+    pthread_mutex_unlock(&c->lock);
+    return e;
+}
+
+srv_entry *srv_cache_find(srv_cache *c, const char *id)
+{
+    pthread_mutex_lock(&c->lock);
+    srv_entry *e = lookup(c, id);
+    if (e)
+        e = await(c, e, NULL);
+    pthread_mutex_unlock(&c->lock);
+    return e;
+}
+
+void srv_cache_release(srv_cache *c, srv_entry *e)
+{
+    if (!e)
+        return;
+    pthread_mutex_lock(&c->lock);
+    if (--e->refs == 0 && !e->linked)
+        entry_free(e);
+    pthread_mutex_unlock(&c->lock);
+}
+
+const pde_solution *srv_entry_solution(const srv_entry *e)
+{
+    return e->sol;
+}
+
+const char *srv_entry_id(const srv_entry *e)
+{
+    return e->id;
+}
+
+/* pthread_once runs a function without arguments: the entry being initialised travels in a thread-local. */
+static _Thread_local srv_entry *props_target;
+
+static void compute_props(void)
+{
+    srv_entry *e = props_target;
+    e->props_ok = pde_properties(e->sol, NULL, &e->props) == PDE_OK;
+}
+
+const pde_props *srv_entry_props(srv_entry *e)
+{
+    props_target = e;
+    pthread_once(&e->props_once, compute_props);
+    return e->props_ok ? &e->props : NULL;
+}
+
+void srv_cache_stats_get(srv_cache *c, srv_cache_stats *out)
+{
+    pthread_mutex_lock(&c->lock);
+    out->hits = c->hits;
+    out->misses = c->misses;
+    out->evictions = c->evictions;
+    out->bytes = c->bytes;
+    out->entries = c->entries;
+    pthread_mutex_unlock(&c->lock);
+}

@@ -1,0 +1,48 @@
+/*
+ * cache.h: solved solutions keyed by their model's id, shared by all
+ * threads: LRU, bounded in bytes. Solutions are immutable; entries are
+ * reference-counted, so an evicted entry stays alive while a request still
+ * samples it. Concurrent requests for one id solve it once: the first solves,
+ * the others wait for it.
+ */
+#ifndef SRV_CACHE_H
+#define SRV_CACHE_H
+
+#include <stddef.h>
+
+#include "id.h"
+#include "model.h"
+#include "pde.h"
+
+typedef struct srv_cache srv_cache;
+typedef struct srv_entry srv_entry;
+
+/* Solves the model behind an id: 0 and *out, or non-zero with err. */
+typedef int (*srv_solve_fn)(void *arg, pde_solution **out, api_error *err);
+
+typedef struct {
+    unsigned long long hits, misses, evictions;
+    size_t bytes, entries;
+} srv_cache_stats;
+
+srv_cache *srv_cache_create(size_t max_bytes);
+void srv_cache_destroy(srv_cache *c);
+
+/*
+ * The entry of id, solving it with solve(arg) if no one has. Returns a
+ * reference (release it), or NULL with err when the solve failed. *hit tells
+ * whether the solution was there (or being solved by another request).
+ */
+srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void *arg, int *hit, api_error *err);
+/* The entry of id if it is cached (waiting for a solve under way), else NULL. */
+srv_entry *srv_cache_find(srv_cache *c, const char *id);
+void srv_cache_release(srv_cache *c, srv_entry *e);
+
+const pde_solution *srv_entry_solution(const srv_entry *e);
+const char *srv_entry_id(const srv_entry *e);
+/* The properties, computed once on first use; NULL if out of memory. */
+const pde_props *srv_entry_props(srv_entry *e);
+
+void srv_cache_stats_get(srv_cache *c, srv_cache_stats *out);
+
+#endif

@@ -1,0 +1,41 @@
+/*
+ * pdesolidd: the pdesolid solve server. Parses flags, starts the daemon,
+ * and waits for SIGTERM or SIGINT, on which it stops accepting, finishes the
+ * requests in flight and exits 0.
+ */
+#include <signal.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "config.h"
+#include "http.h"
+
+int main(int argc, char **argv)
+{
+    srv_config c;
+    int rc = srv_config_parse(argc, argv, &c, stdout, stderr);
+    if (rc)
+        return rc == 1 ? 0 : 2;
+    /* Every thread inherits this mask: the signals arrive only at sigwait below. */
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGTERM);
+    sigaddset(&set, SIGINT);
+    pthread_sigmask(SIG_BLOCK, &set, NULL);
+    signal(SIGPIPE, SIG_IGN);
+    char err[256];
+    srv_server *s = srv_start(&c, err, sizeof err);
+    if (!s) {
+        fprintf(stderr, "pdesolidd: %s\n", err);
+        return 1;
+    }
+    srv_config_print(&c, stderr);
+    fprintf(stderr, "pdesolidd: listening on http://%s%s%s:%u/\n", strchr(c.bind, ':') ? "[" : "", c.bind,
+            strchr(c.bind, ':') ? "]" : "", srv_port(s));
+    int sig;
+    sigwait(&set, &sig);
+    fprintf(stderr, "pdesolidd: %s: finishing the requests in flight\n", sig == SIGTERM ? "SIGTERM" : "SIGINT");
+    srv_stop(s);
+    fprintf(stderr, "pdesolidd: stopped\n");
+    return 0;
+}

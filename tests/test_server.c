@@ -1,0 +1,748 @@
+/*
+ * test_server.c: pdesolidd over HTTP on loopback, with libcurl. Each test
+ * starts the sanitised daemon on a free port ($PDESOLIDD_SAN, build/san/pdesolidd)
+ * and stops it with SIGTERM, which must end in exit status 0 (so a leak the
+ * sanitiser finds at exit fails the test too).
+ */
+#define _GNU_SOURCE   /* strcasestr */
+#include <arpa/inet.h>
+#include <math.h>
+#include <poll.h>
+#include <pthread.h>
+#include <setjmp.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cJSON.h>
+#include <cmocka.h>
+#include <curl/curl.h>
+
+#include "id.h"
+#include "support.h"
+#include "template.h"
+
+static char dir[] = "/tmp/pdesolid-srv-XXXXXX";
+
+typedef struct {
+    pid_t pid;
+    int port;
+    char base[64];
+    char log[128];
+} daemon_t;
+
+static void start(daemon_t *d, const char *args)
+{
+    const char *bin = getenv("PDESOLIDD_SAN") ? getenv("PDESOLIDD_SAN") : "build/san/pdesolidd";
+    static int n;
+    snprintf(d->log, sizeof d->log, "%s/daemon%d.log", dir, n++);
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "exec %s --port 0 --threads 2 %s 2>%s", bin, args, d->log);
+    d->pid = fork();
+    if (d->pid == 0) {
+        execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);
+        _exit(127);
+    }
+    /* Wait for "listening on http://127.0.0.1:PORT/". */
+    for (int i = 0; i < 400; i++) {
+        char *text = read_file(d->log, NULL);
+        const char *p = text ? strstr(text, "listening on http://127.0.0.1:") : NULL;
+        if (p) {
+            d->port = atoi(p + strlen("listening on http://127.0.0.1:"));
+            free(text);
+            snprintf(d->base, sizeof d->base, "http://127.0.0.1:%d", d->port);
+            return;
+        }
+        free(text);
+        int st;
+        if (waitpid(d->pid, &st, WNOHANG) == d->pid)
+            fail_msg("pdesolidd exited at start (status %d)", st);
+        usleep(25000);
+    }
+    fail_msg("pdesolidd did not start");
+}
+
+/* SIGTERM; the daemon must finish and exit 0. */
+static void stop(daemon_t *d)
+{
+    kill(d->pid, SIGTERM);
+    int st;
+    waitpid(d->pid, &st, 0);
+    if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        char *log = read_file(d->log, NULL);
+        fail_msg("pdesolidd exited with status %d:\n%s", WIFEXITED(st) ? WEXITSTATUS(st) : -1, log ? log : "");
+    }
+}
+
+typedef struct {
+    long status;
+    char *body;
+    size_t len;
+    char headers[4096];
+} reply;
+
+static size_t on_body(char *p, size_t size, size_t n, void *cls)
+{
+    reply *r = cls;
+    r->body = realloc(r->body, r->len + size * n + 1);
+    memcpy(r->body + r->len, p, size * n);
+    r->len += size * n;
+    r->body[r->len] = '\0';
+    return size * n;
+}
+
+static size_t on_header(char *p, size_t size, size_t n, void *cls)
+{
+    reply *r = cls;
+    size_t have = strlen(r->headers);
+    if (have + size * n < sizeof r->headers) {
+        memcpy(r->headers + have, p, size * n);
+        r->headers[have + size * n] = '\0';
+    }
+    return size * n;
+}
+
+/* method, path (with query), body or NULL, one extra header or NULL. */
+static reply http(const daemon_t *d, const char *method, const char *path, const char *body, size_t blen,
+                  const char *header)
+{
+    reply r = { 0 };
+    CURL *c = curl_easy_init();
+    char url[512];
+    snprintf(url, sizeof url, "%s%s", d->base, path);
+    curl_easy_setopt(c, CURLOPT_URL, url);
+    curl_easy_setopt(c, CURLOPT_CUSTOMREQUEST, method);
+    if (body) {
+        curl_easy_setopt(c, CURLOPT_POSTFIELDS, body);
+        curl_easy_setopt(c, CURLOPT_POSTFIELDSIZE_LARGE, (curl_off_t)blen);
+    }
+    struct curl_slist *h = curl_slist_append(NULL, "Expect:");
+    if (header)
+        h = curl_slist_append(h, header);
+    curl_easy_setopt(c, CURLOPT_HTTPHEADER, h);
+    curl_easy_setopt(c, CURLOPT_WRITEFUNCTION, on_body);
+    curl_easy_setopt(c, CURLOPT_WRITEDATA, &r);
+    curl_easy_setopt(c, CURLOPT_HEADERFUNCTION, on_header);
+    curl_easy_setopt(c, CURLOPT_HEADERDATA, &r);
+    curl_easy_setopt(c, CURLOPT_TIMEOUT, 120L);
+    CURLcode rc = curl_easy_perform(c);
+    if (rc != CURLE_OK)
+        r.status = -(long)rc;
+    else
+        curl_easy_getinfo(c, CURLINFO_RESPONSE_CODE, &r.status);
+    curl_slist_free_all(h);
+    curl_easy_cleanup(c);
+    if (!r.body)
+        r.body = calloc(1, 1);
+    return r;
+}
+
+static reply post(const daemon_t *d, const char *path, const char *body)
+{
+    return http(d, "POST", path, body, strlen(body), NULL);
+}
+
+/* The value of a response header, into out. */
+static int header_value(const reply *r, const char *name, char *out, size_t n)
+{
+    size_t len = strlen(name);
+    for (const char *p = r->headers; (p = strcasestr(p, name)); p += len)
+        if ((p == r->headers || p[-1] == '\n') && p[len] == ':') {
+            p += len + 1;
+            while (*p == ' ')
+                p++;
+            size_t k = strcspn(p, "\r\n");
+            snprintf(out, n, "%.*s", (int)(k < n ? k : n - 1), p);
+            return 1;
+        }
+    return 0;
+}
+
+static void expect_problem(const reply *r, long status, const char *pointer, const char *words)
+{
+    if (r->status != status)
+        fail_msg("status %ld, expected %ld: %s", r->status, status, r->body);
+    char ct[128];
+    assert_true(header_value(r, "Content-Type", ct, sizeof ct));
+    assert_string_equal(ct, "application/problem+json");
+    cJSON *p = cJSON_Parse(r->body);
+    assert_non_null(p);
+    assert_int_equal(cJSON_GetObjectItem(p, "status")->valueint, status);
+    if (!strstr(cJSON_GetObjectItem(p, "detail")->valuestring, words))
+        fail_msg("detail \"%s\" lacks \"%s\"", cJSON_GetObjectItem(p, "detail")->valuestring, words);
+    if (pointer)
+        assert_string_equal(cJSON_GetObjectItem(p, "pointer")->valuestring, pointer);
+    cJSON_Delete(p);
+}
+
+static pde_solution *local_solve(const char *preset, char *id)
+{
+    const api_preset *ps = api_preset_find(preset);
+    api_params p;
+    api_error err;
+    api_preset_params(ps, &p);
+    api_model *m = api_template_expand(api_preset_template(ps), &p, &err);
+    pde_solution *s;
+    assert_int_equal(api_solve(m, &s, &err), 0);
+    if (id)
+        api_model_id(api_model_get(m), id, NULL);
+    api_model_free(m);
+    return s;
+}
+
+static long metric(const daemon_t *d, const char *name)
+{
+    reply r = http(d, "GET", "/metrics", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    char key[128];
+    snprintf(key, sizeof key, "\n%s ", name);
+    const char *p = strstr(r.body, key);
+    long v = p ? atol(p + strlen(key)) : -1;
+    free(r.body);
+    return v;
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    curl_global_init(CURL_GLOBAL_ALL);
+    signal(SIGPIPE, SIG_IGN);
+    return mkdtemp(dir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    curl_global_cleanup();
+    char cmd[96];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+/* ---- every format, against the core ---- */
+
+static void solve_should_give_every_format_as_the_core_computes_it(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    char id[API_ID_LEN + 1], hid[64];
+    pde_solution *sol = local_solve("fig3c", id);
+    const char *req = "{\"preset\":\"fig3c\"}";
+    /* f32 against pde_eval. */
+    reply r = post(&d, "/solve?format=f32&res=5,6,7", req);
+    assert_int_equal(r.status, 200);
+    assert_true(header_value(&r, "X-Solid-Id", hid, sizeof hid));
+    assert_string_equal(hid, id);
+    assert_int_equal(r.len, 12 * 5 * 6 * 7);
+    float *f = malloc(r.len);
+    memcpy(f, r.body, r.len);
+    for (int k = 0; k < 7; k++)
+        for (int j = 0; j < 6; j++)
+            for (int i = 0; i < 5; i++) {
+                double x[3];
+                pde_eval(sol, i / 4.0, j / 5.0, k / 6.0, x);
+                for (int c = 0; c < 3; c++)
+                    assert_rel(f[3 * ((k * 6 + j) * 5 + i) + c], x[c], 1e-6, 1);
+            }
+    /* grid JSON equals the f32. */
+    reply g = post(&d, "/solve?format=grid&res=5,6,7", req);
+    assert_int_equal(g.status, 200);
+    cJSON *gj = cJSON_Parse(g.body);
+    assert_non_null(gj);
+    const char *comp[3] = { "x", "y", "z" };
+    for (int c = 0; c < 3; c++) {
+        int i = 0;
+        for (cJSON *e = cJSON_GetObjectItem(gj, comp[c])->child; e; e = e->next, i++)
+            assert_true((float)e->valuedouble == f[3 * i + c]);
+        assert_int_equal(i, 5 * 6 * 7);
+    }
+    cJSON_Delete(gj);
+    free(g.body);
+    free(r.body);
+    /* json: the id and the closed form. */
+    r = post(&d, "/solve", req);
+    assert_int_equal(r.status, 200);
+    cJSON *j = cJSON_Parse(r.body);
+    assert_string_equal(cJSON_GetObjectItem(j, "id")->valuestring, id);
+    assert_non_null(cJSON_GetObjectItem(j, "properties"));
+    cJSON_Delete(j);
+    free(r.body);
+    /* glb and gltf through the validator; vts and stl by their size. */
+    char cmd[512];
+    int n = snprintf(cmd, sizeof cmd, "node tests/node/validate_gltf.mjs");
+    const char *mesh[2] = { "glb", "gltf" };
+    for (int m = 0; m < 2; m++) {
+        char path[160], q[64];
+        snprintf(q, sizeof q, "/solve?format=%s&res=20", mesh[m]);
+        r = post(&d, q, req);
+        assert_int_equal(r.status, 200);
+        snprintf(path, sizeof path, "%s/srv.%s", dir, mesh[m]);
+        FILE *o = fopen(path, "wb");
+        fwrite(r.body, 1, r.len, o);
+        fclose(o);
+        free(r.body);
+        n += snprintf(cmd + n, sizeof cmd - (size_t)n, " %s", path);
+    }
+    snprintf(cmd + n, sizeof cmd - (size_t)n, " >/dev/null");
+    assert_int_equal(system(cmd), 0);
+    r = post(&d, "/solve?format=vts&res=4", req);
+    assert_int_equal(r.status, 200);
+    assert_non_null(strstr(r.body, "<VTKFile type=\"StructuredGrid\""));
+    free(r.body);
+    r = post(&d, "/solve?format=stl&res=10", req);
+    assert_int_equal(r.status, 200);
+    uint32_t nt;
+    memcpy(&nt, r.body + 80, 4);
+    assert_int_equal(r.len, 84 + 50 * (size_t)nt);
+    free(r.body);
+    /* GET /solids/{id} samples the cached solution again. */
+    char path[96];
+    snprintf(path, sizeof path, "/solids/%s?format=f32&res=5,6,7", id);
+    r = http(&d, "GET", path, NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    assert_memory_equal(r.body, f, 12 * 5 * 6 * 7);
+    free(r.body);
+    free(f);
+    pde_solution_free(sol);
+    stop(&d);
+}
+
+static void eval_should_agree_with_the_cli(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    reply r = post(&d, "/solve", "{\"preset\":\"fig4a\",\"params\":{\"p0\":41000}}");
+    char id[64];
+    assert_true(header_value(&r, "X-Solid-Id", id, sizeof id));
+    free(r.body);
+    const char *pts = "[[0.5,0.25,0.5],[1,0.125,0.75],[0.3,0.7,0.4],[0,0,0],[1,1,1]]";
+    char body[256], path[96];
+    snprintf(body, sizeof body, "{\"points\":%s,\"derivatives\":true}", pts);
+    snprintf(path, sizeof path, "/solids/%s/eval", id);
+    r = post(&d, path, body);
+    assert_int_equal(r.status, 200);
+    char ppath[160], cmd[512];
+    snprintf(ppath, sizeof ppath, "%s/pts.json", dir);
+    FILE *o = fopen(ppath, "w");
+    fputs(pts, o);
+    fclose(o);
+    snprintf(cmd, sizeof cmd, "%s eval --preset fig4a --param p0=41000 %s > %s/cli.json",
+             getenv("PDESOLID") ? getenv("PDESOLID") : "build/pdesolid", ppath, dir);
+    assert_int_equal(system(cmd), 0);
+    snprintf(ppath, sizeof ppath, "%s/cli.json", dir);
+    char *cli = read_file(ppath, NULL);
+    cJSON *a = cJSON_Parse(r.body), *b = cJSON_Parse(cli);
+    cJSON *vals = cJSON_GetObjectItem(a, "values");
+    assert_int_equal(cJSON_GetArraySize(vals), 5);
+    for (int i = 0; i < 5; i++)
+        for (int c = 0; c < 3; c++)
+            assert_true(cJSON_GetArrayItem(cJSON_GetArrayItem(vals, i), c)->valuedouble ==
+                        cJSON_GetArrayItem(cJSON_GetArrayItem(b, i), c)->valuedouble);
+    assert_int_equal(cJSON_GetArraySize(cJSON_GetObjectItem(a, "dw")), 5);
+    cJSON_Delete(a);
+    cJSON_Delete(b);
+    free(cli);
+    free(r.body);
+    stop(&d);
+}
+
+/* ---- the cache ---- */
+
+static void cache_hits_misses_and_evictions_should_show_in_metrics(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--cache-mb 1");
+    char first[64] = "", body[128];
+    int n = 0;
+    /* Distinct solids until the 1 MiB bound evicts one (a few hundred). */
+    while (metric(&d, "pdesolid_cache_evictions_total") == 0) {
+        assert_true(n < 5000);
+        for (int k = 0; k < 50; k++, n++) {
+            snprintf(body, sizeof body, "{\"preset\":\"fig3d\",\"params\":{\"r0\":%d}}", n + 1);
+            reply r = post(&d, "/solve?format=f32&res=2", body);
+            assert_int_equal(r.status, 200);
+            if (n == 0)
+                header_value(&r, "X-Solid-Id", first, sizeof first);
+            free(r.body);
+        }
+    }
+    assert_int_equal(metric(&d, "pdesolid_cache_misses_total"), n);
+    assert_true(metric(&d, "pdesolid_cache_bytes") <= 1 << 20);
+    /* The first was evicted: 404 for its id, and a miss when it is solved again. */
+    char path[96];
+    snprintf(path, sizeof path, "/solids/%s", first);
+    reply r = http(&d, "GET", path, NULL, 0, NULL);
+    expect_problem(&r, 404, NULL, "evicted");
+    free(r.body);
+    long hits = metric(&d, "pdesolid_cache_hits_total");
+    r = post(&d, "/solve?format=f32&res=2", body);   /* the last one: still cached */
+    free(r.body);
+    assert_int_equal(metric(&d, "pdesolid_cache_hits_total"), hits + 1);
+    stop(&d);
+}
+
+static void etag_with_if_none_match_should_give_304(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    reply r = post(&d, "/solve?format=glb&res=8", "{\"preset\":\"fig2a\"}");
+    assert_int_equal(r.status, 200);
+    char etag[128], inm[160];
+    assert_true(header_value(&r, "ETag", etag, sizeof etag));
+    assert_true(etag[0] == '"');
+    free(r.body);
+    snprintf(inm, sizeof inm, "If-None-Match: %s", etag);
+    const char *body = "{\"preset\":\"fig2a\"}";
+    r = http(&d, "POST", "/solve?format=glb&res=8", body, strlen(body), inm);
+    assert_int_equal(r.status, 304);
+    assert_int_equal(r.len, 0);
+    free(r.body);
+    r = http(&d, "POST", "/solve?format=glb&res=9", body, strlen(body), inm);
+    assert_int_equal(r.status, 200);
+    free(r.body);
+    stop(&d);
+}
+
+/* ---- load ---- */
+
+typedef struct {
+    const daemon_t *d;
+    int k, ok;
+} client_arg;
+
+static void *client(void *arg)
+{
+    client_arg *a = arg;
+    char body[128], id[API_ID_LEN + 1];
+    snprintf(body, sizeof body, "{\"preset\":\"fig4%c\"}", 'a' + a->k % 24);
+    reply r = post(a->d, "/solve?format=f32&res=3", body);
+    char name[8];
+    snprintf(name, sizeof name, "fig4%c", 'a' + a->k % 24);
+    const api_preset *ps = api_preset_find(name);
+    api_params p;
+    api_error err;
+    api_preset_params(ps, &p);
+    api_model *m = api_template_expand(api_preset_template(ps), &p, &err);
+    pde_solution *sol;
+    api_solve(m, &sol, &err);
+    api_model_id(api_model_get(m), id, NULL);
+    api_model_free(m);
+    a->ok = r.status == 200 && r.len == 12 * 27;
+    for (int i = 0; a->ok && i < 27; i++) {
+        double x[3];
+        pde_eval(sol, (i % 3) / 2.0, (i / 3 % 3) / 2.0, (i / 9) / 2.0, x);
+        for (int c = 0; c < 3; c++)
+            a->ok &= close_rel(((float *)r.body)[3 * i + c], x[c], 1e-6, 1);
+    }
+    char hid[64] = "";
+    header_value(&r, "X-Solid-Id", hid, sizeof hid);
+    a->ok &= !strcmp(hid, id);
+    pde_solution_free(sol);
+    free(r.body);
+    return NULL;
+}
+
+static void sixty_four_concurrent_clients_should_all_get_correct_answers(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    enum { N = 64 };
+    pthread_t t[N];
+    client_arg a[N];
+    for (int i = 0; i < N; i++) {
+        a[i] = (client_arg){ &d, i, 0 };
+        pthread_create(&t[i], NULL, client, &a[i]);
+    }
+    for (int i = 0; i < N; i++) {
+        pthread_join(t[i], NULL);
+        if (!a[i].ok)
+            fail_msg("client %d got a wrong answer", i);
+    }
+    stop(&d);
+}
+
+typedef struct {
+    const daemon_t *d;
+    int k;
+    long status;
+    char retry[16];
+} heavy_arg;
+
+static void *heavy(void *arg)
+{
+    heavy_arg *a = arg;
+    char body[128];
+    snprintf(body, sizeof body, "{\"preset\":\"fig3b\",\"params\":{\"r0\":%d}}", a->k + 2);
+    reply r = post(a->d, "/solve?format=glb&res=400", body);
+    a->status = r.status;
+    header_value(&r, "Retry-After", a->retry, sizeof a->retry);
+    if (r.status == 503)
+        expect_problem(&r, 503, NULL, "busy");
+    free(r.body);
+    return NULL;
+}
+
+static void a_full_queue_should_give_503_with_retry_after(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--threads 1 --queue 1");
+    enum { N = 8 };
+    pthread_t t[N];
+    heavy_arg a[N];
+    for (int i = 0; i < N; i++) {
+        a[i] = (heavy_arg){ &d, i, 0, "" };
+        pthread_create(&t[i], NULL, heavy, &a[i]);
+    }
+    int busy = 0, ok = 0;
+    for (int i = 0; i < N; i++) {
+        pthread_join(t[i], NULL);
+        if (a[i].status == 503) {
+            busy++;
+            assert_string_equal(a[i].retry, "1");
+        } else if (a[i].status == 200) {
+            ok++;
+        } else {
+            fail_msg("status %ld", a[i].status);
+        }
+    }
+    assert_true(busy > 0);
+    assert_true(ok > 0);
+    reply r = http(&d, "GET", "/livez", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    free(r.body);
+    stop(&d);
+}
+
+/* ---- bad input ---- */
+
+static void bad_requests_should_get_problems_and_the_daemon_should_keep_serving(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--max-points 10");
+    size_t big = 2 << 20;
+    char *huge = malloc(big);
+    memset(huge, ' ', big);
+    reply r = http(&d, "POST", "/solve", huge, big, NULL);
+    expect_problem(&r, 413, NULL, "limit of 1048576 bytes");
+    free(r.body);
+    free(huge);
+    r = post(&d, "/solve", "{\"pde\": [1, 2");
+    expect_problem(&r, 400, "", "not valid JSON");
+    free(r.body);
+    r = post(&d, "/solve", "{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[-1,-1,-1]},\"boundary\":{\"x\":[{\"u\":{\"tan\":1}}]}}");
+    expect_problem(&r, 422, "/boundary/x/0/u", "unknown key \"tan\"");
+    free(r.body);
+    r = post(&d, "/solve", "{\"preset\":\"fig4a\",\"params\":{\"c\":[-1,-1,0]}}");
+    expect_problem(&r, 422, "/params/c/2", "not fourth order");
+    free(r.body);
+    r = post(&d, "/solve?res=100000", "{\"preset\":\"fig4a\"}");
+    expect_problem(&r, 422, NULL, "limit of 4096");
+    free(r.body);
+    r = post(&d, "/solve?format=obj", "{\"preset\":\"fig4a\"}");
+    expect_problem(&r, 422, NULL, "is not a format");
+    free(r.body);
+    char *deep = malloc(5001);
+    memset(deep, '[', 5000);
+    deep[5000] = '\0';
+    r = post(&d, "/solve", deep);
+    expect_problem(&r, 413, "", "deeper than 64");
+    free(r.body);
+    free(deep);
+    r = post(&d, "/solve", "{\"preset\":\"fig4a\"}");
+    char id[64], path[96];
+    header_value(&r, "X-Solid-Id", id, sizeof id);
+    free(r.body);
+    snprintf(path, sizeof path, "/solids/%s/eval", id);
+    r = post(&d, path, "{\"points\":[[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0],[0,0,0]]}");
+    expect_problem(&r, 413, "/points", "more than 10 points");
+    free(r.body);
+    r = post(&d, path, "{\"points\":[[0,0]]}");
+    expect_problem(&r, 422, "/points/0", "three numbers");
+    free(r.body);
+    r = http(&d, "GET", "/nowhere", NULL, 0, NULL);
+    expect_problem(&r, 404, NULL, "no such resource");
+    free(r.body);
+    r = http(&d, "DELETE", "/solve", NULL, 0, NULL);
+    expect_problem(&r, 405, NULL, "DELETE is not allowed");
+    char allow[64];
+    assert_true(header_value(&r, "Allow", allow, sizeof allow));
+    free(r.body);
+    r = http(&d, "GET", "/solids/xyz", NULL, 0, NULL);
+    expect_problem(&r, 404, NULL, "no solid");
+    free(r.body);
+    r = http(&d, "GET", "/presets/fig9q", NULL, 0, NULL);
+    expect_problem(&r, 404, NULL, "no preset");
+    free(r.body);
+    r = http(&d, "GET", "/livez", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    free(r.body);
+    stop(&d);
+}
+
+static int dial(int port)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a = { .sin_family = AF_INET, .sin_port = htons((uint16_t)port) };
+    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    assert_int_equal(connect(fd, (struct sockaddr *)&a, sizeof a), 0);
+    return fd;
+}
+
+/* Reads until the peer closes or 10 s pass; returns the bytes, or -1 on a timeout. */
+static long read_to_close(int fd, char *buf, size_t cap)
+{
+    size_t n = 0;
+    for (;;) {
+        struct pollfd p = { fd, POLLIN, 0 };
+        if (poll(&p, 1, 10000) <= 0)
+            return -1;
+        ssize_t k = recv(fd, buf + n, cap - n - 1, 0);
+        if (k <= 0) {
+            buf[n] = '\0';
+            return (long)n;
+        }
+        n += (size_t)k;
+    }
+}
+
+static void two_content_lengths_and_stalled_clients_should_be_refused(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--timeout 1");
+    char buf[8192];
+    int fd = dial(d.port);
+    const char *req = "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: 18\r\nContent-Length: 5\r\n\r\n"
+                      "{\"preset\":\"fig4a\"}";
+    send(fd, req, strlen(req), 0);
+    long n = read_to_close(fd, buf, sizeof buf);
+    close(fd);
+    assert_true(n > 0);
+    assert_true(strstr(buf, " 400 ") != NULL);
+    /* Half the headers, then silence: closed after the one-second timeout. */
+    fd = dial(d.port);
+    const char *half = "GET /livez HTTP/1.1\r\nHost: x\r\n";
+    send(fd, half, strlen(half), 0);
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    n = read_to_close(fd, buf, sizeof buf);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    close(fd);
+    assert_int_equal(n, 0);
+    double waited = (t1.tv_sec - t0.tv_sec) + (t1.tv_nsec - t0.tv_nsec) * 1e-9;
+    assert_true(waited >= 0.5 && waited < 8);
+    reply r = http(&d, "GET", "/livez", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    free(r.body);
+    stop(&d);
+}
+
+/* ---- shutdown ---- */
+
+static void sigterm_should_let_a_request_in_flight_complete(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    heavy_arg a = { &d, 99, 0, "" };
+    pthread_t t;
+    pthread_create(&t, NULL, heavy, &a);
+    /* Wait until the job is on a solver thread, then SIGTERM. */
+    for (int i = 0; i < 400 && metric(&d, "pdesolid_queue_depth") < 1; i++)
+        usleep(5000);
+    kill(d.pid, SIGTERM);
+    pthread_join(t, NULL);
+    assert_int_equal(a.status, 200);
+    int st;
+    waitpid(d.pid, &st, 0);
+    assert_true(WIFEXITED(st));
+    assert_int_equal(WEXITSTATUS(st), 0);
+    char *log = read_file(d.log, NULL);
+    assert_non_null(strstr(log, "SIGTERM: finishing the requests in flight"));
+    assert_non_null(strstr(log, "\"POST /solve?format=glb&res=400\" 200"));   /* the access log */
+    free(log);
+}
+
+/* ---- the small routes ---- */
+
+static void presets_version_health_metrics_and_cors_should_answer(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--cors-origin http://a.example,http://b.example");
+    reply r = http(&d, "GET", "/presets", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    cJSON *j = cJSON_Parse(r.body);
+    assert_int_equal(cJSON_GetArraySize(cJSON_GetObjectItem(j, "presets")), 35);
+    assert_int_equal(cJSON_GetArraySize(cJSON_GetObjectItem(j, "templates")), 4);
+    cJSON_Delete(j);
+    free(r.body);
+    r = http(&d, "GET", "/presets/fig4c", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    j = cJSON_Parse(r.body);
+    assert_true(cJSON_GetObjectItem(cJSON_GetObjectItem(j, "params"), "p0")->valuedouble == 1.8e6);
+    /* Its model, posted as a model, is the same solid. */
+    char *model = cJSON_PrintUnformatted(cJSON_GetObjectItem(j, "model"));
+    reply s = post(&d, "/solve?format=f32&res=2", model);
+    char id[64];
+    assert_true(header_value(&s, "X-Solid-Id", id, sizeof id));
+    assert_string_equal(id, cJSON_GetObjectItem(j, "id")->valuestring);
+    free(s.body);
+    free(model);
+    cJSON_Delete(j);
+    free(r.body);
+    r = http(&d, "GET", "/version", NULL, 0, NULL);
+    assert_non_null(strstr(r.body, "\"libmicrohttpd\":\"0.9."));
+    free(r.body);
+    r = http(&d, "GET", "/readyz", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    free(r.body);
+    r = http(&d, "GET", "/metrics", NULL, 0, NULL);
+    assert_non_null(strstr(r.body, "pdesolid_request_duration_seconds_bucket{le=\"+Inf\"}"));
+    assert_non_null(strstr(r.body, "pdesolid_requests_total{route=\"presets\",status=\"200\"} 1"));
+    free(r.body);
+    r = http(&d, "OPTIONS", "/solve", NULL, 0, "Origin: http://b.example");
+    assert_int_equal(r.status, 204);
+    char v[128];
+    assert_true(header_value(&r, "Access-Control-Allow-Origin", v, sizeof v));
+    assert_string_equal(v, "http://b.example");
+    assert_true(header_value(&r, "Access-Control-Allow-Methods", v, sizeof v));
+    assert_string_equal(v, "POST, OPTIONS");
+    free(r.body);
+    r = http(&d, "GET", "/livez", NULL, 0, "Origin: http://evil.example");
+    assert_false(header_value(&r, "Access-Control-Allow-Origin", v, sizeof v));
+    free(r.body);
+    stop(&d);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(solve_should_give_every_format_as_the_core_computes_it),
+        cmocka_unit_test(eval_should_agree_with_the_cli),
+        cmocka_unit_test(cache_hits_misses_and_evictions_should_show_in_metrics),
+        cmocka_unit_test(etag_with_if_none_match_should_give_304),
+        cmocka_unit_test(sixty_four_concurrent_clients_should_all_get_correct_answers),
+        cmocka_unit_test(a_full_queue_should_give_503_with_retry_after),
+        cmocka_unit_test(bad_requests_should_get_problems_and_the_daemon_should_keep_serving),
+        cmocka_unit_test(two_content_lengths_and_stalled_clients_should_be_refused),
+        cmocka_unit_test(sigterm_should_let_a_request_in_flight_complete),
+        cmocka_unit_test(presets_version_health_metrics_and_cors_should_answer),
+    };
+    return cmocka_run_group_tests_name("server", tests, setup, teardown);
+}
