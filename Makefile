@@ -18,7 +18,7 @@ API_SRC  := $(wildcard api/*.c)
 CLI_SRC  := $(wildcard clients/cli/*.c)
 SRV_SRC  := $(wildcard server/*.c)
 TEST_SRC := $(filter-out tests/support.c,$(wildcard tests/test_*.c))
-BENCH_SRC := $(wildcard bench/*.c)
+BENCH_SRC := $(filter-out bench/mhd_minimal.c,$(wildcard bench/*.c))
 
 # Normal objects in build/obj, sanitised ones in build/san.
 obj = $(patsubst %.c,build/obj/%.o,$(1))
@@ -83,8 +83,13 @@ build/bench/%: bench/%.c build/libpdeapi.a build/libpdecore.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(CJSON_CFLAGS) $^ $(LIBS) $(LDLIBS) -o $@
 
-bench: $(BENCHES)
+build/bench/mhd_minimal: bench/mhd_minimal.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $< $(MHD) -lpthread -o $@
+
+bench: $(BENCHES) build/pdesolidd build/bench/mhd_minimal
 	@for b in $(BENCHES); do ./$$b; done
+	@bash bench/bench_server.sh
 
 clean:
 	rm -rf build

@@ -35,6 +35,7 @@
 #include "model.h"
 #include "output.h"
 #include "pool.h"
+#include "rcache.h"
 #include "template.h"
 
 enum route_id {
@@ -71,6 +72,7 @@ struct srv_server {
     srv_pool *pool;
     srv_cache *cache;
     srv_metrics *metrics;
+    srv_rcache *rcache;
     pthread_mutex_t json_lock;   /* cJSON_Parse writes a global */
     pthread_mutex_t lock;        /* in_flight, stopping */
     pthread_cond_t idle;
@@ -110,6 +112,8 @@ typedef struct {
     int retry_after;
     long long sent;
     stream *live;                /* the stream sending this response, if any */
+    char *key;                   /* the response cache's key of this request, or NULL */
+    size_t klen;
 } request;
 
 struct stream {
@@ -172,6 +176,23 @@ static void set_api_error(request *r, const api_error *e)
 {
     set_problem(r, e->status ? e->status : 422, e->pointer, "%s%s%s", e->pointer, e->pointer[0] ? ": " : "",
                 e->message);
+}
+
+/* The response cache's key: route, format, res, and the body or the id. NULL if too large to keep. */
+static void make_key(request *r)
+{
+    const char *fs = MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, "format");
+    const char *rs = MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, "res");
+    const char *tail = r->route == R_SOLVE ? (r->body ? r->body : "") : r->arg;
+    size_t tl = r->route == R_SOLVE ? r->len : strlen(r->arg);
+    if (tl > SRV_RCACHE_MAX_KEY)
+        return;
+    size_t cap = tl + 256;
+    if (!(r->key = malloc(cap)))
+        return;
+    int n = snprintf(r->key, cap, "%c\n%.100s\n%.100s\n", r->route == R_SOLVE ? 'S' : 'G', fs ? fs : "", rs ? rs : "");
+    memcpy(r->key + n, tail, tl);
+    r->klen = (size_t)n + tl;
 }
 
 static void set_text(request *r, int status, const char *ctype, char *text)
@@ -468,7 +489,7 @@ static enum MHD_Result quick(request *r)
         size_t in_flight = s->in_flight;
         pthread_mutex_unlock(&s->lock);
         set_text(r, 200, "text/plain; version=0.0.4; charset=utf-8",
-                 srv_metrics_render(s->metrics, &cs, srv_pool_depth(s->pool), in_flight));
+                 srv_metrics_render(s->metrics, &cs, srv_pool_depth(s->pool), in_flight, srv_rcache_hits(s->rcache)));
         break;
     }
     case R_PRESETS:
@@ -552,11 +573,30 @@ static void answer_entry(request *r, srv_entry *e, api_format f, const unsigned 
         set_problem(r, err.status == 422 ? 422 : 500, NULL, "%s", err.message);
         return;
     }
+    r->status = 200;
+    r->ctype = api_format_info_of(f)->mime;
+    long long size = api_output_size(o);
+    if (r->key && size >= 0 && size <= (long long)SRV_RCACHE_MAX_ITEM) {
+        /* Small and of known size: render it here, and keep it for the next identical request. */
+        char *bytes = malloc((size_t)size + 1);
+        long n = bytes ? api_output_read(o, bytes, (size_t)size) : -1;
+        api_output_free(o);
+        srv_cache_release(s->cache, e);
+        srv_metrics_output(s->metrics, now() - t0, n > 0 ? (size_t)n : 0);
+        if (n != size) {
+            free(bytes);
+            set_problem(r, 500, NULL, "out of memory");
+            return;
+        }
+        bytes[n] = '\0';
+        srv_rcache_put(s->rcache, r->key, r->klen, bytes, (size_t)n, r->ctype, r->id, r->etag);
+        r->text = bytes;
+        r->text_len = (size_t)n;
+        return;
+    }
     srv_metrics_output(s->metrics, now() - t0, 0);
     r->out = o;
     r->entry = e;
-    r->status = 200;
-    r->ctype = api_format_info_of(f)->mime;
 }
 
 static void job_solve(request *r)
@@ -849,6 +889,32 @@ static enum MHD_Result handler(void *cls, struct MHD_Connection *conn, const cha
     }
     if (r->route != R_SOLVE && r->route != R_SOLID && r->route != R_EVAL)
         return quick(r);
+    if (r->route != R_EVAL) {
+        /* A request answered before: its response is kept, no solver thread needed. */
+        make_key(r);
+        const char *inm = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
+        int cors = s->cfg.cors[0] && MHD_lookup_connection_value(conn, MHD_HEADER_KIND, "Origin");
+        srv_rhit h;
+        if (r->key && !inm && !cors && srv_rcache_queue(s->rcache, r->key, r->klen, conn, &h)) {
+            r->status = 200;
+            r->sent = (long long)h.len;
+            snprintf(r->id, sizeof r->id, "%.32s", h.id);
+            r->phase = DONE;
+            return MHD_YES;
+        }
+        if (r->key && (inm || cors) && srv_rcache_copy(s->rcache, r->key, r->klen, &h)) {
+            snprintf(r->id, sizeof r->id, "%.32s", h.id);
+            snprintf(r->etag, sizeof r->etag, "%s", h.etag);
+            if (inm && (strstr(inm, h.etag) || !strcmp(inm, "*"))) {
+                free(h.copy);
+                r->status = 304;
+                return respond_text(r);
+            }
+            set_text(r, 200, h.ctype, h.copy);
+            r->text_len = h.len;
+            return respond_text(r);
+        }
+    }
     if (srv_pool_reserve(s->pool)) {
         r->retry_after = 1;
         set_problem(r, 503, NULL, "all %d solver threads are busy and %zu jobs are waiting (--queue); try again",
@@ -890,6 +956,7 @@ static void completed(void *cls, struct MHD_Connection *conn, void **con_cls, en
     srv_cache_release(s->cache, r->entry);
     free(r->body);
     free(r->text);
+    free(r->key);
     free(r);
     pthread_mutex_lock(&s->lock);
     if (--s->in_flight == 0)
@@ -931,6 +998,7 @@ static void free_server(srv_server *s)
     if (s->pool)
         srv_pool_destroy(s->pool);
     srv_cache_destroy(s->cache);
+    srv_rcache_destroy(s->rcache);
     srv_metrics_destroy(s->metrics);
     for (size_t i = 0; i < NSTATIC; i++)
         free(s->files[i]);
@@ -952,9 +1020,11 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
     pthread_mutex_init(&s->lock, NULL);
     pthread_cond_init(&s->idle, NULL);
     s->cache = srv_cache_create(c->cache_bytes);
+    /* Finished responses: an eighth of the solution cache's bound, at least 4 MiB. */
+    s->rcache = srv_rcache_create(c->cache_bytes / 8 > (4u << 20) ? c->cache_bytes / 8 : 4u << 20);
     s->metrics = srv_metrics_create(route_names, R_COUNT);
     s->pool = srv_pool_create(c->threads, c->queue);
-    if (!s->cache || !s->metrics || !s->pool) {
+    if (!s->cache || !s->rcache || !s->metrics || !s->pool) {
         snprintf(err, errlen, "out of memory, or a solver thread could not start");
         free_server(s);
         return NULL;

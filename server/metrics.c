@@ -126,7 +126,8 @@ __attribute__((format(printf, 2, 3))) static void add(sbuf *b, const char *fmt, 
     }
 }
 
-char *srv_metrics_render(srv_metrics *m, const srv_cache_stats *c, size_t queue_depth, size_t in_flight)
+char *srv_metrics_render(srv_metrics *m, const srv_cache_stats *c, size_t queue_depth, size_t in_flight,
+                         unsigned long long response_hits)
 {
     sbuf b = { 0 };
     pthread_mutex_lock(&m->lock);
@@ -176,6 +177,8 @@ char *srv_metrics_render(srv_metrics *m, const srv_cache_stats *c, size_t queue_
             "pdesolid_cache_bytes %zu\n", c->bytes);
     add(&b, "# HELP pdesolid_cache_entries Cached solutions.\n# TYPE pdesolid_cache_entries gauge\n"
             "pdesolid_cache_entries %zu\n", c->entries);
+    add(&b, "# HELP pdesolid_response_cache_hits_total Requests answered from a kept response, without a solver thread.\n"
+            "# TYPE pdesolid_response_cache_hits_total counter\npdesolid_response_cache_hits_total %llu\n", response_hits);
     add(&b, "# HELP pdesolid_queue_depth Jobs queued or running on the solver threads.\n"
             "# TYPE pdesolid_queue_depth gauge\npdesolid_queue_depth %zu\n", queue_depth);
     add(&b, "# HELP pdesolid_requests_in_flight Requests begun and not yet finished.\n"

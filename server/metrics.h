@@ -19,7 +19,8 @@ void srv_metrics_solve(srv_metrics *m, double seconds);
 void srv_metrics_output(srv_metrics *m, double seconds, size_t bytes);
 void srv_metrics_connection(srv_metrics *m, int delta);
 
-/* The exposition text (malloc'd), with the cache's figures and the queue depth. */
-char *srv_metrics_render(srv_metrics *m, const srv_cache_stats *cache, size_t queue_depth, size_t in_flight);
+/* The exposition text (malloc'd), with the caches' figures and the queue depth. */
+char *srv_metrics_render(srv_metrics *m, const srv_cache_stats *cache, size_t queue_depth, size_t in_flight,
+                         unsigned long long response_hits);
 
 #endif

@@ -385,8 +385,16 @@ static void cache_hits_misses_and_evictions_should_show_in_metrics(void **state)
     reply r = http(&d, "GET", path, NULL, 0, NULL);
     expect_problem(&r, 404, NULL, "evicted");
     free(r.body);
-    long hits = metric(&d, "pdesolid_cache_hits_total");
-    r = post(&d, "/solve?format=f32&res=2", body);   /* the last one: still cached */
+    /* The last one again: answered from the kept response; at another res, from the cached solution. */
+    long hits = metric(&d, "pdesolid_cache_hits_total"), rhits = metric(&d, "pdesolid_response_cache_hits_total");
+    r = post(&d, "/solve?format=f32&res=2", body);
+    assert_int_equal(r.status, 200);
+    free(r.body);
+    assert_int_equal(metric(&d, "pdesolid_response_cache_hits_total"), rhits + 1);
+    assert_int_equal(metric(&d, "pdesolid_cache_hits_total"), hits);
+    r = post(&d, "/solve?format=f32&res=3", body);
+    assert_int_equal(r.status, 200);
+    assert_int_equal(r.len, 12 * 27);
     free(r.body);
     assert_int_equal(metric(&d, "pdesolid_cache_hits_total"), hits + 1);
     stop(&d);
