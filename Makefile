@@ -34,12 +34,16 @@ CURL     := $(shell pkg-config --libs libcurl 2>/dev/null || echo -lcurl)
 TESTS := $(patsubst tests/%.c,build/san/tests/%,$(TEST_SRC))
 BENCHES := $(patsubst bench/%.c,build/bench/%,$(BENCH_SRC))
 
-.PHONY: all test bench clean deps
+.PHONY: all test bench clean deps run
 all: build/pdesolid build/pdesolidd
 
-# Installs missing Debian packages (a no-op when all are there).
+# Installs missing Debian and npm packages (a no-op when all are there).
 deps:
 	@bash .ci/deps
+
+# Builds and starts pdesolidd on http://127.0.0.1:8080/ (ARGS="--port 9000 ..." for flags).
+run: all
+	build/pdesolidd $(ARGS)
 
 # Complex division without C99's NaN and overflow recovery: the core's systems are scaled to O(1).
 build/obj/core/%.o build/san/core/%.o: CFLAGS += -fcx-fortran-rules

@@ -738,9 +738,37 @@ static void presets_version_health_metrics_and_cors_should_answer(void **state)
     stop(&d);
 }
 
+static void openapi_should_be_valid_and_name_every_route(void **state)
+{
+    (void)state;
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "node tests/node/validate_openapi.mjs docs/openapi.yaml > %s/paths.txt", dir);
+    assert_int_equal(system(cmd), 0);
+    snprintf(cmd, sizeof cmd, "%s/paths.txt", dir);
+    char *paths = read_file(cmd, NULL);
+    /* The routes of server/http.c, in the document, and nothing else. */
+    const char *routes[] = { "/solve", "/solids/{id}", "/solids/{id}/eval", "/presets", "/presets/{name}",
+                             "/livez", "/readyz", "/version", "/metrics", "/" };
+    size_t listed = 0;
+    for (const char *p = paths; *p; p += strcspn(p, "\n") + (p[strcspn(p, "\n")] != 0))
+        listed++;
+    assert_int_equal(listed, sizeof routes / sizeof *routes);
+    for (size_t i = 0; i < sizeof routes / sizeof *routes; i++) {
+        char line[64];
+        snprintf(line, sizeof line, "\n%s\n", routes[i]);
+        char *framed = malloc(strlen(paths) + 3);
+        sprintf(framed, "\n%s", paths);
+        if (!strstr(framed, line))
+            fail_msg("docs/openapi.yaml lacks %s", routes[i]);
+        free(framed);
+    }
+    free(paths);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(openapi_should_be_valid_and_name_every_route),
         cmocka_unit_test(solve_should_give_every_format_as_the_core_computes_it),
         cmocka_unit_test(eval_should_agree_with_the_cli),
         cmocka_unit_test(cache_hits_misses_and_evictions_should_show_in_metrics),
