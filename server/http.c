@@ -59,10 +59,11 @@ static const struct {
       "text/javascript; charset=utf-8" },
     { "/vendor/three/addons/utils/BufferGeometryUtils.js", "node_modules/three/examples/jsm/utils/BufferGeometryUtils.js",
       "text/javascript; charset=utf-8" },
+    { "/vendor/three/addons/utils/SkeletonUtils.js", "node_modules/three/examples/jsm/utils/SkeletonUtils.js",
+      "text/javascript; charset=utf-8" },
     { "/vendor/three/addons/controls/OrbitControls.js", "node_modules/three/examples/jsm/controls/OrbitControls.js",
       "text/javascript; charset=utf-8" },
     { "/vendor/lil-gui/lil-gui.esm.js", "node_modules/lil-gui/dist/lil-gui.esm.js", "text/javascript; charset=utf-8" },
-    { "/favicon.ico", "favicon.ico", "image/x-icon" },
 };
 #define NSTATIC (sizeof static_files / sizeof *static_files)
 
@@ -114,6 +115,7 @@ typedef struct {
     stream *live;                /* the stream sending this response, if any */
     char *key;                   /* the response cache's key of this request, or NULL */
     size_t klen;
+    char timing[128];            /* Server-Timing: solve (or cache) and output */
 } request;
 
 struct stream {
@@ -309,6 +311,8 @@ static enum MHD_Result queue(request *r, struct MHD_Response *resp)
     }
     if (r->status == 405)
         MHD_add_response_header(resp, MHD_HTTP_HEADER_ALLOW, r->allow);
+    if (r->timing[0])
+        MHD_add_response_header(resp, "Server-Timing", r->timing);
     if (r->retry_after) {
         char v[16];
         snprintf(v, sizeof v, "%d", r->retry_after);
@@ -568,6 +572,7 @@ static void answer_entry(request *r, srv_entry *e, api_format f, const unsigned 
     api_error err;
     double t0 = now();
     api_output *o = api_output_open(srv_entry_solution(e), r->id, props, f, res, &err);
+    size_t tl = strlen(r->timing);
     if (!o) {
         srv_cache_release(s->cache, e);
         set_problem(r, err.status == 422 ? 422 : 500, NULL, "%s", err.message);
@@ -583,6 +588,7 @@ static void answer_entry(request *r, srv_entry *e, api_format f, const unsigned 
         api_output_free(o);
         srv_cache_release(s->cache, e);
         srv_metrics_output(s->metrics, now() - t0, n > 0 ? (size_t)n : 0);
+        snprintf(r->timing + tl, sizeof r->timing - tl, "%soutput;dur=%.3f", tl ? ", " : "", (now() - t0) * 1e3);
         if (n != size) {
             free(bytes);
             set_problem(r, 500, NULL, "out of memory");
@@ -595,6 +601,8 @@ static void answer_entry(request *r, srv_entry *e, api_format f, const unsigned 
         return;
     }
     srv_metrics_output(s->metrics, now() - t0, 0);
+    snprintf(r->timing + tl, sizeof r->timing - tl, "%soutput;desc=\"streamed\";dur=%.3f", tl ? ", " : "",
+             (now() - t0) * 1e3);
     r->out = o;
     r->entry = e;
 }
@@ -629,8 +637,13 @@ static void job_solve(request *r)
     int hit;
     double t0 = now();
     srv_entry *e = srv_cache_get(s->cache, id, solve_model, &sa, &hit, &err);
+    double dt = now() - t0;
     if (!hit)
-        srv_metrics_solve(s->metrics, now() - t0);
+        srv_metrics_solve(s->metrics, dt);
+    if (hit)
+        snprintf(r->timing, sizeof r->timing, "solve;desc=\"cached\";dur=%.3f", dt * 1e3);
+    else
+        snprintf(r->timing, sizeof r->timing, "solve;dur=%.3f", dt * 1e3);
     api_model_free(m);
     if (!e) {
         set_api_error(r, &err);

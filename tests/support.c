@@ -2,9 +2,18 @@
  * support.c: the tests' independent solver and helpers (support.h).
  */
 #include <math.h>
+#include <setjmp.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmocka.h>
 
 #include "support.h"
 
@@ -434,4 +443,47 @@ char *read_file(const char *path, size_t *len)
     if (len)
         *len = n;
     return buf;
+}
+
+void daemon_start(daemon_t *d, const char *dir, const char *args)
+{
+    const char *bin = getenv("PDESOLIDD_SAN") ? getenv("PDESOLIDD_SAN") : "build/san/pdesolidd";
+    static int n;
+    snprintf(d->log, sizeof d->log, "%s/daemon%d.log", dir, n++);
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "exec %s --port 0 --threads 2 %s 2>%s", bin, args, d->log);
+    pid_t pid = fork();
+    if (pid == 0) {
+        execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);
+        _exit(127);
+    }
+    d->pid = (int)pid;
+    /* Wait for "listening on http://127.0.0.1:PORT/". */
+    for (int i = 0; i < 400; i++) {
+        char *text = read_file(d->log, NULL);
+        const char *p = text ? strstr(text, "listening on http://127.0.0.1:") : NULL;
+        if (p) {
+            d->port = atoi(p + strlen("listening on http://127.0.0.1:"));
+            free(text);
+            snprintf(d->base, sizeof d->base, "http://127.0.0.1:%d", d->port);
+            return;
+        }
+        free(text);
+        int st;
+        if (waitpid(pid, &st, WNOHANG) == pid)
+            fail_msg("pdesolidd exited at start (status %d)", st);
+        usleep(25000);
+    }
+    fail_msg("pdesolidd did not start");
+}
+
+void daemon_stop(daemon_t *d)
+{
+    kill(d->pid, SIGTERM);
+    int st;
+    waitpid(d->pid, &st, 0);
+    if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        char *log = read_file(d->log, NULL);
+        fail_msg("pdesolidd exited with status %d:\n%s", WIFEXITED(st) ? WEXITSTATUS(st) : -1, log ? log : "");
+    }
 }

@@ -69,4 +69,20 @@ void paper_figure_model(size_t i, pde_model *m);
 /* Reads a whole file into a NUL-terminated buffer; NULL on failure. */
 char *read_file(const char *path, size_t *len);
 
+/*
+ * pdesolidd for a test: started on a free loopback port with its stderr in a
+ * log file in dir, and stopped with SIGTERM, which must end in exit status 0
+ * (so a leak the sanitiser finds at exit fails the test). $PDESOLIDD_SAN
+ * names the binary (build/san/pdesolidd). Both fail the test with cmocka on error.
+ */
+typedef struct {
+    int pid;
+    int port;
+    char base[64];
+    char log[160];
+} daemon_t;
+
+void daemon_start(daemon_t *d, const char *dir, const char *args);
+void daemon_stop(daemon_t *d);
+
 #endif

@@ -32,54 +32,14 @@
 
 static char dir[] = "/tmp/pdesolid-srv-XXXXXX";
 
-typedef struct {
-    pid_t pid;
-    int port;
-    char base[64];
-    char log[128];
-} daemon_t;
-
 static void start(daemon_t *d, const char *args)
 {
-    const char *bin = getenv("PDESOLIDD_SAN") ? getenv("PDESOLIDD_SAN") : "build/san/pdesolidd";
-    static int n;
-    snprintf(d->log, sizeof d->log, "%s/daemon%d.log", dir, n++);
-    char cmd[1024];
-    snprintf(cmd, sizeof cmd, "exec %s --port 0 --threads 2 %s 2>%s", bin, args, d->log);
-    d->pid = fork();
-    if (d->pid == 0) {
-        execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);
-        _exit(127);
-    }
-    /* Wait for "listening on http://127.0.0.1:PORT/". */
-    for (int i = 0; i < 400; i++) {
-        char *text = read_file(d->log, NULL);
-        const char *p = text ? strstr(text, "listening on http://127.0.0.1:") : NULL;
-        if (p) {
-            d->port = atoi(p + strlen("listening on http://127.0.0.1:"));
-            free(text);
-            snprintf(d->base, sizeof d->base, "http://127.0.0.1:%d", d->port);
-            return;
-        }
-        free(text);
-        int st;
-        if (waitpid(d->pid, &st, WNOHANG) == d->pid)
-            fail_msg("pdesolidd exited at start (status %d)", st);
-        usleep(25000);
-    }
-    fail_msg("pdesolidd did not start");
+    daemon_start(d, dir, args);
 }
 
-/* SIGTERM; the daemon must finish and exit 0. */
 static void stop(daemon_t *d)
 {
-    kill(d->pid, SIGTERM);
-    int st;
-    waitpid(d->pid, &st, 0);
-    if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-        char *log = read_file(d->log, NULL);
-        fail_msg("pdesolidd exited with status %d:\n%s", WIFEXITED(st) ? WEXITSTATUS(st) : -1, log ? log : "");
-    }
+    daemon_stop(d);
 }
 
 typedef struct {

@@ -1,0 +1,51 @@
+/*
+ * test_web.c: the browser front-end in a real browser. Starts pdesolidd
+ * with the front-end and runs tests/node/browser.mjs, which drives Debian's
+ * Chromium through playwright-core: the page loads with no console errors and
+ * draws fig4a; the gallery loads every preset; a control re-solves and changes
+ * the picture; an invalid value shows the server's error beside its field.
+ * Screenshots go to build/artifacts/web/.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "support.h"
+
+static char dir[] = "/tmp/pdesolid-web-XXXXXX";
+
+static void the_front_end_should_work_in_a_real_browser(void **state)
+{
+    (void)state;
+    assert_non_null(mkdtemp(dir));
+    daemon_t d;
+    daemon_start(&d, dir, "--web clients/web --quiet");
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, "node tests/node/browser.mjs %s build/artifacts/web > %s/browser.txt 2>&1", d.base, dir);
+    int st = system(cmd);
+    char path[128];
+    snprintf(path, sizeof path, "%s/browser.txt", dir);
+    char *report = read_file(path, NULL);
+    printf("%s", report ? report : "");
+    daemon_stop(&d);
+    if (st != 0)
+        fail_msg("the browser checks failed (screenshots in build/artifacts/web)");
+    free(report);
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(the_front_end_should_work_in_a_real_browser),
+    };
+    return cmocka_run_group_tests_name("web", tests, NULL, NULL);
+}
