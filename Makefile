@@ -63,7 +63,7 @@ build/libpdeapi.a: $(API_OBJ)
 	$(AR) rcs $@ $^
 
 build/pdesolid: $(CLI_OBJ) build/libpdeapi.a build/libpdecore.a
-	$(CC) $(CFLAGS) $^ $(LIBS) $(LDLIBS) -o $@
+	$(CC) $(CFLAGS) $^ $(LIBS) $(CURL) $(LDLIBS) -o $@
 
 build/pdesolidd: $(SRV_OBJ) build/libpdeapi.a build/libpdecore.a
 	$(CC) $(CFLAGS) $^ $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@
@@ -74,7 +74,7 @@ build/san/pdesolidd: $(call san,$(SRV_SRC) $(API_SRC) $(CORE_SRC))
 
 # The sanitised CLI, which the CLI tests drive alongside build/pdesolid.
 build/san/pdesolid: $(call san,$(CLI_SRC) $(API_SRC) $(CORE_SRC))
-	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(LDLIBS) -o $@
+	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CURL) $(LDLIBS) -o $@
 
 build/san/tests/%: build/san/tests/%.o build/san/tests/support.o $(call san,$(API_SRC) $(CORE_SRC))
 	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(CURL) $(LDLIBS) -lpthread -o $@

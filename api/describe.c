@@ -121,8 +121,12 @@ void api_describe(FILE *out, const pde_solution *sol, const pde_props *props)
             fputc('\n', out);
         }
     }
-    if (!props)
-        return;
+    if (props)
+        api_describe_props(out, props);
+}
+
+void api_describe_props(FILE *out, const pde_props *props)
+{
     fprintf(out, "properties:\n");
     fprintf(out, "  bounding box: [%.10g, %.10g, %.10g] to [%.10g, %.10g, %.10g]\n", props->bbox_min[0],
             props->bbox_min[1], props->bbox_min[2], props->bbox_max[0], props->bbox_max[1], props->bbox_max[2]);

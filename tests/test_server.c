@@ -725,9 +725,66 @@ static void openapi_should_be_valid_and_name_every_route(void **state)
     free(paths);
 }
 
+/* Runs a shell command; returns its exit status and stdout (free it). */
+static int sh(const char *cmd, char **out)
+{
+    char full[2048], path[160];
+    snprintf(path, sizeof path, "%s/sh.out", dir);
+    snprintf(full, sizeof full, "%s > %s 2>&1", cmd, path);
+    int st = system(full);
+    *out = read_file(path, NULL);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static void the_cli_should_give_the_same_answers_through_the_server(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    const char *cli = getenv("PDESOLID_SAN") ? getenv("PDESOLID_SAN") : "build/san/pdesolid";
+    char cmd[1024], *a, *b;
+    const char *forms[] = { "solve --preset fig4b --param p0=12345 --param c=-11,-11,-10",
+                            "solve --preset fig3d --format grid --res 3,4,5",
+                            "solve examples/fig4a.json --format json" };
+    for (int i = 0; i < 3; i++) {
+        snprintf(cmd, sizeof cmd, "%s %s --server %s", cli, forms[i], d.base);
+        assert_int_equal(sh(cmd, &a), 0);
+        snprintf(cmd, sizeof cmd, "%s %s", cli, forms[i]);
+        assert_int_equal(sh(cmd, &b), 0);
+        if (i < 2)
+            assert_string_equal(a, b);   /* the json document differs only in key order, not here */
+        else
+            assert_non_null(strstr(a, "\"closed_form\""));
+        free(a);
+        free(b);
+    }
+    char pts[160];
+    snprintf(pts, sizeof pts, "%s/p.json", dir);
+    FILE *f = fopen(pts, "w");
+    fputs("[[0.5,0.25,0.5],[1,0.1,0.9],[0,0,0]]", f);
+    fclose(f);
+    snprintf(cmd, sizeof cmd, "%s eval examples/fig4a.json %s --server %s", cli, pts, d.base);
+    assert_int_equal(sh(cmd, &a), 0);
+    snprintf(cmd, sizeof cmd, "%s eval examples/fig4a.json %s", cli, pts);
+    assert_int_equal(sh(cmd, &b), 0);
+    assert_string_equal(a, b);
+    free(a);
+    free(b);
+    snprintf(cmd, sizeof cmd, "%s solve --preset fig4a --param c=-1,-1,0 --server %s", cli, d.base);
+    assert_int_equal(sh(cmd, &a), 2);
+    assert_non_null(strstr(a, "422: /params/c/2: c of component z is 0"));
+    free(a);
+    stop(&d);
+    snprintf(cmd, sizeof cmd, "%s solve examples/fig4a.json --server %s", cli, d.base);
+    assert_int_equal(sh(cmd, &a), 1);
+    assert_non_null(strstr(a, "connect"));
+    free(a);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(the_cli_should_give_the_same_answers_through_the_server),
         cmocka_unit_test(openapi_should_be_valid_and_name_every_route),
         cmocka_unit_test(solve_should_give_every_format_as_the_core_computes_it),
         cmocka_unit_test(eval_should_agree_with_the_cli),

@@ -12,6 +12,7 @@
 #include "id.h"
 #include "model.h"
 #include "output.h"
+#include "remote.h"
 #include "template.h"
 
 #define VERSION "0.2.0"
@@ -42,6 +43,8 @@ static const char usage[] =
     "  --res N|NU,NV,NW     samples per axis (grid, f32, vts; default 33) or per face\n"
     "                       edge (gltf, glb, stl; default 64)\n"
     "  -o FILE              write to FILE instead of standard output\n"
+    "  --server URL         solve and eval on a pdesolidd (e.g. http://127.0.0.1:8080)\n"
+    "                       instead of here; the output is the same\n"
     "  -h, --help           this text\n"
     "  --version            the version\n"
     "\n"
@@ -49,7 +52,7 @@ static const char usage[] =
     "pointer), 1 anything else.\n";
 
 typedef struct {
-    const char *preset, *format, *res, *out;
+    const char *preset, *format, *res, *out, *server;
     const char *params[64];
     int nparams;
     const char *args[3];
@@ -206,8 +209,74 @@ static int write_output(const options *o, const pde_solution *sol, const char *i
     return 0;
 }
 
+/* The request for --server: the model file's text, or {"preset": NAME, "params": {...}}. NULL on error. */
+static char *request_text(const options *o, const char *path, size_t *len)
+{
+    if (!o->preset)
+        return slurp(path, len);
+    size_t cap = 256 + 96 * (size_t)o->nparams, n = 0;
+    char *b = malloc(cap);
+    if (!b)
+        return NULL;
+    n += (size_t)snprintf(b, cap, "{\"preset\":\"%.60s\",\"params\":{", o->preset);
+    for (int i = 0; i < o->nparams; i++) {
+        const char *eq = strchr(o->params[i], '=');
+        double v[3];
+        int k = 0;
+        char *end = NULL;
+        const char *s = eq ? eq + 1 : "";
+        do {
+            v[k++] = strtod(s, &end);
+            s = end + (*end == ',');
+        } while (end && *end == ',' && k < 3);
+        if (!eq || eq == o->params[i] || end == eq + 1 || *end || eq - o->params[i] > 40) {
+            fprintf(stderr, "pdesolid: --param %s: write NAME=VALUE, with a number or x,y,z\n", o->params[i]);
+            free(b);
+            return NULL;
+        }
+        n += (size_t)snprintf(b + n, cap - n, "%s\"%.*s\":", i ? "," : "", (int)(eq - o->params[i]), o->params[i]);
+        if (k == 3)
+            n += (size_t)snprintf(b + n, cap - n, "[%.17g,%.17g,%.17g]", v[0], v[1], v[2]);
+        else
+            n += (size_t)snprintf(b + n, cap - n, "%.17g", v[0]);
+    }
+    n += (size_t)snprintf(b + n, cap - n, "}}");
+    *len = n;
+    return b;
+}
+
+static int remote(const options *o, int eval)
+{
+    size_t len, plen = 0;
+    char *body = request_text(o, o->nargs && !o->preset ? o->args[0] : NULL, &len);
+    if (!body)
+        return 2;
+    char *pts = eval ? slurp(o->args[o->nargs - 1], &plen) : NULL;
+    int rc;
+    if (eval && !pts) {
+        rc = 1;
+    } else if (eval) {
+        rc = remote_eval(o->server, body, len, pts, plen, stdout);
+    } else {
+        FILE *out = o->out ? fopen(o->out, "wb") : stdout;
+        if (!out) {
+            fprintf(stderr, "pdesolid: %s: %s\n", o->out, strerror(errno));
+            rc = 1;
+        } else {
+            rc = remote_solve(o->server, body, len, o->format, o->res, out);
+            if (out != stdout && fclose(out) != 0)
+                rc = 1;
+        }
+    }
+    free(body);
+    free(pts);
+    return rc;
+}
+
 static int cmd_solve(const options *o)
 {
+    if (o->server)
+        return remote(o, 0);
     pde_solution *sol;
     char id[API_ID_LEN + 1] = "";
     int rc = load(o, o->nargs ? o->args[0] : NULL, &sol, id);
@@ -233,6 +302,8 @@ static int cmd_solve(const options *o)
 
 static int cmd_eval(const options *o)
 {
+    if (o->server)
+        return remote(o, 1);
     const char *points_path = o->args[o->nargs - 1];
     size_t len, n;
     char *text = slurp(points_path, &len);
@@ -291,6 +362,8 @@ int main(int argc, char **argv)
             val = &o.res;
         } else if (strcmp(a, "-o") == 0) {
             val = &o.out;
+        } else if (strcmp(a, "--server") == 0) {
+            val = &o.server;
         } else if (strcmp(a, "--param") == 0) {
             if (i + 1 >= argc || o.nparams == 64) {
                 fprintf(stderr, "pdesolid: --param needs NAME=VALUE (at most 64)\n");

@@ -1,0 +1,201 @@
+/*
+ * remote.c: pdesolid --server (remote.h), with libcurl.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include <cJSON.h>
+#include <curl/curl.h>
+
+#include "describe.h"
+#include "remote.h"
+
+typedef struct {
+    char *data;
+    size_t len;
+    char id[64];        /* X-Solid-Id */
+    long status;
+} reply;
+
+static size_t on_data(char *p, size_t size, size_t n, void *cls)
+{
+    reply *r = cls;
+    size_t k = size * n;
+    char *d = realloc(r->data, r->len + k + 1);
+    if (!d)
+        return 0;
+    r->data = d;
+    memcpy(r->data + r->len, p, k);
+    r->len += k;
+    r->data[r->len] = '\0';
+    return k;
+}
+
+static size_t on_header(char *p, size_t size, size_t n, void *cls)
+{
+    reply *r = cls;
+    size_t k = size * n;
+    if (k > 12 && !strncasecmp(p, "X-Solid-Id:", 11)) {
+        const char *v = p + 11;
+        while (*v == ' ')
+            v++;
+        snprintf(r->id, sizeof r->id, "%.*s", (int)strcspn(v, "\r\n"), v);
+    }
+    return k;
+}
+
+/* POST body to url; 0 with the reply, or 1 after printing why the server could not be reached. */
+static int post(const char *url, const char *body, size_t len, reply *r)
+{
+    memset(r, 0, sizeof *r);
+    CURL *c = curl_easy_init();
+    if (!c) {
+        fprintf(stderr, "pdesolid: libcurl failed to start\n");
+        return 1;
+    }
+    struct curl_slist *h = curl_slist_append(NULL, "Content-Type: application/json");
+    h = curl_slist_append(h, "Expect:");
+    curl_easy_setopt(c, CURLOPT_URL, url);
+    curl_easy_setopt(c, CURLOPT_POST, 1L);
+    curl_easy_setopt(c, CURLOPT_POSTFIELDS, body);
+    curl_easy_setopt(c, CURLOPT_POSTFIELDSIZE_LARGE, (curl_off_t)len);
+    curl_easy_setopt(c, CURLOPT_HTTPHEADER, h);
+    curl_easy_setopt(c, CURLOPT_WRITEFUNCTION, on_data);
+    curl_easy_setopt(c, CURLOPT_WRITEDATA, r);
+    curl_easy_setopt(c, CURLOPT_HEADERFUNCTION, on_header);
+    curl_easy_setopt(c, CURLOPT_HEADERDATA, r);
+    CURLcode rc = curl_easy_perform(c);
+    if (rc == CURLE_OK)
+        curl_easy_getinfo(c, CURLINFO_RESPONSE_CODE, &r->status);
+    curl_slist_free_all(h);
+    curl_easy_cleanup(c);
+    if (rc != CURLE_OK) {
+        fprintf(stderr, "pdesolid: %s: %s\n", url, curl_easy_strerror(rc));
+        return 1;
+    }
+    return 0;
+}
+
+/* A problem answer, printed as offline errors are; returns the exit status. */
+static int problem(const char *server, const reply *r)
+{
+    cJSON *p = r->data ? cJSON_Parse(r->data) : NULL;
+    const cJSON *detail = cJSON_GetObjectItemCaseSensitive(p, "detail");
+    fprintf(stderr, "pdesolid: %s: %ld: %s\n", server, r->status,
+            cJSON_IsString(detail) ? detail->valuestring : "the server gave no reason");
+    cJSON_Delete(p);
+    return r->status >= 400 && r->status < 500 ? 2 : 1;
+}
+
+static double num(const cJSON *o, const char *k)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, k);
+    return cJSON_IsNumber(v) ? v->valuedouble : 0.0;
+}
+
+static void vec3(const cJSON *o, const char *k, double out[3])
+{
+    const cJSON *a = cJSON_GetObjectItemCaseSensitive(o, k);
+    for (int i = 0; i < 3; i++) {
+        const cJSON *v = cJSON_GetArrayItem(a, i);
+        out[i] = cJSON_IsNumber(v) ? v->valuedouble : 0.0;
+    }
+}
+
+/* The text of `pdesolid solve` from the json format's document. */
+static int print_solve(const char *json, FILE *out)
+{
+    cJSON *d = cJSON_Parse(json);
+    const cJSON *text = cJSON_GetObjectItemCaseSensitive(d, "closed_form");
+    const cJSON *props = cJSON_GetObjectItemCaseSensitive(d, "properties");
+    const cJSON *id = cJSON_GetObjectItemCaseSensitive(d, "id");
+    if (!cJSON_IsString(text) || !cJSON_IsObject(props)) {
+        cJSON_Delete(d);
+        fprintf(stderr, "pdesolid: the server's answer is not a solution\n");
+        return 1;
+    }
+    pde_props p;
+    memset(&p, 0, sizeof p);
+    const cJSON *bbox = cJSON_GetObjectItemCaseSensitive(props, "bbox");
+    const cJSON *dj = cJSON_GetObjectItemCaseSensitive(props, "detJ");
+    const cJSON *res = cJSON_GetObjectItemCaseSensitive(props, "residuals");
+    vec3(bbox, "min", p.bbox_min);
+    vec3(bbox, "max", p.bbox_max);
+    p.volume = num(props, "volume");
+    p.signed_volume = num(props, "signed_volume");
+    p.detj_min = num(dj, "min");
+    p.detj_max = num(dj, "max");
+    vec3(dj, "min_at", p.detj_min_at);
+    p.folds = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(props, "folds"));
+    p.bc_residual = num(res, "boundary");
+    p.pde_residual = num(res, "pde");
+    fprintf(out, "solid %s\n%s", cJSON_IsString(id) ? id->valuestring : "", text->valuestring);
+    api_describe_props(out, &p);
+    cJSON_Delete(d);
+    return 0;
+}
+
+int remote_solve(const char *server, const char *body, size_t len, const char *format, const char *res, FILE *out)
+{
+    char url[2048];
+    snprintf(url, sizeof url, "%s/solve?format=%s%s%s", server, format ? format : "json", res ? "&res=" : "",
+             res ? res : "");
+    reply r;
+    if (post(url, body, len, &r))
+        return 1;
+    int rc;
+    if (r.status != 200)
+        rc = problem(server, &r);
+    else if (!format)
+        rc = print_solve(r.data ? r.data : "", out);
+    else
+        rc = fwrite(r.data, 1, r.len, out) == r.len ? 0 : 1;
+    free(r.data);
+    return rc;
+}
+
+int remote_eval(const char *server, const char *body, size_t len, const char *points, size_t plen, FILE *out)
+{
+    char url[2048];
+    snprintf(url, sizeof url, "%s/solve?format=f32&res=2", server);
+    reply r;
+    if (post(url, body, len, &r))
+        return 1;
+    if (r.status != 200) {
+        int rc = problem(server, &r);
+        free(r.data);
+        return rc;
+    }
+    free(r.data);
+    char *req = malloc(plen + 32);
+    if (!req)
+        return 1;
+    int n = snprintf(req, plen + 32, "{\"points\":%.*s}", (int)plen, points);
+    snprintf(url, sizeof url, "%s/solids/%s/eval", server, r.id);
+    reply e;
+    int rc = post(url, req, (size_t)n, &e);
+    free(req);
+    if (rc)
+        return rc;
+    if (e.status != 200) {
+        rc = problem(server, &e);
+        free(e.data);
+        return rc;
+    }
+    cJSON *d = cJSON_Parse(e.data ? e.data : "");
+    const cJSON *vals = cJSON_GetObjectItemCaseSensitive(d, "values");
+    fputc('[', out);
+    int i = 0;
+    for (const cJSON *v = vals ? vals->child : NULL; v; v = v->next, i++) {
+        double x[3];
+        for (int c = 0; c < 3; c++) {
+            const cJSON *q = cJSON_GetArrayItem(v, c);
+            x[c] = cJSON_IsNumber(q) ? q->valuedouble : 0.0;
+        }
+        fprintf(out, "%s[%.17g,%.17g,%.17g]", i ? ",\n" : "", x[0], x[1], x[2]);
+    }
+    fputs("]\n", out);
+    cJSON_Delete(d);
+    free(e.data);
+    return 0;
+}
