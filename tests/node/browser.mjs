@@ -61,11 +61,14 @@ await check('choosing fig4a in the gallery draws it', async () => {
   if (!/4a: b = 1, c = -9\.5/.test(caption)) throw new Error(`caption: ${caption}`);
 });
 
-await check('moving a control solves again and changes the picture', async () => {
+await check('dragging a slider solves again and changes the picture', async () => {
   const before = await snapshot(), s0 = await state();
-  const input = page.locator('[data-param="p0"] input').first();
-  await input.fill('200000');
-  await input.press('Enter');
+  const slider = page.locator('[data-param="p0"] .lil-slider');
+  const box = await slider.boundingBox();
+  await page.mouse.move(box.x + box.width * 0.5, box.y + box.height / 2);
+  await page.mouse.down();
+  await page.mouse.move(box.x + box.width * 0.8, box.y + box.height / 2, { steps: 8 });
+  await page.mouse.up();
   await solved(s0.solves);
   const s1 = await state(), after = await snapshot();
   if (s1.id === s0.id) throw new Error('the same solid');
@@ -87,6 +90,16 @@ await check("an invalid value shows the server's error beside its field", async 
   if (await page.locator('.field-error').count()) throw new Error('the error stayed after a valid value');
   // Chromium logs the deliberate 422 as a failed resource: it was expected, and later checks start clean.
   problems.length = 0;
+});
+
+await check('a download gives the solid as a file', async () => {
+  await page.locator('.lil-title', { hasText: 'Download' }).click();
+  const [dl] = await Promise.all([page.waitForEvent('download'), page.locator('.lil-controller', { hasText: '.glb' }).locator('button').click()]);
+  const path = `${out}/${dl.suggestedFilename()}`;
+  await dl.saveAs(path);
+  const { readFileSync } = await import('node:fs');
+  const head = readFileSync(path).subarray(0, 4).toString('latin1');
+  if (head !== 'glTF') throw new Error(`the download ${dl.suggestedFilename()} is not a GLB`);
 });
 
 await check('isoparametric lines and slices draw', async () => {
