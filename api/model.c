@@ -577,7 +577,7 @@ static void add_factor(cJSON *o, const char *key, pde_factor f)
         cJSON_AddNumberToObject(x, kinds[f.kind], f.p);
 }
 
-char *api_model_json(const pde_model *m)
+cJSON *api_model_tree(const pde_model *m)
 {
     cJSON *root = cJSON_CreateObject(), *pde = cJSON_AddObjectToObject(root, "pde");
     cJSON *bd = cJSON_AddObjectToObject(root, "boundary"), *fo = cJSON_AddObjectToObject(root, "force");
@@ -623,7 +623,13 @@ char *api_model_json(const pde_model *m)
             }
         }
     }
-    char *s = cJSON_PrintUnformatted(root);
+    return root;
+}
+
+char *api_model_json(const pde_model *m)
+{
+    cJSON *root = api_model_tree(m);
+    char *s = root ? cJSON_PrintUnformatted(root) : NULL;
     cJSON_Delete(root);
     return s;
 }

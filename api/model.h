@@ -83,6 +83,8 @@ int api_eval_parse(const char *text, size_t len, size_t max_points, double **out
 
 /* The model in the general JSON format (malloc'd, unformatted); NULL if out of memory. */
 char *api_model_json(const pde_model *m);
+/* The same as a cJSON tree (cJSON_Delete it), to put inside a larger document without a parse. */
+struct cJSON *api_model_tree(const pde_model *m);
 
 /* Sets err from a printf format, with status 422; returns -1, for one-line error returns. */
 int api_fail(api_error *err, const char *pointer, const char *fmt, ...)

@@ -215,6 +215,35 @@ char *api_props_json(const pde_props *p)
     return s;
 }
 
+/* ,"name":[[x,y,z],...] into buf at *len (the caller sized it). */
+static void put_triples(char *buf, size_t *len, const char *name, const double *v, size_t n)
+{
+    *len += (size_t)sprintf(buf + *len, ",\"%s\":[", name);
+    for (size_t i = 0; i < n; i++)
+        *len += (size_t)sprintf(buf + *len, "%s[%.17g,%.17g,%.17g]", i ? "," : "", v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+    buf[(*len)++] = ']';
+}
+
+char *api_eval_json(const char *id, const double *values, const double *du, const double *dv, const double *dw,
+                    size_t n)
+{
+    /* Each number takes at most 24 characters, each triple 3 of them and 4 more. */
+    size_t arrays = 1 + (du != NULL) + (dv != NULL) + (dw != NULL);
+    char *buf = malloc(64 + strlen(id) + arrays * (16 + n * (3 * 24 + 4)));
+    if (!buf)
+        return NULL;
+    size_t len = (size_t)sprintf(buf, "{\"id\":\"%s\"", id);
+    put_triples(buf, &len, "values", values, n);
+    if (du)
+        put_triples(buf, &len, "du", du, n);
+    if (dv)
+        put_triples(buf, &len, "dv", dv, n);
+    if (dw)
+        put_triples(buf, &len, "dw", dw, n);
+    memcpy(buf + len, "}\n", 3);
+    return buf;
+}
+
 static cJSON *factor_tree(pde_factor f)
 {
     static const char *const k[] = { "pow", "sin", "cos", "exp", "sinh", "cosh" };

@@ -72,4 +72,9 @@ void api_output_free(api_output *o);
 /* The properties as JSON text (for asset.extras and the json format); malloc'd, NULL if out of memory. */
 char *api_props_json(const pde_props *p);
 
+/* An eval answer {"id", "values": [[x, y, z], ...]} and, when given, "du", "dv", "dw" (3 n doubles
+ * each), at 17 significant digits; malloc'd, NULL if out of memory. */
+char *api_eval_json(const char *id, const double *values, const double *du, const double *dv, const double *dw,
+                    size_t n);
+
 #endif

@@ -34,6 +34,7 @@
 #include "metrics.h"
 #include "model.h"
 #include "output.h"
+#include "catalog.h"
 #include "pool.h"
 #include "rcache.h"
 #include "template.h"
@@ -391,72 +392,6 @@ static enum MHD_Result respond_stream(request *r)
 
 /* ---- the cheap routes, on the polling thread ---- */
 
-static char *presets_json(void)
-{
-    cJSON *root = cJSON_CreateObject(), *list = cJSON_AddArrayToObject(root, "presets");
-    for (size_t i = 0; list && i < api_preset_count(); i++) {
-        const api_preset *p = api_preset_at(i);
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddItemToArray(list, o);
-        cJSON_AddStringToObject(o, "name", p->name);
-        cJSON_AddStringToObject(o, "template", p->template);
-        cJSON_AddStringToObject(o, "caption", p->caption);
-    }
-    cJSON *tl = cJSON_AddArrayToObject(root, "templates");
-    for (size_t i = 0; tl && i < api_template_count(); i++) {
-        const api_template *t = api_template_at(i);
-        cJSON *o = cJSON_CreateObject(), *ps;
-        cJSON_AddItemToArray(tl, o);
-        cJSON_AddStringToObject(o, "name", api_template_name(t));
-        cJSON_AddStringToObject(o, "title", api_template_title(t));
-        ps = cJSON_AddArrayToObject(o, "params");
-        size_t n;
-        const api_param_info *info = api_template_params(t, &n);
-        for (size_t k = 0; ps && k < n; k++) {
-            cJSON *q = cJSON_CreateObject();
-            cJSON_AddItemToArray(ps, q);
-            cJSON_AddStringToObject(q, "name", info[k].name);
-            cJSON_AddNumberToObject(q, "size", info[k].slots);
-            cJSON_AddStringToObject(q, "help", info[k].help);
-        }
-    }
-    char *s = cJSON_PrintUnformatted(root);
-    cJSON_Delete(root);
-    return s;
-}
-
-static char *preset_json(const api_preset *ps)
-{
-    const api_template *t = api_preset_template(ps);
-    api_params p;
-    api_preset_params(ps, &p);
-    api_error err;
-    api_model *m = api_template_expand(t, &p, &err);
-    char *model = m ? api_model_json(api_model_get(m)) : NULL;
-    char id[API_ID_LEN + 1] = "";
-    if (m)
-        api_model_id(api_model_get(m), id, NULL);
-    api_model_free(m);
-    cJSON *root = cJSON_CreateObject(), *params = cJSON_CreateObject();
-    cJSON_AddStringToObject(root, "name", ps->name);
-    cJSON_AddStringToObject(root, "template", ps->template);
-    cJSON_AddStringToObject(root, "caption", ps->caption);
-    cJSON_AddStringToObject(root, "id", id);
-    size_t n;
-    const api_param_info *info = api_template_params(t, &n);
-    for (size_t k = 0; k < n; k++) {
-        double v[3];
-        int slots = api_params_get(t, &p, info[k].name, v);
-        cJSON_AddItemToObject(params, info[k].name, slots == 3 ? cJSON_CreateDoubleArray(v, 3) : cJSON_CreateNumber(v[0]));
-    }
-    cJSON_AddItemToObject(root, "params", params);
-    cJSON_AddItemToObject(root, "model", model ? cJSON_Parse(model) : cJSON_CreateNull());
-    free(model);
-    char *s = cJSON_PrintUnformatted(root);
-    cJSON_Delete(root);
-    return s;
-}
-
 static enum MHD_Result quick(request *r)
 {
     srv_server *s = r->s;
@@ -497,14 +432,14 @@ static enum MHD_Result quick(request *r)
         break;
     }
     case R_PRESETS:
-        set_text(r, 200, "application/json", presets_json());
+        set_text(r, 200, "application/json", api_presets_json());
         break;
     case R_PRESET: {
         const api_preset *ps = api_preset_find(r->arg);
         if (!ps)
             set_problem(r, 404, NULL, "no preset \"%.60s\"; GET /presets lists them", r->arg);
         else
-            set_text(r, 200, "application/json", preset_json(ps));
+            set_text(r, 200, "application/json", api_preset_json(ps));
         break;
     }
     case R_STATIC: {
@@ -668,45 +603,6 @@ static void job_solid(request *r)
     answer_entry(r, e, f, res);
 }
 
-typedef struct {
-    char *s;
-    size_t len, cap;
-    int oom;
-} sbuf;
-
-static void put(sbuf *b, const char *p, size_t n)
-{
-    if (b->oom)
-        return;
-    if (b->cap - b->len <= n) {
-        size_t cap = b->cap ? b->cap : 4096;
-        while (cap - b->len <= n)
-            cap *= 2;
-        char *s = realloc(b->s, cap);
-        if (!s) {
-            b->oom = 1;
-            return;
-        }
-        b->s = s;
-        b->cap = cap;
-    }
-    memcpy(b->s + b->len, p, n);
-    b->len += n;
-    b->s[b->len] = '\0';
-}
-
-static void put_triples(sbuf *b, const char *name, const double *v, size_t n)
-{
-    char num[96];
-    int k = snprintf(num, sizeof num, ",\"%s\":[", name);
-    put(b, num, (size_t)k);
-    for (size_t i = 0; i < n; i++) {
-        k = snprintf(num, sizeof num, "%s[%.17g,%.17g,%.17g]", i ? "," : "", v[3 * i], v[3 * i + 1], v[3 * i + 2]);
-        put(b, num, (size_t)k);
-    }
-    put(b, "]", 1);
-}
-
 static void job_eval(request *r)
 {
     srv_server *s = r->s;
@@ -739,26 +635,12 @@ static void job_eval(request *r)
     for (size_t i = 0; i < n; i++)
         pde_eval_d(sol, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], v + 3 * i, derivs ? du + 3 * i : NULL,
                    derivs ? dv + 3 * i : NULL, derivs ? dw + 3 * i : NULL);
-    sbuf b = { 0 };
-    char head[80];
-    int k = snprintf(head, sizeof head, "{\"id\":\"%s\"", srv_entry_id(e));
-    put(&b, head, (size_t)k);
-    put_triples(&b, "values", v, n);
-    if (derivs) {
-        put_triples(&b, "du", du, n);
-        put_triples(&b, "dv", dv, n);
-        put_triples(&b, "dw", dw, n);
-    }
-    put(&b, "}\n", 2);
     snprintf(r->id, sizeof r->id, "%s", srv_entry_id(e));
     srv_cache_release(s->cache, e);
+    char *json = api_eval_json(r->id, v, derivs ? du : NULL, derivs ? dv : NULL, derivs ? dw : NULL, n);
     free(pts);
     free(v);
-    if (b.oom) {
-        free(b.s);
-        b.s = NULL;
-    }
-    set_text(r, 200, "application/json", b.s);
+    set_text(r, 200, "application/json", json);
 }
 
 static void run_job(void *arg)

@@ -2,12 +2,12 @@
  * metrics.c: request, latency, solve and output counters (metrics.h).
  */
 #include <pthread.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "metrics.h"
+#include "sbuf.h"
 
 static const int statuses[] = { 200, 204, 304, 400, 404, 405, 413, 422, 500, 503 };
 #define NSTATUS (int)(sizeof statuses / sizeof *statuses)
@@ -93,95 +93,62 @@ void srv_metrics_connection(srv_metrics *m, int delta)
     pthread_mutex_unlock(&m->lock);
 }
 
-/* A growing string. */
-typedef struct {
-    char *s;
-    size_t len, cap;
-    int oom;
-} sbuf;
-
-__attribute__((format(printf, 2, 3))) static void add(sbuf *b, const char *fmt, ...)
-{
-    for (;;) {
-        va_list ap;
-        va_start(ap, fmt);
-        int n = b->oom ? 0 : vsnprintf(b->s + b->len, b->cap - b->len, fmt, ap);
-        va_end(ap);
-        if (b->oom || n < 0)
-            return;
-        if ((size_t)n < b->cap - b->len) {
-            b->len += (size_t)n;
-            return;
-        }
-        size_t cap = b->cap ? 2 * b->cap : 4096;
-        while (cap - b->len <= (size_t)n)
-            cap *= 2;
-        char *s = realloc(b->s, cap);
-        if (!s) {
-            b->oom = 1;
-            return;
-        }
-        b->s = s;
-        b->cap = cap;
-    }
-}
-
 char *srv_metrics_render(srv_metrics *m, const srv_cache_stats *c, size_t queue_depth, size_t in_flight,
                          unsigned long long response_hits)
 {
-    sbuf b = { 0 };
+    srv_sbuf b = { 0 };
     pthread_mutex_lock(&m->lock);
-    add(&b, "# HELP pdesolid_requests_total HTTP requests answered, by route and status.\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_requests_total HTTP requests answered, by route and status.\n"
             "# TYPE pdesolid_requests_total counter\n");
     for (int r = 0; r < m->nroutes; r++)
         for (int s = 0; s <= NSTATUS; s++) {
             unsigned long long n = m->requests[r * (NSTATUS + 1) + s];
             if (n) {
                 if (s < NSTATUS)
-                    add(&b, "pdesolid_requests_total{route=\"%s\",status=\"%d\"} %llu\n", m->routes[r], statuses[s], n);
+                    srv_sbuf_printf(&b, "pdesolid_requests_total{route=\"%s\",status=\"%d\"} %llu\n", m->routes[r], statuses[s], n);
                 else
-                    add(&b, "pdesolid_requests_total{route=\"%s\",status=\"other\"} %llu\n", m->routes[r], n);
+                    srv_sbuf_printf(&b, "pdesolid_requests_total{route=\"%s\",status=\"other\"} %llu\n", m->routes[r], n);
             }
         }
-    add(&b, "# HELP pdesolid_request_duration_seconds Time from a request's first byte to its last byte sent.\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_request_duration_seconds Time from a request's first byte to its last byte sent.\n"
             "# TYPE pdesolid_request_duration_seconds histogram\n");
     unsigned long long cum = 0;
     for (int i = 0; i < NBUCKET; i++) {
         cum += m->hist[i];
-        add(&b, "pdesolid_request_duration_seconds_bucket{le=\"%g\"} %llu\n", buckets[i], cum);
+        srv_sbuf_printf(&b, "pdesolid_request_duration_seconds_bucket{le=\"%g\"} %llu\n", buckets[i], cum);
     }
     cum += m->hist[NBUCKET];
-    add(&b, "pdesolid_request_duration_seconds_bucket{le=\"+Inf\"} %llu\n", cum);
-    add(&b, "pdesolid_request_duration_seconds_sum %.9g\npdesolid_request_duration_seconds_count %llu\n",
+    srv_sbuf_printf(&b, "pdesolid_request_duration_seconds_bucket{le=\"+Inf\"} %llu\n", cum);
+    srv_sbuf_printf(&b, "pdesolid_request_duration_seconds_sum %.9g\npdesolid_request_duration_seconds_count %llu\n",
         m->latency_sum, m->latency_count);
-    add(&b, "# HELP pdesolid_solve_seconds Time spent solving models (cache misses).\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_solve_seconds Time spent solving models (cache misses).\n"
             "# TYPE pdesolid_solve_seconds summary\n"
             "pdesolid_solve_seconds_sum %.9g\npdesolid_solve_seconds_count %llu\n",
         m->solve_sum, m->solve_count);
-    add(&b, "# HELP pdesolid_output_seconds Time spent sampling solutions and writing outputs.\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_output_seconds Time spent sampling solutions and writing outputs.\n"
             "# TYPE pdesolid_output_seconds summary\n"
             "pdesolid_output_seconds_sum %.9g\npdesolid_output_seconds_count %llu\n",
         m->output_sum, m->output_count);
-    add(&b, "# HELP pdesolid_output_bytes_total Bytes of outputs written.\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_output_bytes_total Bytes of outputs written.\n"
             "# TYPE pdesolid_output_bytes_total counter\npdesolid_output_bytes_total %llu\n", m->output_bytes);
-    add(&b, "# HELP pdesolid_connections Open HTTP connections.\n# TYPE pdesolid_connections gauge\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_connections Open HTTP connections.\n# TYPE pdesolid_connections gauge\n"
             "pdesolid_connections %lld\n", m->connections);
     pthread_mutex_unlock(&m->lock);
-    add(&b, "# HELP pdesolid_cache_hits_total Requests whose solution was cached (or being solved).\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_cache_hits_total Requests whose solution was cached (or being solved).\n"
             "# TYPE pdesolid_cache_hits_total counter\npdesolid_cache_hits_total %llu\n", c->hits);
-    add(&b, "# HELP pdesolid_cache_misses_total Requests that solved their model.\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_cache_misses_total Requests that solved their model.\n"
             "# TYPE pdesolid_cache_misses_total counter\npdesolid_cache_misses_total %llu\n", c->misses);
-    add(&b, "# HELP pdesolid_cache_evictions_total Solutions evicted to keep the cache within its bound.\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_cache_evictions_total Solutions evicted to keep the cache within its bound.\n"
             "# TYPE pdesolid_cache_evictions_total counter\npdesolid_cache_evictions_total %llu\n", c->evictions);
-    add(&b, "# HELP pdesolid_cache_bytes Bytes of cached solutions.\n# TYPE pdesolid_cache_bytes gauge\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_cache_bytes Bytes of cached solutions.\n# TYPE pdesolid_cache_bytes gauge\n"
             "pdesolid_cache_bytes %zu\n", c->bytes);
-    add(&b, "# HELP pdesolid_cache_entries Cached solutions.\n# TYPE pdesolid_cache_entries gauge\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_cache_entries Cached solutions.\n# TYPE pdesolid_cache_entries gauge\n"
             "pdesolid_cache_entries %zu\n", c->entries);
-    add(&b, "# HELP pdesolid_response_cache_hits_total Requests answered from a kept response, without a solver thread.\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_response_cache_hits_total Requests answered from a kept response, without a solver thread.\n"
             "# TYPE pdesolid_response_cache_hits_total counter\npdesolid_response_cache_hits_total %llu\n", response_hits);
-    add(&b, "# HELP pdesolid_queue_depth Jobs queued or running on the solver threads.\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_queue_depth Jobs queued or running on the solver threads.\n"
             "# TYPE pdesolid_queue_depth gauge\npdesolid_queue_depth %zu\n", queue_depth);
-    add(&b, "# HELP pdesolid_requests_in_flight Requests begun and not yet finished.\n"
+    srv_sbuf_printf(&b, "# HELP pdesolid_requests_in_flight Requests begun and not yet finished.\n"
             "# TYPE pdesolid_requests_in_flight gauge\npdesolid_requests_in_flight %zu\n", in_flight);
     if (b.oom) {
         free(b.s);

@@ -1,0 +1,74 @@
+/*
+ * catalog.c: presets and templates as JSON (catalog.h).
+ */
+#include <stdlib.h>
+
+#include <cJSON.h>
+
+#include "catalog.h"
+#include "id.h"
+
+char *api_presets_json(void)
+{
+    cJSON *root = cJSON_CreateObject(), *list = cJSON_AddArrayToObject(root, "presets");
+    for (size_t i = 0; list && i < api_preset_count(); i++) {
+        const api_preset *p = api_preset_at(i);
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddItemToArray(list, o);
+        cJSON_AddStringToObject(o, "name", p->name);
+        cJSON_AddStringToObject(o, "template", p->template);
+        cJSON_AddStringToObject(o, "caption", p->caption);
+    }
+    cJSON *tl = cJSON_AddArrayToObject(root, "templates");
+    for (size_t i = 0; tl && i < api_template_count(); i++) {
+        const api_template *t = api_template_at(i);
+        cJSON *o = cJSON_CreateObject(), *ps;
+        cJSON_AddItemToArray(tl, o);
+        cJSON_AddStringToObject(o, "name", api_template_name(t));
+        cJSON_AddStringToObject(o, "title", api_template_title(t));
+        ps = cJSON_AddArrayToObject(o, "params");
+        size_t n;
+        const api_param_info *info = api_template_params(t, &n);
+        for (size_t k = 0; ps && k < n; k++) {
+            cJSON *q = cJSON_CreateObject();
+            cJSON_AddItemToArray(ps, q);
+            cJSON_AddStringToObject(q, "name", info[k].name);
+            cJSON_AddNumberToObject(q, "size", info[k].slots);
+            cJSON_AddStringToObject(q, "help", info[k].help);
+        }
+    }
+    char *s = cJSON_PrintUnformatted(root);
+    cJSON_Delete(root);
+    return s;
+}
+
+char *api_preset_json(const api_preset *ps)
+{
+    const api_template *t = api_preset_template(ps);
+    api_params p;
+    api_preset_params(ps, &p);
+    api_error err;
+    api_model *m = api_template_expand(t, &p, &err);
+    cJSON *model = m ? api_model_tree(api_model_get(m)) : NULL;   /* no cJSON_Parse: it writes a global */
+    char id[API_ID_LEN + 1] = "";
+    if (m)
+        api_model_id(api_model_get(m), id, NULL);
+    api_model_free(m);
+    cJSON *root = cJSON_CreateObject(), *params = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "name", ps->name);
+    cJSON_AddStringToObject(root, "template", ps->template);
+    cJSON_AddStringToObject(root, "caption", ps->caption);
+    cJSON_AddStringToObject(root, "id", id);
+    size_t n;
+    const api_param_info *info = api_template_params(t, &n);
+    for (size_t k = 0; k < n; k++) {
+        double v[3];
+        int slots = api_params_get(t, &p, info[k].name, v);
+        cJSON_AddItemToObject(params, info[k].name, slots == 3 ? cJSON_CreateDoubleArray(v, 3) : cJSON_CreateNumber(v[0]));
+    }
+    cJSON_AddItemToObject(root, "params", params);
+    cJSON_AddItemToObject(root, "model", model ? model : cJSON_CreateNull());
+    char *s = cJSON_PrintUnformatted(root);
+    cJSON_Delete(root);
+    return s;
+}

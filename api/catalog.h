@@ -1,0 +1,15 @@
+/*
+ * catalog.h: the presets and templates as JSON documents, for GET /presets
+ * and GET /presets/{name}. Reentrant (cJSON only prints here).
+ */
+#ifndef API_CATALOG_H
+#define API_CATALOG_H
+
+#include "template.h"
+
+/* {"presets": [{"name", "template", "caption"}], "templates": [{"name", "title", "params": [...]}]}; malloc'd. */
+char *api_presets_json(void);
+/* {"name", "template", "caption", "id", "params": {...}, "model": {...}}; malloc'd, NULL if out of memory. */
+char *api_preset_json(const api_preset *ps);
+
+#endif
