@@ -34,7 +34,7 @@ CURL     := $(shell pkg-config --libs libcurl 2>/dev/null || echo -lcurl)
 TESTS := $(patsubst tests/%.c,build/san/tests/%,$(TEST_SRC))
 BENCHES := $(patsubst bench/%.c,build/bench/%,$(BENCH_SRC))
 
-.PHONY: all test bench clean deps run
+.PHONY: all test bench clean deps run tsan
 all: build/pdesolid build/pdesolidd
 
 # Installs missing Debian and npm packages (a no-op when all are there).
@@ -82,6 +82,19 @@ build/san/tests/%: build/san/tests/%.o build/san/tests/support.o $(call san,$(AP
 test: build/pdesolid build/pdesolidd build/san/pdesolid build/san/pdesolidd $(TESTS)
 	@set -e; for t in $(TESTS); do echo "== $$t"; PDESOLID=build/pdesolid PDESOLID_SAN=build/san/pdesolid \
 	    PDESOLIDD_SAN=build/san/pdesolidd ./$$t; done
+
+# The server's integration tests against a ThreadSanitizer build of pdesolidd; a race
+# leaves a report in build/tsan/ and fails the target.
+build/tsan/pdesolidd: $(SRV_SRC) $(API_SRC) $(CORE_SRC)
+	@mkdir -p $(dir $@)
+	$(CC) $(STD) -O1 -g $(WARN) -Icore -Iapi $(CJSON_CFLAGS) -fcx-fortran-rules -fsanitize=thread $^ \
+	    $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@
+
+tsan: build/tsan/pdesolidd build/san/tests/test_server build/pdesolid build/san/pdesolid
+	@rm -f build/tsan/report.*
+	PDESOLIDD_SAN=build/tsan/pdesolidd PDESOLID=build/pdesolid PDESOLID_SAN=build/san/pdesolid \
+	    TSAN_OPTIONS="log_path=$(CURDIR)/build/tsan/report" ./build/san/tests/test_server
+	@if ls build/tsan/report.* >/dev/null 2>&1; then cat build/tsan/report.*; exit 1; fi
 
 build/bench/%: bench/%.c build/libpdeapi.a build/libpdecore.a
 	@mkdir -p $(dir $@)

@@ -360,6 +360,42 @@ static void cache_hits_misses_and_evictions_should_show_in_metrics(void **state)
     stop(&d);
 }
 
+typedef struct {
+    const daemon_t *d;
+    long status;
+} same_arg;
+
+static void *same_request(void *arg)
+{
+    same_arg *a = arg;
+    reply r = post(a->d, "/solve?format=glb&res=200", "{\"preset\":\"fig3b\",\"params\":{\"r0\":0.77}}");
+    a->status = r.status;
+    free(r.body);
+    return NULL;
+}
+
+static void concurrent_identical_requests_should_solve_once(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--threads 4");
+    enum { N = 16 };
+    pthread_t t[N];
+    same_arg a[N];
+    for (int i = 0; i < N; i++) {
+        a[i] = (same_arg){ &d, 0 };
+        pthread_create(&t[i], NULL, same_request, &a[i]);
+    }
+    for (int i = 0; i < N; i++) {
+        pthread_join(t[i], NULL);
+        assert_int_equal(a[i].status, 200);
+    }
+    /* One solve; every other request found the solution, or the whole response, already made. */
+    assert_int_equal(metric(&d, "pdesolid_cache_misses_total"), 1);
+    assert_int_equal(metric(&d, "pdesolid_cache_hits_total") + metric(&d, "pdesolid_response_cache_hits_total"), N - 1);
+    stop(&d);
+}
+
 static void etag_with_if_none_match_should_give_304(void **state)
 {
     (void)state;
@@ -789,6 +825,7 @@ int main(void)
         cmocka_unit_test(solve_should_give_every_format_as_the_core_computes_it),
         cmocka_unit_test(eval_should_agree_with_the_cli),
         cmocka_unit_test(cache_hits_misses_and_evictions_should_show_in_metrics),
+        cmocka_unit_test(concurrent_identical_requests_should_solve_once),
         cmocka_unit_test(etag_with_if_none_match_should_give_304),
         cmocka_unit_test(sixty_four_concurrent_clients_should_all_get_correct_answers),
         cmocka_unit_test(a_full_queue_should_give_503_with_retry_after),
