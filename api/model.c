@@ -567,14 +567,19 @@ int api_eval_parse(const char *text, size_t len, size_t max_points, double **out
     return rc;
 }
 
-static void add_factor(cJSON *o, const char *key, pde_factor f)
+cJSON *api_factor_tree(pde_factor f)
 {
     static const char *const kinds[] = { "pow", "sin", "cos", "exp", "sinh", "cosh" };
-    if (f.kind == PDE_POW && f.p == 0)
-        return;     /* 1, the default */
-    cJSON *x = cJSON_AddObjectToObject(o, key);
-    if (x)
-        cJSON_AddNumberToObject(x, kinds[f.kind], f.p);
+    cJSON *o = cJSON_CreateObject();
+    if (o)
+        cJSON_AddNumberToObject(o, kinds[f.kind], f.p);
+    return o;
+}
+
+static void add_factor(cJSON *o, const char *key, pde_factor f)
+{
+    if (f.kind != PDE_POW || f.p != 0)   /* 1, the default, is left out */
+        cJSON_AddItemToObject(o, key, api_factor_tree(f));
 }
 
 cJSON *api_model_tree(const pde_model *m)

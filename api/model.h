@@ -85,6 +85,8 @@ int api_eval_parse(const char *text, size_t len, size_t max_points, double **out
 char *api_model_json(const pde_model *m);
 /* The same as a cJSON tree (cJSON_Delete it), to put inside a larger document without a parse. */
 struct cJSON *api_model_tree(const pde_model *m);
+/* One factor as {"sin": k} and so on, a cJSON tree. */
+struct cJSON *api_factor_tree(pde_factor f);
 
 /* Sets err from a printf format, with status 422; returns -1, for one-line error returns. */
 int api_fail(api_error *err, const char *pointer, const char *fmt, ...)

@@ -244,15 +244,6 @@ char *api_eval_json(const char *id, const double *values, const double *du, cons
     return buf;
 }
 
-static cJSON *factor_tree(pde_factor f)
-{
-    static const char *const k[] = { "pow", "sin", "cos", "exp", "sinh", "cosh" };
-    cJSON *o = cJSON_CreateObject();
-    if (o)
-        cJSON_AddNumberToObject(o, k[f.kind], f.p);
-    return o;
-}
-
 static cJSON *numbers(const double *v, int n)
 {
     cJSON *a = cJSON_CreateArray();
@@ -286,8 +277,8 @@ static int json_document(api_output *o)
         for (size_t m = 0; modes && m < nm; m++) {
             cJSON *mo = cJSON_CreateObject(), *terms;
             cJSON_AddItemToArray(modes, mo);
-            cJSON_AddItemToObject(mo, "u", factor_tree(md[m].u));
-            cJSON_AddItemToObject(mo, "v", factor_tree(md[m].v));
+            cJSON_AddItemToObject(mo, "u", api_factor_tree(md[m].u));
+            cJSON_AddItemToObject(mo, "v", api_factor_tree(md[m].v));
             cJSON_AddNumberToObject(mo, "e", md[m].e);
             if (!(terms = cJSON_AddArrayToObject(mo, "h")))
                 continue;
