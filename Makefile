@@ -76,8 +76,11 @@ build/san/pdesolidd: $(call san,$(SRV_SRC) $(API_SRC) $(CORE_SRC))
 build/san/pdesolid: $(call san,$(CLI_SRC) $(API_SRC) $(CORE_SRC))
 	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CURL) $(LDLIBS) -o $@
 
-build/san/tests/%: build/san/tests/%.o build/san/tests/support.o $(call san,$(API_SRC) $(CORE_SRC))
-	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(CURL) $(LDLIBS) -lpthread -o $@
+# Tests link the server's modules too (all but main.c), for test_config and test_log.
+build/san/tests/%.o: CFLAGS += -Iserver
+build/san/tests/%: build/san/tests/%.o build/san/tests/support.o $(call san,$(filter-out server/main.c,$(SRV_SRC)) \
+                   $(API_SRC) $(CORE_SRC))
+	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(CURL) $(MHD) $(LDLIBS) -lpthread -o $@
 
 test: build/pdesolid build/pdesolidd build/san/pdesolid build/san/pdesolidd $(TESTS)
 	@set -e; for t in $(TESTS); do echo "== $$t"; PDESOLID=build/pdesolid PDESOLID_SAN=build/san/pdesolid \
@@ -99,6 +102,10 @@ tsan: build/tsan/pdesolidd build/san/tests/test_server build/pdesolid build/san/
 build/bench/%: bench/%.c build/libpdeapi.a build/libpdecore.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(CJSON_CFLAGS) $^ $(LIBS) $(LDLIBS) -o $@
+
+build/bench/bench_log: bench/bench_log.c build/obj/server/log.o
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Iserver $^ $(LDLIBS) -lpthread -o $@
 
 build/bench/mhd_minimal: bench/mhd_minimal.c
 	@mkdir -p $(dir $@)

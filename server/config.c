@@ -1,7 +1,11 @@
 /*
- * config.c: flags (config.h).
+ * config.c: flags (config.h). One table row per flag: parsing, defaults, the
+ * usage text and srv_config_print all read the table, so that a new flag is
+ * one row (and its field in srv_config).
  */
+#include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,37 +13,124 @@
 
 #include "config.h"
 
-static const char usage[] =
+typedef enum {
+    K_STR,       /* char array; lo is the least length */
+    K_UNSIGNED,  /* unsigned, a whole number in [lo, hi] */
+    K_INT,       /* int, a whole number in [lo, hi] */
+    K_COUNT,     /* size_t, a whole number in [lo, hi] */
+    K_MB,        /* size_t bytes, given in MiB in [lo, hi] */
+    K_BYTES,     /* size_t bytes, given as SIZE (parse_size), at least lo */
+    K_REAL,      /* double in (lo, hi]: 2.5, 2e9, 2000000000 */
+    K_LOGFMT,    /* srv_log_format: text or json */
+    K_SWITCH,    /* int set to 1; takes no value */
+    K_HELP,
+    K_VERSION
+} kind;
+
+static const size_t kind_size[] = { [K_UNSIGNED] = sizeof(unsigned), [K_INT] = sizeof(int),
+                                    [K_COUNT] = sizeof(size_t),      [K_MB] = sizeof(size_t),
+                                    [K_BYTES] = sizeof(size_t),      [K_REAL] = sizeof(double),
+                                    [K_LOGFMT] = sizeof(srv_log_format), [K_SWITCH] = sizeof(int) };
+
+typedef struct {
+    const char *name, *arg;  /* "--port", "N" (NULL for a switch) */
+    kind k;
+    size_t off, size;        /* the field in srv_config */
+    double lo, hi;
+    const char *def;         /* the default, parsed as a value would be; NULL: set in code */
+    const char *shown;       /* the default as the usage shows it, when def is NULL or not plain */
+    const char *help;        /* "\n" continues on the next line, indented */
+} flag;
+
+#define AT(f) offsetof(srv_config, f), sizeof(((srv_config *)0)->f)
+#define NONE 0, 0
+
+static const flag flags[] = {
+    { "--bind", "ADDR", K_STR, AT(bind), 1, 0, "127.0.0.1", NULL, "address to listen on" },
+    { "--port", "N", K_UNSIGNED, AT(port), 0, 65535, "8080", NULL, "port; 0 picks a free one" },
+    { "--threads", "N", K_INT, AT(threads), 1, 256, NULL, "one per core", "solver threads" },
+    { "--http-threads", "N", K_INT, AT(http_threads), 1, 256, NULL, "one per core",
+      "libmicrohttpd's polling threads, each serving\nconnections" },
+    { "--queue", "N", K_COUNT, AT(queue), 1, 1 << 20, "64", NULL, "jobs that may wait for a thread before 503" },
+    { "--cache-mb", "N", K_MB, AT(cache_bytes), 0, 1 << 20, "256", NULL, "bound of the solution cache, MiB" },
+    { "--max-body", "SIZE", K_BYTES, AT(max_body), 1024, 0, "1MiB", NULL,
+      "largest request body, e.g. 1MiB, 512KiB, 65536" },
+    { "--max-points", "N", K_COUNT, AT(max_points), 1, 10000000, "100000", NULL, "points in one eval request" },
+    { "--max-work", "N", K_REAL, AT(max_work), 0, 1e18, "2e9", NULL,
+      "refuse with a 422 a request whose estimated cost\n"
+      "is over N units (about 1 ns of one core each);\n"
+      "2e9 or 2000000000" },
+    { "--max-mem-mb", "N", K_MB, AT(max_mem), 1, 1 << 20, "64", NULL,
+      "scratch memory one request may use beyond\nthe caches, MiB" },
+    { "--job-timeout", "S", K_REAL, AT(job_timeout), 0, 86400, "2", NULL,
+      "wall-clock seconds one job may run; it is\ncancelled past it" },
+    { "--request-timeout", "S", K_REAL, AT(request_timeout), 0, 86400, "30", NULL,
+      "total seconds to receive a request, headers\nand body" },
+    { "--timeout", "S", K_UNSIGNED, AT(timeout), 1, 86400, "30", NULL,
+      "seconds before an idle connection is closed" },
+    { "--max-conns-per-ip", "N", K_UNSIGNED, AT(per_ip), 1, 65535, "128", NULL,
+      "connections open at once from one address; a\n"
+      "new one over the limit is closed at once, the\n"
+      "others stay. No address is locked out longer\n"
+      "than --request-timeout (a request in progress)\n"
+      "or --timeout (an idle keep-alive connection)" },
+    { "--max-conns", "N", K_UNSIGNED, AT(max_conns), 1, 65535, "1024", NULL, "connections in all" },
+    { "--grace", "S", K_UNSIGNED, AT(grace), 0, 3600, "30", NULL,
+      "seconds to finish requests on SIGTERM or SIGINT" },
+    { "--cors-origin", "LIST", K_STR, AT(cors), 0, 0, "", "none: same origin only",
+      "origins allowed cross-origin calls, comma-separated,\nor * for any" },
+    { "--web", "DIR", K_STR, AT(web), 1, 0, NULL, "clients/web by the binary",
+      "the browser front-end's files; DIR/index.html\nmust be readable" },
+    { "--log-format", "F", K_LOGFMT, AT(log_format), 0, 0, "text", NULL,
+      "access log lines: text, or json (one object\na line)" },
+    { "--quiet", NULL, K_SWITCH, AT(quiet), 0, 0, NULL, NULL, "no access log on stderr" },
+    { "-h", NULL, K_HELP, NONE, 0, 0, NULL, NULL, "this text" },
+    { "--help", NULL, K_HELP, NONE, 0, 0, NULL, NULL, "this text" },
+    { "--version", NULL, K_VERSION, NONE, 0, 0, NULL, NULL, "the version" },
+};
+#define NFLAGS (sizeof flags / sizeof *flags)
+
+static const char intro[] =
     "usage: pdesolidd [OPTIONS]\n"
     "\n"
     "The pdesolid solve server: an HTTP daemon that solves fourth-order PDE solids\n"
     "in closed form and returns closed forms, grids and meshes (docs/API.md).\n"
+    "Every option that takes a value takes it as --opt VALUE or --opt=VALUE.\n"
     "\n"
-    "options (defaults in brackets):\n"
-    "  --bind ADDR            address to listen on [127.0.0.1]\n"
-    "  --port N               port; 0 picks a free one [8080]\n"
-    "  --threads N            solver threads [one per core]\n"
-    "  --queue N              jobs that may wait for a thread before 503 [64]\n"
-    "  --cache-mb N           bound of the solution cache, MiB [256]\n"
-    "  --max-body SIZE        largest request body, e.g. 1MiB, 512KiB [1MiB]\n"
-    "  --max-points N         points in one eval request [100000]\n"
-    "  --cors-origin LIST     origins allowed cross-origin calls, comma-separated,\n"
-    "                         or * for any [none: same origin only]\n"
-    "  --timeout S            seconds before an idle connection is closed [30]\n"
-    "  --max-conns-per-ip N   connections from one address [128]\n"
-    "  --max-conns N          connections in all [1024]\n"
-    "  --grace S              seconds to finish requests on SIGTERM or SIGINT [30]\n"
-    "  --web DIR              the browser front-end's files [clients/web beside build/]\n"
-    "  --quiet                no access log on stderr\n"
-    "  -h, --help             this text\n"
-    "  --version              the version\n";
+    "options (defaults in brackets):\n";
+
+static void print_usage(FILE *f)
+{
+    fputs(intro, f);
+    for (size_t i = 0; i < NFLAGS; i++) {
+        const flag *r = &flags[i];
+        if (!strcmp(r->name, "-h"))
+            continue;   /* shown with --help */
+        char left[64];
+        snprintf(left, sizeof left, "%s%s%s%s", !strcmp(r->name, "--help") ? "-h, " : "", r->name,
+                 r->arg ? " " : "", r->arg ? r->arg : "");
+        fprintf(f, "  %-22s ", left);
+        for (const char *h = r->help; *h; h++) {
+            fputc(*h, f);
+            if (*h == '\n')
+                fprintf(f, "%25s", "");
+        }
+        const char *d = r->shown ? r->shown : r->def;
+        if (d)
+            fprintf(f, " [%s]", d);
+        fputc('\n', f);
+    }
+}
 
 /* SIZE: bytes, or with KiB, MiB, GiB (or K, M, G, KB, MB, GB as powers of 1024). */
 static int parse_size(const char *s, size_t *out)
 {
     char *end;
+    if (*s < '0' || *s > '9')
+        return -1;
+    errno = 0;
     unsigned long long v = strtoull(s, &end, 10);
-    if (end == s || *s == '-')
+    if (errno)
         return -1;
     unsigned long long mul = 1;
     if (!strcmp(end, "") || !strcmp(end, "B"))
@@ -58,19 +149,121 @@ static int parse_size(const char *s, size_t *out)
     return 0;
 }
 
-static int parse_uint(const char *s, unsigned long long lo, unsigned long long hi, unsigned long long *out)
+static int parse_whole(const char *s, double lo, double hi, unsigned long long *out)
 {
     char *end;
     if (*s < '0' || *s > '9')
         return -1;
+    errno = 0;
     unsigned long long v = strtoull(s, &end, 10);
-    if (*end || v < lo || v > hi)
+    if (errno || *end || (double)v < lo || (double)v > hi)
         return -1;
     *out = v;
     return 0;
 }
 
-/* The web directory beside the binary: build/pdesolidd -> clients/web. */
+/* A plain decimal number (digits, '.', an exponent): no hex, inf, nan or spaces, which strtod would take. */
+static int parse_real(const char *s, double lo, double hi, double *out)
+{
+    if (!((*s >= '0' && *s <= '9') || *s == '.') || strspn(s, "0123456789.eE+-") != strlen(s))
+        return -1;
+    char *end;
+    double v = strtod(s, &end);
+    if (*end || !isfinite(v) || !(v > lo) || v > hi)
+        return -1;
+    *out = v;
+    return 0;
+}
+
+/* Sets the row's field from v; -1 if v is not a valid value. */
+static int set(const flag *r, const char *v, srv_config *c)
+{
+    void *p = (char *)c + r->off;
+    unsigned long long n;
+    size_t z;
+    double d;
+    if (r->k != K_STR && r->size != kind_size[r->k])
+        return -1;   /* a row whose kind does not fit its field: the defaults test fails */
+    switch (r->k) {
+    case K_STR:
+        if (strlen(v) < (size_t)r->lo || strlen(v) >= r->size)
+            return -1;
+        memcpy(p, v, strlen(v) + 1);
+        return 0;
+    case K_UNSIGNED:
+        if (parse_whole(v, r->lo, r->hi, &n))
+            return -1;
+        *(unsigned *)p = (unsigned)n;
+        return 0;
+    case K_INT:
+        if (parse_whole(v, r->lo, r->hi, &n))
+            return -1;
+        *(int *)p = (int)n;
+        return 0;
+    case K_COUNT:
+        if (parse_whole(v, r->lo, r->hi, &n))
+            return -1;
+        *(size_t *)p = (size_t)n;
+        return 0;
+    case K_MB:
+        if (parse_whole(v, r->lo, r->hi, &n))
+            return -1;
+        *(size_t *)p = (size_t)n << 20;
+        return 0;
+    case K_BYTES:
+        if (parse_size(v, &z) || (double)z < r->lo)
+            return -1;
+        *(size_t *)p = z;
+        return 0;
+    case K_REAL:
+        if (parse_real(v, r->lo, r->hi, &d))
+            return -1;
+        *(double *)p = d;
+        return 0;
+    case K_LOGFMT:
+        if (strcmp(v, "text") && strcmp(v, "json"))
+            return -1;
+        *(srv_log_format *)p = strcmp(v, "json") ? SRV_LOG_TEXT : SRV_LOG_JSON;
+        return 0;
+    case K_SWITCH:
+    case K_HELP:
+    case K_VERSION:
+        break;
+    }
+    return -1;
+}
+
+/* What a valid value of the row is, for the error message. */
+static void describe(const flag *r, char *out, size_t n)
+{
+    switch (r->k) {
+    case K_STR:
+        snprintf(out, n, "%sat most %zu characters", r->lo ? "not empty, " : "", r->size - 1);
+        break;
+    case K_UNSIGNED:
+    case K_INT:
+    case K_COUNT:
+    case K_MB:
+        snprintf(out, n, "a whole number from %.0f to %.0f", r->lo, r->hi);
+        break;
+    case K_BYTES:
+        snprintf(out, n, "a size such as 1MiB, 512KiB or 65536, at least %.0f bytes", r->lo);
+        break;
+    case K_REAL:
+        snprintf(out, n, "a number over %g and at most %g, such as %s", r->lo, r->hi, r->def ? r->def : "1");
+        break;
+    case K_LOGFMT:
+        snprintf(out, n, "text or json");
+        break;
+    default:
+        snprintf(out, n, "no value");
+        break;
+    }
+}
+
+/* Candidates for the web directory: clients/web beside the binary's directory and up to two levels
+ * further up (build/pdesolidd and build/san/pdesolidd both find the source tree's). The first whose
+ * index.html is readable, else the first candidate. */
 static void default_web(char *out, size_t n)
 {
     char exe[PATH_MAX];
@@ -82,94 +275,138 @@ static void default_web(char *out, size_t n)
     char *slash = strrchr(exe, '/');
     if (!slash)
         return;
-    *slash = '\0';
-    slash = strrchr(exe, '/');
-    if (slash)
+    *slash = '\0';   /* the binary's directory */
+    for (int up = 0; up < 3; up++) {
+        slash = strrchr(exe, '/');
+        if (!slash)
+            return;
         *slash = '\0';
-    snprintf(out, n, "%.900s/clients/web", exe);
+        char dir[PATH_MAX + 16], index[PATH_MAX + 32];
+        snprintf(dir, sizeof dir, "%s/clients/web", exe);
+        snprintf(index, sizeof index, "%s/index.html", dir);
+        if (up == 0 || !access(index, R_OK))
+            snprintf(out, n, "%.1000s", dir);
+        if (!access(index, R_OK))
+            return;
+    }
+}
+
+static const flag *find(const char *a, size_t len)
+{
+    for (size_t i = 0; i < NFLAGS; i++)
+        if (strlen(flags[i].name) == len && !strncmp(flags[i].name, a, len))
+            return &flags[i];
+    return NULL;
 }
 
 int srv_config_parse(int argc, char **argv, srv_config *c, FILE *out, FILE *err)
 {
     memset(c, 0, sizeof *c);
-    snprintf(c->bind, sizeof c->bind, "127.0.0.1");
-    c->port = 8080;
+    for (size_t i = 0; i < NFLAGS; i++)
+        if (flags[i].def && set(&flags[i], flags[i].def, c)) {
+            fprintf(err, "pdesolidd: the default of %s, %s, is not valid (a bug)\n", flags[i].name, flags[i].def);
+            return 2;
+        }
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    c->threads = cores > 0 ? (int)cores : 2;
-    c->queue = 64;
-    c->cache_bytes = 256u << 20;
-    c->max_body = 1u << 20;
-    c->max_points = 100000;
-    c->timeout = 30;
-    c->per_ip = 128;
-    c->max_conns = 1024;
-    c->grace = 30;
+    c->threads = c->http_threads = cores > 0 ? (cores < 256 ? (int)cores : 256) : 2;
     default_web(c->web, sizeof c->web);
+    int web_given = 0;
     for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        unsigned long long n;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            fputs(usage, out);
-            return 1;
+        const char *a = argv[i];
+        if (a[0] != '-') {
+            fprintf(err, "pdesolidd: unexpected argument %s: pdesolidd takes options only (see --help)\n", a);
+            return 2;
         }
-        if (!strcmp(a, "--version")) {
-            fprintf(out, "pdesolidd %s\n", SRV_VERSION);
-            return 1;
+        const char *eq = strncmp(a, "--", 2) ? NULL : strchr(a, '=');
+        const flag *r = find(a, eq ? (size_t)(eq - a) : strlen(a));
+        if (!r) {
+            fprintf(err, "pdesolidd: unknown option %s (see --help)\n", a);
+            return 2;
         }
-        if (!strcmp(a, "--quiet")) {
-            c->quiet = 1;
+        if (!r->arg) {
+            if (eq) {
+                fprintf(err, "pdesolidd: %s: %s takes no value (see --help)\n", a, r->name);
+                return 2;
+            }
+            if (r->k == K_HELP) {
+                print_usage(out);
+                return 1;
+            }
+            if (r->k == K_VERSION) {
+                fprintf(out, "pdesolidd %s\n", PDESOLID_VERSION);
+                return 1;
+            }
+            *(int *)((char *)c + r->off) = 1;
             continue;
         }
+        const char *v = eq ? eq + 1 : NULL;
+        if (!eq && i + 1 < argc && strncmp(argv[i + 1], "--", 2))
+            v = argv[++i];
         if (!v) {
-            fprintf(err, "pdesolidd: %s needs a value (see --help)\n", a);
+            fprintf(err, "pdesolidd: %s needs a value: %s %s or %s=%s (see --help)\n", a, r->name, r->arg, r->name,
+                    r->arg);
             return 2;
         }
-        int bad = 0;
-        if (!strcmp(a, "--bind"))
-            bad = snprintf(c->bind, sizeof c->bind, "%s", v) >= (int)sizeof c->bind;
-        else if (!strcmp(a, "--port"))
-            bad = parse_uint(v, 0, 65535, &n) || (c->port = (unsigned)n, 0);
-        else if (!strcmp(a, "--threads"))
-            bad = parse_uint(v, 1, 256, &n) || (c->threads = (int)n, 0);
-        else if (!strcmp(a, "--queue"))
-            bad = parse_uint(v, 1, 1u << 20, &n) || (c->queue = (size_t)n, 0);
-        else if (!strcmp(a, "--cache-mb"))
-            bad = parse_uint(v, 0, 1u << 20, &n) || (c->cache_bytes = (size_t)n << 20, 0);
-        else if (!strcmp(a, "--max-body"))
-            bad = parse_size(v, &c->max_body) || c->max_body < 1024;
-        else if (!strcmp(a, "--max-points"))
-            bad = parse_uint(v, 1, 10000000, &n) || (c->max_points = (size_t)n, 0);
-        else if (!strcmp(a, "--cors-origin"))
-            bad = snprintf(c->cors, sizeof c->cors, "%s", v) >= (int)sizeof c->cors;
-        else if (!strcmp(a, "--timeout"))
-            bad = parse_uint(v, 1, 86400, &n) || (c->timeout = (unsigned)n, 0);
-        else if (!strcmp(a, "--max-conns-per-ip"))
-            bad = parse_uint(v, 1, 65535, &n) || (c->per_ip = (unsigned)n, 0);
-        else if (!strcmp(a, "--max-conns"))
-            bad = parse_uint(v, 1, 65535, &n) || (c->max_conns = (unsigned)n, 0);
-        else if (!strcmp(a, "--grace"))
-            bad = parse_uint(v, 0, 3600, &n) || (c->grace = (unsigned)n, 0);
-        else if (!strcmp(a, "--web"))
-            bad = snprintf(c->web, sizeof c->web, "%s", v) >= (int)sizeof c->web;
-        else {
-            fprintf(err, "pdesolidd: unknown option %s\n\n%s", a, usage);
+        if (set(r, v, c)) {
+            char what[128];
+            describe(r, what, sizeof what);
+            fprintf(err, "pdesolidd: %s%s%s: not a valid value; give %s (see --help)\n", a, eq ? "" : " ",
+                    eq ? "" : v, what);
             return 2;
         }
-        if (bad) {
-            fprintf(err, "pdesolidd: %s %s: not a valid value (see --help)\n", a, v);
+        web_given |= r->off == offsetof(srv_config, web);
+    }
+    char index[sizeof c->web + 16];
+    snprintf(index, sizeof index, "%s/index.html", c->web);
+    if (access(index, R_OK)) {
+        if (web_given) {
+            fprintf(err, "pdesolidd: --web %s: cannot read %s (%s); give the directory of the front-end, "
+                         "clients/web\n", c->web, index, strerror(errno));
             return 2;
         }
-        i++;
+        fprintf(err, "pdesolidd: warning: no front-end in %s (%s), so / answers 404; give --web DIR\n", c->web,
+                strerror(errno));
     }
     return 0;
 }
 
 void srv_config_print(const srv_config *c, FILE *f)
 {
-    fprintf(f,
-            "pdesolidd %s: --bind %s --port %u --threads %d --queue %zu --cache-mb %zu --max-body %zu "
-            "--max-points %zu --cors-origin '%s' --timeout %u --max-conns-per-ip %u --max-conns %u --grace %u "
-            "--web %s%s\n",
-            SRV_VERSION, c->bind, c->port, c->threads, c->queue, c->cache_bytes >> 20, c->max_body, c->max_points,
-            c->cors, c->timeout, c->per_ip, c->max_conns, c->grace, c->web, c->quiet ? " --quiet" : "");
+    fprintf(f, "pdesolidd %s:", PDESOLID_VERSION);
+    for (size_t i = 0; i < NFLAGS; i++) {
+        const flag *r = &flags[i];
+        const void *p = (const char *)c + r->off;
+        switch (r->k) {
+        case K_STR:
+            fprintf(f, *(const char *)p ? " %s %s" : " %s ''", r->name, (const char *)p);
+            break;
+        case K_UNSIGNED:
+            fprintf(f, " %s %u", r->name, *(const unsigned *)p);
+            break;
+        case K_INT:
+            fprintf(f, " %s %d", r->name, *(const int *)p);
+            break;
+        case K_COUNT:
+        case K_BYTES:
+            fprintf(f, " %s %zu", r->name, *(const size_t *)p);
+            break;
+        case K_MB:
+            fprintf(f, " %s %zu", r->name, *(const size_t *)p >> 20);
+            break;
+        case K_REAL:
+            fprintf(f, " %s %g", r->name, *(const double *)p);
+            break;
+        case K_LOGFMT:
+            fprintf(f, " %s %s", r->name, *(const srv_log_format *)p == SRV_LOG_JSON ? "json" : "text");
+            break;
+        case K_SWITCH:
+            if (*(const int *)p)
+                fprintf(f, " %s", r->name);
+            break;
+        case K_HELP:
+        case K_VERSION:
+            break;
+        }
+    }
+    fputc('\n', f);
 }

@@ -14,8 +14,8 @@
 #include "output.h"
 #include "remote.h"
 #include "template.h"
+#include "version.h"
 
-#define VERSION "0.2.0"
 #define MAX_INPUT (64u << 20)
 
 static const char usage[] =
@@ -352,7 +352,7 @@ int main(int argc, char **argv)
             fputs(usage, stdout);
             return 0;
         } else if (strcmp(a, "--version") == 0) {
-            printf("pdesolid %s\n", VERSION);
+            printf("pdesolid %s\n", PDESOLID_VERSION);
             return 0;
         } else if (strcmp(a, "--preset") == 0) {
             val = &o.preset;
