@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -493,6 +494,92 @@ static size_t random_json_string(char *out, size_t max_chars)
     return w;
 }
 
+/* Appends a random JSON-like value at buf + *w (at most about 600 bytes), mostly valid, sometimes not. */
+static void random_json(char *buf, size_t *w, int depth)
+{
+    static const char *const ws[] = { "", "", " ", "\n", "\t", "\r", " \r\n ", "\f", "\v" };
+    static const char *const numbers[] = { "0", "-0", "1", "-12", "3.25", "1e5", "1E+2", "-0.0e-7", "123456789012345678901234",
+                                           "01", "1.", ".5", "+1", "-", "1e", "0x1", "1.5e+", "00", "-01.5" };
+    static const char *const lits[] = { "true", "false", "null", "nul", "True", "NaN", "Infinity", "truex" };
+    static const char *const pieces[] = { "a", "\\n", "\\\"", "\\/", "\\u0041", "\\u00e9", "\\ud83d\\ude00", "\\ud800",
+                                          "\\udc00", "\\u0000", "\\uDBFF\\uDFFF", "\\x", "\\u12G4", "\xc3\xa9",
+                                          "\xe2\x82\xac", "\xf0\x9f\x98\x80", "\xff", "\xc0\x80", "\xed\xa0\x80",
+                                          "\x7f", "\t", "\x01", "/", "~" };
+    *w += (size_t)sprintf(buf + *w, "%s", ws[rnd(sizeof ws / sizeof *ws)]);
+    unsigned kind = rnd(depth > 4 ? 3 : 4);
+    if (kind == 0) {
+        *w += (size_t)sprintf(buf + *w, "%s", numbers[rnd(sizeof numbers / sizeof *numbers)]);
+    } else if (kind == 1) {
+        *w += (size_t)sprintf(buf + *w, "%s", lits[rnd(sizeof lits / sizeof *lits)]);
+    } else if (kind == 2) {
+        buf[(*w)++] = '"';
+        for (unsigned i = rnd(4); i > 0; i--)
+            *w += (size_t)sprintf(buf + *w, "%s", pieces[rnd(sizeof pieces / sizeof *pieces)]);
+        buf[(*w)++] = '"';
+    } else {
+        int obj = (int)rnd(2);
+        buf[(*w)++] = obj ? '{' : '[';
+        for (unsigned i = rnd(4), first = 1; i > 0; i--, first = 0) {
+            if (!first)
+                buf[(*w)++] = ',';
+            if (obj)
+                *w += (size_t)sprintf(buf + *w, "%s\"%s\"%s:", ws[rnd(3)], pieces[rnd(sizeof pieces / sizeof *pieces)],
+                                      ws[rnd(3)]);
+            random_json(buf, w, depth + 1);
+        }
+        *w += (size_t)sprintf(buf + *w, "%s%c", ws[rnd(3)], obj ? '}' : ']');
+    }
+    *w += (size_t)sprintf(buf + *w, "%s", ws[rnd(3)]);
+}
+
+static void json_check_should_agree_with_node_on_random_documents(void **state)
+{
+    (void)state;
+    enum { N = 3000 };
+    char **texts = calloc(N, sizeof *texts);
+    size_t *lens = calloc(N, sizeof *lens);
+    for (size_t i = 0; i < N; i++) {
+        static char buf[1 << 17];   /* far more than 3^5 leaves of at most 100 bytes need */
+        size_t w = 0;
+        random_json(buf, &w, 0);
+        for (unsigned k = rnd(6) == 0 ? rnd(3) + 1 : 0; k > 0 && w > 0; k--) {   /* mutate a few */
+            size_t at = rnd((unsigned)w);
+            unsigned op = rnd(3);
+            if (op == 0)
+                memmove(buf + at, buf + at + 1, --w - at);
+            else if (op == 1)
+                memmove(buf + at + 1, buf + at, w++ - at), buf[at] = (char)rnd(256);
+            else
+                buf[at] = (char)rnd(256);
+        }
+        texts[i] = malloc(w ? w : 1);
+        memcpy(texts[i], buf, w);
+        lens[i] = w;
+    }
+    char *node = node_run(node_verdicts, texts, lens, N);
+    assert_true(strlen(node) == N + 1);
+    size_t accepted = 0, differ = 0;
+    for (size_t i = 0; i < N; i++) {
+        api_error err;
+        int ours = api_json_check(texts[i], lens[i], &err) == 0;
+        accepted += ours;
+        if (ours == (node[i] == '1'))
+            continue;
+        /* The intended differences: JSON.parse takes \u0000 and unpaired surrogate escapes. */
+        if (ours || (!strstr(err.message, "\\u0000") && !strstr(err.message, "surrogate pair")))
+            fail_msg("document %zu: ours %d, JSON.parse %c: %s", i, ours, node[i], ours ? "" : err.message);
+        differ++;
+    }
+    /* Enough of both kinds for the comparison to mean something. */
+    if (accepted < N / 5 || accepted > N * 4 / 5 || differ == 0)
+        fail_msg("%zu of %d accepted, %zu intended differences", accepted, N, differ);
+    free(node);
+    for (size_t i = 0; i < N; i++)
+        free(texts[i]);
+    free(texts);
+    free(lens);
+}
+
 static void errors_should_be_valid_utf8_whatever_the_input(void **state)
 {
     (void)state;
@@ -609,39 +696,61 @@ static void eval_json_should_write_null_for_what_is_not_finite(void **state)
     free(s);
 }
 
-/* The CLI's eval refuses a point whose value overflows, like a bad document: exit 2 and the point's pointer. */
+/* Runs `bin args` in dir; returns the exit status, with stdout and stderr in *out and *err (free them). */
+static int run_cli(const char *dir, const char *bin, const char *args, char **out, char **err)
+{
+    char cmd[2048], path[256];
+    snprintf(cmd, sizeof cmd, "cd %s && %s %s >out 2>err", dir, bin, args);
+    int st = system(cmd);
+    assert_true(WIFEXITED(st));
+    snprintf(path, sizeof path, "%s/out", dir);
+    *out = read_file(path, NULL);
+    snprintf(path, sizeof path, "%s/err", dir);
+    *err = read_file(path, NULL);
+    assert_non_null(*out);
+    assert_non_null(*err);
+    return WEXITSTATUS(st);
+}
+
+/* The CLI's eval refuses a point whose value overflows, offline and through a server, like a bad document:
+ * exit 2, the point, and nothing on standard output. */
 static void cli_eval_should_refuse_points_whose_values_are_not_finite(void **state)
 {
     (void)state;
-    const char *bin = getenv("PDESOLID_SAN") ? getenv("PDESOLID_SAN") : "build/san/pdesolid";
-    if (access(bin, X_OK) != 0) {
-        fprintf(stderr, "test_strict: no %s; run `make test`\n", bin);
+    const char *name = getenv("PDESOLID_SAN") ? getenv("PDESOLID_SAN") : "build/san/pdesolid";
+    const char *dname = getenv("PDESOLIDD_SAN") ? getenv("PDESOLIDD_SAN") : "build/san/pdesolidd";
+    char bin[4096];
+    if (!realpath(name, bin) || access(dname, X_OK) != 0) {
+        fprintf(stderr, "test_strict: no %s or %s; run `make test`\n", name, dname);
         skip();
     }
     char dir[] = "/tmp/pdesolid-strict-XXXXXX";
     assert_non_null(mkdtemp(dir));
-    char path[256], cmd[1024];
+    char path[256], args[512], *out, *err;
     snprintf(path, sizeof path, "%s/pts.json", dir);
     FILE *f = fopen(path, "w");
     assert_non_null(f);
     fputs("[[0.5,0.5,0.5],[1e300,1e300,1e300]]", f);
     fclose(f);
-    snprintf(cmd, sizeof cmd, "%s eval --preset fig4a %s >%s/out 2>%s/err", bin, path, dir, dir);
-    int st = system(cmd);
-    assert_true(WIFEXITED(st));
-    assert_int_equal(WEXITSTATUS(st), 2);
-    snprintf(path, sizeof path, "%s/err", dir);
-    char *err = read_file(path, NULL);
-    snprintf(path, sizeof path, "%s/out", dir);
-    char *out = read_file(path, NULL);
-    assert_non_null(err);
-    assert_non_null(out);
-    assert_non_null(strstr(err, "pts.json: /1: x(u, v, w) is not a finite number"));
+    assert_int_equal(run_cli(dir, bin, "eval --preset fig4a pts.json", &out, &err), 2);
+    if (!strstr(err, "pts.json: /1: x(u, v, w) is not a finite number"))
+        fail_msg("stderr: %s", err);
     assert_string_equal(out, "");
-    free(err);
     free(out);
-    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-    assert_int_equal(system(cmd), 0);
+    free(err);
+    daemon_t d;
+    daemon_start(&d, dir, "");
+    snprintf(args, sizeof args, "eval --server %s --preset fig4a pts.json", d.base);
+    int st = run_cli(dir, bin, args, &out, &err);
+    daemon_stop(&d);
+    /* /1 from the CLI on the server's null, or /points/1 from a server that refuses the point itself */
+    if (st != 2 || !strstr(err, "/1: x(u, v, w) is not a finite number"))
+        fail_msg("status %d, stderr: %s", st, err);
+    assert_string_equal(out, "");
+    free(out);
+    free(err);
+    snprintf(args, sizeof args, "rm -rf %s", dir);
+    assert_int_equal(system(args), 0);
 }
 
 int main(void)
@@ -650,6 +759,7 @@ int main(void)
         cmocka_unit_test(the_test_validators_should_refuse_what_utf8_forbids),
         cmocka_unit_test(json_check_should_follow_rfc8259_strictly_as_node_does),
         cmocka_unit_test(json_check_should_say_where_and_what_is_wrong),
+        cmocka_unit_test(json_check_should_agree_with_node_on_random_documents),
         cmocka_unit_test(text_clean_should_replace_bad_bytes_and_cut_at_characters),
         cmocka_unit_test(text_clean_should_agree_with_node_textdecoder),
         cmocka_unit_test(errors_should_be_valid_utf8_whatever_the_input),
