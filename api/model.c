@@ -62,7 +62,7 @@ static void child_ptr(char *out, size_t n, const char *ptr, const char *key)
         out[w] = '\0';
 }
 
-/* A key for a message: "..." of at most 60 bytes cut at a character boundary (the text is checked UTF-8). */
+/* A name for a message: at most 63 bytes, cut at a character boundary, controls as U+FFFD. */
 static const char *quoted(char out[64], const char *s)
 {
     api_text_clean(out, 64, s, strlen(s));
