@@ -14,6 +14,7 @@
 #include <cJSON.h>
 
 #include "model.h"
+#include "strict.h"
 #include "template.h"
 
 struct api_model {
@@ -25,17 +26,47 @@ struct api_model {
 
 static const char *const comp_key[3] = { "x", "y", "z" };
 
+/*
+ * Both strings go through api_text_clean(), so that whatever a message quotes
+ * (a key, a preset's name, a truncated %.60s) and however it is cut, the error
+ * is valid UTF-8 with no control characters, fit for a JSON body or a terminal.
+ */
 int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
 {
     if (!err)
         return -1;
     err->status = 422;
-    snprintf(err->pointer, sizeof err->pointer, "%s", pointer);
+    char text[1024];
+    api_text_clean(err->pointer, sizeof err->pointer, pointer, strlen(pointer));
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(err->message, sizeof err->message, fmt, ap);
+    vsnprintf(text, sizeof text, fmt, ap);
     va_end(ap);
+    api_text_clean(err->message, sizeof err->message, text, strlen(text));
     return -1;
+}
+
+/* ptr + "/" + key as RFC 6901 writes a key: ~ as ~0 and / as ~1. */
+static void child_ptr(char *out, size_t n, const char *ptr, const char *key)
+{
+    size_t w = (size_t)snprintf(out, n, "%s/", ptr);
+    for (; *key && w + 2 < n; key++) {
+        if (*key == '~' || *key == '/') {
+            out[w++] = '~';
+            out[w++] = *key == '~' ? '0' : '1';
+        } else {
+            out[w++] = *key;
+        }
+    }
+    if (w < n)
+        out[w] = '\0';
+}
+
+/* A name for a message: at most 63 bytes, cut at a character boundary, controls as U+FFFD. */
+static const char *quoted(char out[64], const char *s)
+{
+    api_text_clean(out, 64, s, strlen(s));
+    return out;
 }
 
 static const char *type_name(const cJSON *j)
@@ -65,23 +96,22 @@ static int check_object(const cJSON *obj, const char *ptr, const char *const *ke
         size_t i = 0;
         while (i < nk && strcmp(keys[i], c->string) != 0)
             i++;
+        char at[200], q[64];
         if (i == nk) {
             char allowed[160] = "";
             for (size_t k = 0; k < nk; k++)
                 snprintf(allowed + strlen(allowed), sizeof allowed - strlen(allowed), "%s\"%s\"",
                          k ? ", " : "", keys[k]);
-            return api_fail(err, ptr, "unknown key \"%.60s\"; the keys here are %s", c->string, allowed);
+            child_ptr(at, sizeof at, ptr, c->string);
+            return api_fail(err, at, "unknown key \"%s\"; the keys here are %s", quoted(q, c->string), allowed);
         }
-        if (found[i])
-            return api_fail(err, ptr, "the key \"%s\" appears twice", keys[i]);
+        if (found[i]) {
+            child_ptr(at, sizeof at, ptr, keys[i]);
+            return api_fail(err, at, "the key \"%s\" appears twice", keys[i]);
+        }
         found[i] = c;
     }
     return 0;
-}
-
-static void child_ptr(char *out, size_t n, const char *ptr, const char *key)
-{
-    snprintf(out, n, "%s/%s", ptr, key);
 }
 
 /* A finite number, or 0 when absent. */
@@ -295,18 +325,20 @@ static api_model *parse_request(const cJSON *root, api_error *err)
     }
     const api_template *t;
     api_params p;
+    char q0[64];
     if (k[0]) {
         const api_preset *ps = api_preset_find(name->valuestring);
         if (!ps) {
-            api_fail(err, ptr, "no preset \"%.60s\"; GET /presets (or `pdesolid presets`) lists them", name->valuestring);
+            api_fail(err, ptr, "no preset \"%s\"; GET /presets (or `pdesolid presets`) lists them",
+                     quoted(q0, name->valuestring));
             return NULL;
         }
         t = api_preset_template(ps);
         api_preset_params(ps, &p);
     } else {
         if (!(t = api_template_find(name->valuestring))) {
-            api_fail(err, ptr, "no template \"%.60s\"; the templates are example1, example2, example3, example4",
-                     name->valuestring);
+            api_fail(err, ptr, "no template \"%s\"; the templates are example1, example2, example3, example4",
+                     quoted(q0, name->valuestring));
             return NULL;
         }
         api_template_defaults(t, &p);
@@ -317,20 +349,20 @@ static api_model *parse_request(const cJSON *root, api_error *err)
             return NULL;
         }
         for (const cJSON *c = k[2]->child; c; c = c->next) {
+            char q[200];
+            child_ptr(q, sizeof q, "/params", c->string);
             for (const cJSON *d = k[2]->child; d != c; d = d->next)
                 if (strcmp(d->string, c->string) == 0) {
-                    api_fail(err, "/params", "the key \"%.60s\" appears twice", c->string);
+                    api_fail(err, q, "the key \"%s\" appears twice", quoted(q0, c->string));
                     return NULL;
                 }
             double v[3];
             int n = 0;
-            char q[96];
-            snprintf(q, sizeof q, "/params/%.80s", c->string);
             if (cJSON_IsNumber(c)) {
                 v[n++] = c->valuedouble;
             } else if (cJSON_IsArray(c) && cJSON_GetArraySize(c) == 3) {
                 for (const cJSON *x = c->child; x; x = x->next) {
-                    char qi[112];
+                    char qi[220];
                     snprintf(qi, sizeof qi, "%s/%d", q, n);
                     if (get_number(x, qi, &v[n++], err))
                         return NULL;
@@ -341,44 +373,25 @@ static api_model *parse_request(const cJSON *root, api_error *err)
             }
             if (n == 1 && get_number(c, q, &v[0], err))
                 return NULL;
-            if (api_params_set(t, &p, c->string, v, n, err))
+            if (api_params_set(t, &p, c->string, v, n, err)) {
+                /* template.c writes the key as it is; a pointer escapes ~ and / */
+                api_text_clean(err->pointer, sizeof err->pointer, q, strlen(q));
                 return NULL;
+            }
         }
     }
     return api_template_expand(t, &p, err);
 }
 
-/* The deepest nesting of arrays and objects outside strings. */
-static int nesting(const char *s, size_t len)
-{
-    int depth = 0, most = 0, in_str = 0;
-    for (size_t i = 0; i < len; i++) {
-        char c = s[i];
-        if (in_str) {
-            if (c == '\\')
-                i++;
-            else if (c == '"')
-                in_str = 0;
-        } else if (c == '"') {
-            in_str = 1;
-        } else if (c == '[' || c == '{') {
-            if (++depth > most)
-                most = depth;
-        } else if (c == ']' || c == '}') {
-            depth--;
-        }
-    }
-    return most;
-}
-
-/* cJSON over a private NUL-terminated copy: 1.7.15 may read past a buffer without one. */
+/*
+ * cJSON over a private NUL-terminated copy (1.7.15 may read past a buffer
+ * without one), after api_json_check(): cJSON never sees NUL, invalid UTF-8,
+ * leading zeros or nesting over the limit.
+ */
 static cJSON *parse_json(const char *text, size_t len, api_error *err)
 {
-    if (nesting(text, len) > API_MAX_DEPTH) {
-        api_fail(err, "", "the document nests arrays and objects deeper than %d levels, the limit", API_MAX_DEPTH);
-        err->status = 413;
+    if (api_json_check(text, len, err))
         return NULL;
-    }
     char *copy = malloc(len + 1);
     if (!copy) {
         api_fail(err, "", "out of memory");
@@ -386,33 +399,9 @@ static cJSON *parse_json(const char *text, size_t len, api_error *err)
     }
     memcpy(copy, text, len);
     copy[len] = '\0';
-    const char *end = NULL;
-    cJSON *root = cJSON_ParseWithLengthOpts(copy, len + 1, &end, 0);
-    if (!root) {
-        size_t at = end && end >= copy && end <= copy + len ? (size_t)(end - copy) : 0;
-        size_t line = 1, col = 1;
-        for (size_t i = 0; i < at; i++, col++)
-            if (copy[i] == '\n')
-                line++, col = 0;
-        if (len == 0 || strspn(copy, " \t\r\n") == len)
-            api_fail(err, "", "the document is empty; it must be a JSON object");
-        else
-            api_fail(err, "", "not valid JSON: syntax error at line %zu, column %zu (byte %zu)%s", line,
-                     col, at, at >= len ? ", the end of the text" : "");
-        err->status = 400;
-    } else {
-        /* Anything but white space after the value is an error too. */
-        const char *rest = end ? end : copy + len;
-        while (rest < copy + len && strchr(" \t\r\n", *rest))
-            rest++;
-        if (rest < copy + len) {
-            api_fail(err, "", "not valid JSON: text after the end of the value, at byte %zu",
-                     (size_t)(rest - copy));
-            err->status = 400;
-            cJSON_Delete(root);
-            root = NULL;
-        }
-    }
+    cJSON *root = cJSON_ParseWithLength(copy, len + 1);
+    if (!root)   /* checked JSON that cJSON still refuses: it ran out of memory */
+        api_fail(err, "", "out of memory");
     free(copy);
     return root;
 }

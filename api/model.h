@@ -18,7 +18,10 @@
  * where a factor F is one of {"pow": n}, {"sin": k}, {"cos": k}, {"exp": a},
  * {"sinh": a}, {"cosh": a}. An omitted factor is 1, an omitted number 0,
  * "boundary", "force" and each component in them are optional; "pde" and its
- * three arrays are required. Unknown and duplicate keys are errors.
+ * three arrays are required. Unknown and duplicate keys are errors whose
+ * pointer is the key itself ("/boundry"). Every parser here first runs
+ * api_json_check() (strict.h), so text with NUL, invalid UTF-8 or leading
+ * zeros is a 400 before cJSON reads it.
  *
  * Parsing uses cJSON, which records its last error in a global: callers that
  * parse on several threads must serialise api_model_parse() and
@@ -88,7 +91,8 @@ struct cJSON *api_model_tree(const pde_model *m);
 /* One factor as {"sin": k} and so on, a cJSON tree. */
 struct cJSON *api_factor_tree(pde_factor f);
 
-/* Sets err from a printf format, with status 422; returns -1, for one-line error returns. */
+/* Sets err from a printf format, with status 422; returns -1, for one-line error returns. The pointer
+ * and the message pass through api_text_clean(): valid UTF-8, no control characters, whatever they quote. */
 int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 

@@ -215,12 +215,26 @@ char *api_props_json(const pde_props *p)
     return s;
 }
 
+/* One number at 17 digits, or null when it is not finite: nan and inf are not JSON (the callers
+ * refuse such results first with api_eval_check(); this is the last resort). */
+static size_t put_number(char *buf, double v)
+{
+    return isfinite(v) ? (size_t)sprintf(buf, "%.17g", v) : (size_t)sprintf(buf, "null");
+}
+
 /* ,"name":[[x,y,z],...] into buf at *len (the caller sized it). */
 static void put_triples(char *buf, size_t *len, const char *name, const double *v, size_t n)
 {
     *len += (size_t)sprintf(buf + *len, ",\"%s\":[", name);
-    for (size_t i = 0; i < n; i++)
-        *len += (size_t)sprintf(buf + *len, "%s[%.17g,%.17g,%.17g]", i ? "," : "", v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+    for (size_t i = 0; i < n; i++) {
+        if (i)
+            buf[(*len)++] = ',';
+        for (int k = 0; k < 3; k++) {
+            buf[(*len)++] = k ? ',' : '[';
+            *len += put_number(buf + *len, v[3 * i + k]);
+        }
+        buf[(*len)++] = ']';
+    }
     buf[(*len)++] = ']';
 }
 

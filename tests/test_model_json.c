@@ -77,6 +77,8 @@ static void model_should_default_omitted_factors_to_one_and_numbers_to_zero(void
     api_model_free(NULL);
 }
 
+static api_error perr;
+
 #define PDE3 "\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[-1,-1,-1]}"
 
 typedef struct {
@@ -87,7 +89,7 @@ static const bad_case bad[] = {
     { "", "", "empty" },
     { "  \n", "", "empty" },
     { "{", "", "not valid JSON" },
-    { "{\"pde\":}", "", "line 1, column 8" },
+    { "{\"pde\":}", "/pde", "line 1, column 8" },
     { "[]", "", "must be an object, not an array" },
     { "{" PDE3 "} x", "", "after the end" },
     { "{}", "/pde", "required" },
@@ -95,15 +97,15 @@ static const bad_case bad[] = {
     { "{\"pde\":{\"a\":[1,1],\"b\":[1,1,1],\"c\":[1,1,1]}}", "/pde/a", "three numbers" },
     { "{\"pde\":{\"a\":[1,\"1\",1],\"b\":[1,1,1],\"c\":[1,1,1]}}", "/pde/a/1", "not a string" },
     { "{\"pde\":{\"a\":[null,1,1],\"b\":[1,1,1],\"c\":[1,1,1]}}", "/pde/a/0", "not null" },
-    { "{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[1,1,1],\"d\":[1,1,1]}}", "/pde", "unknown key \"d\"" },
-    { "{" PDE3 ",\"forces\":{}}", "", "unknown key \"forces\"" },
-    { "{" PDE3 "," PDE3 "}", "", "\"pde\" appears twice" },
-    { "{" PDE3 ",\"boundary\":{\"w\":[]}}", "/boundary", "unknown key \"w\"" },
+    { "{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[1,1,1],\"d\":[1,1,1]}}", "/pde/d", "unknown key \"d\"" },
+    { "{" PDE3 ",\"forces\":{}}", "/forces", "unknown key \"forces\"" },
+    { "{" PDE3 "," PDE3 "}", "/pde", "\"pde\" appears twice" },
+    { "{" PDE3 ",\"boundary\":{\"w\":[]}}", "/boundary/w", "unknown key \"w\"" },
     { "{" PDE3 ",\"boundary\":{\"x\":{}}}", "/boundary/x", "array of terms" },
     { "{" PDE3 ",\"boundary\":{\"x\":[3]}}", "/boundary/x/0", "must be an object, not a number" },
-    { "{" PDE3 ",\"boundary\":{\"x\":[{\"w0\":1,\"w0\":2}]}}", "/boundary/x/0", "\"w0\" appears twice" },
+    { "{" PDE3 ",\"boundary\":{\"x\":[{\"w0\":1,\"w0\":2}]}}", "/boundary/x/0/w0", "\"w0\" appears twice" },
     { "{" PDE3 ",\"boundary\":{\"x\":[{\"u\":{\"sin\":1,\"cos\":2}}]}}", "/boundary/x/0/u", "one key" },
-    { "{" PDE3 ",\"boundary\":{\"x\":[{\"u\":{\"tan\":1}}]}}", "/boundary/x/0/u", "unknown key \"tan\"" },
+    { "{" PDE3 ",\"boundary\":{\"x\":[{\"u\":{\"tan\":1}}]}}", "/boundary/x/0/u/tan", "unknown key \"tan\"" },
     { "{" PDE3 ",\"boundary\":{\"x\":[{\"u\":{}}]}}", "/boundary/x/0/u", "needs one of" },
     { "{" PDE3 ",\"boundary\":{\"x\":[{\"u\":\"sin\"}]}}", "/boundary/x/0/u", "must be an object" },
     { "{" PDE3 ",\"boundary\":{\"y\":[{},{\"v\":{\"pow\":2.5}}]}}", "/boundary/y/1/v/pow", "whole number" },
@@ -114,20 +116,23 @@ static const bad_case bad[] = {
     { "{" PDE3 ",\"boundary\":{\"x\":[{\"u\":{\"sin\":1e7}}]}}", "/boundary/x/0/u/sin", "1e6" },
     { "{" PDE3 ",\"force\":{\"y\":[{\"coef\":\"3\"}]}}", "/force/y/0/coef", "must be a number" },
     { "{" PDE3 ",\"force\":{\"x\":[{\"w\":{\"exp\":800}}]}}", "/force/x/0/w/exp", "overflows" },
-    { "{" PDE3 ",\"force\":{\"z\":[{\"w0\":1}]}}", "/force/z/0", "unknown key \"w0\"" },
+    { "{" PDE3 ",\"force\":{\"z\":[{\"w0\":1}]}}", "/force/z/0/w0", "unknown key \"w0\"" },
     { "{\"pde\":\"heat\"}", "/pde", "must be an object, not a string" },
     { "{\"preset\":\"fig9z\"}", "/preset", "no preset \"fig9z\"" },
     { "{\"preset\":4}", "/preset", "must be a string, not a number" },
     { "{\"template\":\"example7\"}", "/template", "example1, example2, example3, example4" },
     { "{\"preset\":\"fig4a\",\"template\":\"example4\"}", "", "not both" },
-    { "{\"preset\":\"fig4a\",\"pde\":{}}", "", "unknown key \"pde\"" },
+    { "{\"preset\":\"fig4a\",\"pde\":{}}", "/pde", "unknown key \"pde\"" },
     { "{\"preset\":\"fig4a\",\"params\":[]}", "/params", "must be an object" },
     { "{\"preset\":\"fig4a\",\"params\":{\"p00\":1}}", "/params/p00", "its parameters are a, b, c, r0" },
     { "{\"preset\":\"fig4a\",\"params\":{\"p0\":\"big\"}}", "/params/p0", "not a string" },
     { "{\"preset\":\"fig4a\",\"params\":{\"p0\":[1,2,3]}}", "/params/p0", "must be a number" },
     { "{\"preset\":\"fig4a\",\"params\":{\"c\":-1}}", "/params/c", "three numbers" },
     { "{\"preset\":\"fig4a\",\"params\":{\"c\":[-1,-1,1e999]}}", "/params/c/2", "finite" },
-    { "{\"preset\":\"fig4a\",\"params\":{\"xi\":1,\"xi\":2}}", "/params", "\"xi\" appears twice" },
+    { "{\"preset\":\"fig4a\",\"params\":{\"xi\":1,\"xi\":2}}", "/params/xi", "\"xi\" appears twice" },
+    { "{\"pde\":{},\"a/b~c\":1}", "/a~1b~0c", "unknown key \"a/b~c\"" },
+    { "{\"preset\":\"fig4a\",\"params\":{\"r/0\":1}}", "/params/r~10", "no parameter \"r/0\"" },
+    { "{\"preset\":\"fig4a\",\"params\":{\"\\n\":1}}", "/params/\xef\xbf\xbd", "no parameter \"\xef\xbf\xbd\"" },
     { "{\"template\":\"example3\",\"params\":{\"n_xy\":2e6}}", "", "" },
 };
 
@@ -190,6 +195,50 @@ static void model_should_refuse_deep_nesting_and_huge_documents(void **state)
     free(big);
 }
 
+/* What cJSON alone lets through: it ends a string at NUL, skips a raw NUL and reads 0001 as 1. */
+static void model_should_refuse_nul_leading_zeros_and_invalid_utf8_as_not_json(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *text;
+        size_t len;
+        const char *pointer, *words;
+    } cases[] = {
+#define C(s) s, sizeof s - 1
+        { C("{\"pde\\u0000junk\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[-1,-1,-1]}}"), "", "\\u0000" },
+        { C("{\"preset\":\"fig4a\\u0000x\"}"), "/preset", "\\u0000" },
+        { C("{\"preset\":\"fig4a\\u0000\"}"), "/preset", "\\u0000" },
+        { C("{\0\"preset\":\"fig4a\"}"), "", "NUL" },
+        { C("{\"preset\":\"fig4a\"}\0"), "", "NUL" },
+        { C("{\"preset\":\"fig4a\0\"}"), "/preset", "NUL" },
+        { C("{\"preset\":\"fig4a\",\"params\":{\"p0\":0001}}"), "/params/p0", "leading zero" },
+        { C("{\"preset\":\"fig\xff\"}"), "/preset", "UTF-8" },
+        { C("{\"preset\":\"fig\xc0\xae\"}"), "/preset", "UTF-8" },
+        { C("{\"preset\":\"fig\\ud800\"}"), "/preset", "surrogate" },
+#undef C
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        api_error err;
+        char *copy = malloc(cases[i].len);
+        memcpy(copy, cases[i].text, cases[i].len);
+        api_model *m = api_model_parse(copy, cases[i].len, &err);
+        free(copy);
+        if (m)
+            fail_msg("case %zu parsed", i);
+        if (err.status != 400 || strcmp(err.pointer, cases[i].pointer) != 0 || !strstr(err.message, cases[i].words))
+            fail_msg("case %zu: got %d %s: %s", i, err.status, err.pointer, err.message);
+    }
+    double *p;
+    size_t n;
+    int d;
+    const char *pts = "{\"points\":[[0,0,01]]}";
+    assert_int_equal(api_eval_parse(pts, strlen(pts), 10, &p, &n, &d, &perr), -1);
+    assert_int_equal(perr.status, 400);
+    assert_string_equal(perr.pointer, "/points/0/2");
+    assert_int_equal(api_points_parse("[[0,0,1]]\0", 10, &p, &n, &perr), -1);
+    assert_int_equal(perr.status, 400);
+}
+
 static void solve_errors_should_point_at_the_term_or_coefficient(void **state)
 {
     (void)state;
@@ -228,7 +277,7 @@ static void eval_requests_should_parse_and_name_bad_entries(void **state)
     assert_true(n == 1 && d == 1 && p[1] == 0.5);
     free(p);
     const char *cases[][3] = { { "{}", "/points", "required" },
-                               { "{\"points\":[],\"extra\":1}", "", "unknown key \"extra\"" },
+                               { "{\"points\":[],\"extra\":1}", "/extra", "unknown key \"extra\"" },
                                { "{\"points\":[[1,2,3]],\"derivatives\":1}", "/derivatives", "true or false" },
                                { "{\"points\":[[1,2]]}", "/points/0", "three numbers" },
                                { "{\"points\":[[1,2,3],[1,2,3],[1,2,3]]}", "/points", "more than 2 points" } };
@@ -269,6 +318,7 @@ int main(void)
         cmocka_unit_test(model_should_default_omitted_factors_to_one_and_numbers_to_zero),
         cmocka_unit_test(model_should_name_the_field_of_every_kind_of_bad_input),
         cmocka_unit_test(model_should_refuse_deep_nesting_and_huge_documents),
+        cmocka_unit_test(model_should_refuse_nul_leading_zeros_and_invalid_utf8_as_not_json),
         cmocka_unit_test(solve_errors_should_point_at_the_term_or_coefficient),
         cmocka_unit_test(points_should_parse_and_name_bad_entries),
         cmocka_unit_test(eval_requests_should_parse_and_name_bad_entries),

@@ -546,10 +546,10 @@ static void bad_requests_should_get_problems_and_the_daemon_should_keep_serving(
     free(r.body);
     free(huge);
     r = post(&d, "/solve", "{\"pde\": [1, 2");
-    expect_problem(&r, 400, "", "not valid JSON");
+    expect_problem(&r, 400, "/pde", "not valid JSON");
     free(r.body);
     r = post(&d, "/solve", "{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[-1,-1,-1]},\"boundary\":{\"x\":[{\"u\":{\"tan\":1}}]}}");
-    expect_problem(&r, 422, "/boundary/x/0/u", "unknown key \"tan\"");
+    expect_problem(&r, 422, "/boundary/x/0/u/tan", "unknown key \"tan\"");
     free(r.body);
     r = post(&d, "/solve", "{\"preset\":\"fig4a\",\"params\":{\"c\":[-1,-1,0]}}");
     expect_problem(&r, 422, "/params/c/2", "not fourth order");

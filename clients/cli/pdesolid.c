@@ -13,6 +13,7 @@
 #include "model.h"
 #include "output.h"
 #include "remote.h"
+#include "strict.h"
 #include "template.h"
 #include "version.h"
 
@@ -320,15 +321,20 @@ static int cmd_eval(const options *o)
         free(pts);
         return rc;
     }
-    fputc('[', stdout);
-    for (size_t i = 0; i < n; i++) {
-        double x[3];
-        pde_eval(sol, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], x);
-        printf("%s[%.17g,%.17g,%.17g]", i ? ",\n" : "", x[0], x[1], x[2]);
+    for (size_t i = 0; i < n; i++)   /* in place: point i is read before its value is written */
+        pde_eval(sol, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], pts + 3 * i);
+    pde_solution_free(sol);
+    if (api_eval_check(pts, NULL, NULL, NULL, n, &err)) {
+        free(pts);
+        /* The points file is the array itself: its pointer has no "/points" in front. */
+        memmove(err.pointer, err.pointer + 7, strlen(err.pointer + 7) + 1);
+        return report(points_path, &err);
     }
+    fputc('[', stdout);
+    for (size_t i = 0; i < n; i++)
+        printf("%s[%.17g,%.17g,%.17g]", i ? ",\n" : "", pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
     fputs("]\n", stdout);
     free(pts);
-    pde_solution_free(sol);
     return fflush(stdout) == 0 ? 0 : 1;
 }
 

@@ -184,18 +184,28 @@ int remote_eval(const char *server, const char *body, size_t len, const char *po
     }
     cJSON *d = cJSON_Parse(e.data ? e.data : "");
     const cJSON *vals = cJSON_GetObjectItemCaseSensitive(d, "values");
-    fputc('[', out);
+    /* Every value a number, checked before anything is printed: a server writes null, never nan, for a
+     * value that is not finite, and that is an error here as it is offline. */
     int i = 0;
-    for (const cJSON *v = vals ? vals->child : NULL; v; v = v->next, i++) {
-        double x[3];
-        for (int c = 0; c < 3; c++) {
-            const cJSON *q = cJSON_GetArrayItem(v, c);
-            x[c] = cJSON_IsNumber(q) ? q->valuedouble : 0.0;
-        }
-        fprintf(out, "%s[%.17g,%.17g,%.17g]", i ? ",\n" : "", x[0], x[1], x[2]);
+    for (const cJSON *v = vals ? vals->child : NULL; v && !rc; v = v->next, i++)
+        for (int c = 0; c < 3 && !rc; c++)
+            if (!cJSON_IsNumber(cJSON_GetArrayItem(v, c))) {
+                fprintf(stderr, "pdesolid: %s: /%d: x(u, v, w) is not a finite number at this point\n", server, i);
+                rc = 2;
+            }
+    if (!rc && !cJSON_IsArray(vals)) {
+        fprintf(stderr, "pdesolid: %s: the server's answer has no values\n", server);
+        rc = 1;
     }
-    fputs("]\n", out);
+    if (!rc) {
+        fputc('[', out);
+        i = 0;
+        for (const cJSON *v = vals->child; v; v = v->next, i++)
+            fprintf(out, "%s[%.17g,%.17g,%.17g]", i ? ",\n" : "", cJSON_GetArrayItem(v, 0)->valuedouble,
+                    cJSON_GetArrayItem(v, 1)->valuedouble, cJSON_GetArrayItem(v, 2)->valuedouble);
+        fputs("]\n", out);
+    }
     cJSON_Delete(d);
     free(e.data);
-    return 0;
+    return rc;
 }
