@@ -65,11 +65,16 @@ build/libpdeapi.a: $(API_OBJ)
 build/pdesolid: $(CLI_OBJ) build/libpdeapi.a build/libpdecore.a
 	$(CC) $(CFLAGS) $^ $(LIBS) $(CURL) $(LDLIBS) -o $@
 
-build/pdesolidd: $(SRV_OBJ) build/libpdeapi.a build/libpdecore.a
+# docs/openapi.yaml, linked into the daemon, which serves it at /openapi.yaml.
+build/obj/openapi.o: docs/openapi.yaml
+	@mkdir -p $(dir $@)
+	ld -r -b binary -z noexecstack -o $@ $<
+
+build/pdesolidd: $(SRV_OBJ) build/obj/openapi.o build/libpdeapi.a build/libpdecore.a
 	$(CC) $(CFLAGS) $^ $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@
 
 # The sanitised daemon, which the integration tests start.
-build/san/pdesolidd: $(call san,$(SRV_SRC) $(API_SRC) $(CORE_SRC))
+build/san/pdesolidd: $(call san,$(SRV_SRC) $(API_SRC) $(CORE_SRC)) build/obj/openapi.o
 	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@
 
 # The sanitised CLI, which the CLI tests drive alongside build/pdesolid.
@@ -79,7 +84,7 @@ build/san/pdesolid: $(call san,$(CLI_SRC) $(API_SRC) $(CORE_SRC))
 # Tests link the server's modules too (all but main.c), for test_config and test_log.
 build/san/tests/%.o: CFLAGS += -Iserver
 build/san/tests/%: build/san/tests/%.o build/san/tests/support.o $(call san,$(filter-out server/main.c,$(SRV_SRC)) \
-                   $(API_SRC) $(CORE_SRC))
+                   $(API_SRC) $(CORE_SRC)) build/obj/openapi.o
 	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(CURL) $(MHD) $(LDLIBS) -lpthread -o $@
 
 test: build/pdesolid build/pdesolidd build/san/pdesolid build/san/pdesolidd $(TESTS)
@@ -88,7 +93,7 @@ test: build/pdesolid build/pdesolidd build/san/pdesolid build/san/pdesolidd $(TE
 
 # The server's integration tests against a ThreadSanitizer build of pdesolidd; a race
 # leaves a report in build/tsan/ and fails the target.
-build/tsan/pdesolidd: $(SRV_SRC) $(API_SRC) $(CORE_SRC)
+build/tsan/pdesolidd: $(SRV_SRC) $(API_SRC) $(CORE_SRC) build/obj/openapi.o
 	@mkdir -p $(dir $@)
 	$(CC) $(STD) -O1 -g $(WARN) -Icore -Iapi $(CJSON_CFLAGS) -fcx-fortran-rules -fsanitize=thread $^ \
 	    $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@

@@ -76,3 +76,12 @@ pde_status api_model_id(const pde_model *m, char id[API_ID_LEN + 1], pde_diag *d
     id[API_ID_LEN] = '\0';
     return PDE_OK;
 }
+
+int api_id_valid(const char *s)
+{
+    size_t n = 0;
+    for (; s[n]; n++)
+        if (!((s[n] >= '0' && s[n] <= '9') || (s[n] >= 'a' && s[n] <= 'f')))
+            return 0;
+    return n == API_ID_LEN;
+}

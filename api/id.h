@@ -13,5 +13,7 @@
 
 /* Writes the id and a NUL into id[API_ID_LEN + 1]. Returns PDE_OK or the model's error. */
 pde_status api_model_id(const pde_model *m, char id[API_ID_LEN + 1], pde_diag *diag);
+/* 1 if s is the form of an id: API_ID_LEN lowercase hex digits and nothing else. */
+int api_id_valid(const char *s);
 
 #endif

@@ -1,715 +1,318 @@
 /*
- * http.c: routes and request handling of pdesolidd (http.h).
+ * http.c: pdesolidd's HTTP edge (http.h): the libmicrohttpd daemon, a
+ * request's lifecycle, and start and stop.
  *
  * DESIGN
- * libmicrohttpd's internal polling thread (epoll) accepts connections and
- * parses requests. The handler follows post_example.c: the first call makes
- * the request's state, further calls take the body in against a byte cap,
- * and the last call acts. Cheap routes answer at once on the polling thread.
- * Solve, solids and eval work goes to the solver threads: the handler
- * reserves a place in the queue (or answers 503), suspends the connection,
- * and submits the job; the job stores its result and resumes the connection
- * as its last act, and the handler, called again, queues the response.
- * Large outputs stream from a content-reader callback in bounded memory;
- * the stream owns its output and a reference to the cached solution.
- * cJSON's parser writes a global, so parses are serialised by json_lock.
+ * libmicrohttpd's polling threads (--http-threads, epoll) accept
+ * connections and parse requests; they never compute. The handler follows
+ * post_example.c: the first call makes the request's state and decides
+ * what it can from the headers alone (framing, size, route, query, origin);
+ * further calls take the body in against a byte cap and the request's total
+ * deadline; the last call answers. Rows of the route table without
+ * SRV_RT_JOB answer at once. Job rows first look in the response cache;
+ * else the handler reserves a place in the solver queue (or answers 503),
+ * suspends the connection and submits the job, whose last act is to resume
+ * it, and the handler, called again, sends the result: a whole body, or a
+ * stream that the solver threads fill (stream.c).
+ * A request refused before its body was read still has its body read and
+ * discarded, bounded in bytes and time as nginx's lingering close, so that
+ * the client, which is still writing, can read the answer.
  */
 #include <arpa/inet.h>
 #include <netdb.h>
-#include <pthread.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/socket.h>
-#include <time.h>
 #include <unistd.h>
 
-#include <cJSON.h>
-#include <microhttpd.h>
-
-#include "cache.h"
 #include "http.h"
-#include "id.h"
-#include "metrics.h"
-#include "model.h"
-#include "output.h"
-#include "catalog.h"
-#include "pool.h"
-#include "rcache.h"
-#include "template.h"
+#include "internal.h"
 
-enum route_id {
-    R_SOLVE, R_SOLID, R_EVAL, R_PRESETS, R_PRESET, R_LIVEZ, R_READYZ, R_VERSION, R_METRICS, R_STATIC, R_NONE,
-    R_COUNT
-};
-static const char *const route_names[R_COUNT] = { "solve", "solids", "eval", "presets", "preset", "livez",
-                                                  "readyz", "version", "metrics", "static", "none" };
+/* Discarding a refused body: at most this many bytes, and this long. */
+#define DRAIN_BYTES (16u << 20)
+#define DRAIN_SECONDS 5.0
 
-/* The front-end's files: a fixed set, never a path taken from the URL. */
-static const struct {
-    const char *url, *file, *type;
-} static_files[] = {
-    { "/", "index.html", "text/html; charset=utf-8" },
-    { "/index.html", "index.html", "text/html; charset=utf-8" },
-    { "/app.js", "app.js", "text/javascript; charset=utf-8" },
-    { "/style.css", "style.css", "text/css; charset=utf-8" },
-    { "/vendor/three/three.module.js", "node_modules/three/build/three.module.js", "text/javascript; charset=utf-8" },
-    { "/vendor/three/three.core.js", "node_modules/three/build/three.core.js", "text/javascript; charset=utf-8" },
-    { "/vendor/three/addons/loaders/GLTFLoader.js", "node_modules/three/examples/jsm/loaders/GLTFLoader.js",
-      "text/javascript; charset=utf-8" },
-    { "/vendor/three/addons/utils/BufferGeometryUtils.js", "node_modules/three/examples/jsm/utils/BufferGeometryUtils.js",
-      "text/javascript; charset=utf-8" },
-    { "/vendor/three/addons/utils/SkeletonUtils.js", "node_modules/three/examples/jsm/utils/SkeletonUtils.js",
-      "text/javascript; charset=utf-8" },
-    { "/vendor/three/addons/controls/OrbitControls.js", "node_modules/three/examples/jsm/controls/OrbitControls.js",
-      "text/javascript; charset=utf-8" },
-    { "/vendor/lil-gui/lil-gui.esm.js", "node_modules/lil-gui/dist/lil-gui.esm.js", "text/javascript; charset=utf-8" },
-};
-#define NSTATIC (sizeof static_files / sizeof *static_files)
+/* ---- the request's key for the response cache ---- */
 
-struct srv_server {
-    srv_config cfg;
-    struct MHD_Daemon *d;
-    srv_pool *pool;
-    srv_cache *cache;
-    srv_metrics *metrics;
-    srv_rcache *rcache;
-    pthread_mutex_t json_lock;   /* cJSON_Parse writes a global */
-    pthread_mutex_t lock;        /* in_flight, stopping */
-    pthread_cond_t idle;
-    size_t in_flight;
-    int stopping;
-    uint16_t port;
-    char *files[NSTATIC];
-    size_t file_len[NSTATIC];
-};
-
-enum phase { NEW, BODY, QUEUED, DONE };
-
-typedef struct stream stream;
-
-typedef struct {
-    srv_server *s;
-    struct MHD_Connection *conn;
-    enum route_id route;
-    int phase;
-    double t0;
-    char method[8], url[256];
-    char arg[96];                /* the id of /solids/{id}, the name of /presets/{name}, the static index */
-    char *body;
-    size_t len, cap;
-    int early;                   /* a status decided before the body was read */
-    char early_msg[200];
-    /* The result. */
-    int status;
-    const char *ctype;
-    char *text;                  /* a whole body, or NULL */
-    size_t text_len;
-    api_output *out;             /* or a stream */
-    srv_entry *entry;            /* referenced while the stream lives */
-    char id[API_ID_LEN + 1];
-    char etag[96];
-    const char *allow;           /* for 405 */
-    int retry_after;
-    long long sent;
-    stream *live;                /* the stream sending this response, if any */
-    char *key;                   /* the response cache's key of this request, or NULL */
-    size_t klen;
-    char timing[128];            /* Server-Timing: solve (or cache) and output */
-} request;
-
-struct stream {
-    srv_server *s;
-    api_output *out;
-    srv_entry *entry;
-    request *r;                  /* NULL once the request has completed */
-    double seconds;
-    long long bytes;
-};
-
-static double now(void)
+/* Route, format, res, then the body or the path's argument: the whole request, nothing cut. */
+static void make_key(srv_req *r)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-static const char *title_of(int status)
-{
-    switch (status) {
-    case 400: return "Bad Request";
-    case 404: return "Not Found";
-    case 405: return "Method Not Allowed";
-    case 413: return "Content Too Large";
-    case 422: return "Unprocessable Content";
-    case 503: return "Service Unavailable";
-    default: return "Internal Server Error";
-    }
-}
-
-/* An RFC 9457 problem body as the request's result. */
-static void set_problem(request *r, int status, const char *pointer, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
-static void set_problem(request *r, int status, const char *pointer, const char *fmt, ...)
-{
-    char detail[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(detail, sizeof detail, fmt, ap);
-    va_end(ap);
-    cJSON *o = cJSON_CreateObject();
-    cJSON_AddStringToObject(o, "type", "about:blank");
-    cJSON_AddStringToObject(o, "title", title_of(status));
-    cJSON_AddNumberToObject(o, "status", status);
-    cJSON_AddStringToObject(o, "detail", detail);
-    if (pointer)
-        cJSON_AddStringToObject(o, "pointer", pointer);
-    free(r->text);
-    r->text = cJSON_PrintUnformatted(o);
-    cJSON_Delete(o);
-    r->text_len = r->text ? strlen(r->text) : 0;
-    r->status = status;
-    r->ctype = "application/problem+json";
-}
-
-/* detail reads as a sentence on its own: the pointer, then what is wrong there. */
-static void set_api_error(request *r, const api_error *e)
-{
-    set_problem(r, e->status ? e->status : 422, e->pointer, "%s%s%s", e->pointer, e->pointer[0] ? ": " : "",
-                e->message);
-}
-
-/* The response cache's key: route, format, res, and the body or the id. NULL if too large to keep. */
-static void make_key(request *r)
-{
-    const char *fs = MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, "format");
-    const char *rs = MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, "res");
-    const char *tail = r->route == R_SOLVE ? (r->body ? r->body : "") : r->arg;
-    size_t tl = r->route == R_SOLVE ? r->len : strlen(r->arg);
+    const char *tail = r->body ? r->body : r->arg;
+    size_t tl = r->body ? r->len : strlen(r->arg);
     if (tl > SRV_RCACHE_MAX_KEY)
         return;
-    size_t cap = tl + 256;
+    size_t cap = tl + sizeof r->q.format + sizeof r->q.res + 16;
     if (!(r->key = malloc(cap)))
         return;
-    int n = snprintf(r->key, cap, "%c\n%.100s\n%.100s\n", r->route == R_SOLVE ? 'S' : 'G', fs ? fs : "", rs ? rs : "");
+    int n = snprintf(r->key, cap, "%d\n%s\n%s\n", r->route, r->q.format, r->q.res);
     memcpy(r->key + n, tail, tl);
     r->klen = (size_t)n + tl;
 }
 
-static void set_text(request *r, int status, const char *ctype, char *text)
-{
-    free(r->text);
-    r->text = text;
-    r->text_len = text ? strlen(text) : 0;
-    r->status = text ? status : 500;
-    r->ctype = ctype;
-    if (!text)
-        set_problem(r, 500, NULL, "out of memory");
-}
-
-/* ---- routing ---- */
-
-static int valid_id(const char *s)
-{
-    size_t n = 0;
-    for (; s[n]; n++)
-        if (!((s[n] >= '0' && s[n] <= '9') || (s[n] >= 'a' && s[n] <= 'f')))
-            return 0;
-    return n == API_ID_LEN;
-}
-
-/* The route of a path, with its argument; the methods it allows in *allow. */
-static enum route_id route_of(const char *url, char *arg, size_t argn, const char **allow)
-{
-    static const struct {
-        const char *path;
-        enum route_id id;
-        const char *allow;
-    } exact[] = {
-        { "/solve", R_SOLVE, "POST, OPTIONS" },       { "/presets", R_PRESETS, "GET, OPTIONS" },
-        { "/livez", R_LIVEZ, "GET, OPTIONS" },        { "/readyz", R_READYZ, "GET, OPTIONS" },
-        { "/version", R_VERSION, "GET, OPTIONS" },    { "/metrics", R_METRICS, "GET, OPTIONS" },
-    };
-    for (size_t i = 0; i < sizeof exact / sizeof *exact; i++)
-        if (!strcmp(url, exact[i].path)) {
-            *allow = exact[i].allow;
-            return exact[i].id;
-        }
-    for (size_t i = 0; i < NSTATIC; i++)
-        if (!strcmp(url, static_files[i].url)) {
-            snprintf(arg, argn, "%zu", i);
-            *allow = "GET, OPTIONS";
-            return R_STATIC;
-        }
-    if (!strncmp(url, "/solids/", 8)) {
-        const char *id = url + 8, *slash = strchr(id, '/');
-        size_t n = slash ? (size_t)(slash - id) : strlen(id);
-        if (n < argn) {
-            snprintf(arg, argn, "%.*s", (int)n, id);
-            if (!slash) {
-                *allow = "GET, OPTIONS";
-                return R_SOLID;
-            }
-            if (!strcmp(slash, "/eval")) {
-                *allow = "POST, OPTIONS";
-                return R_EVAL;
-            }
-        }
-    }
-    if (!strncmp(url, "/presets/", 9) && strlen(url + 9) < argn && !strchr(url + 9, '/')) {
-        snprintf(arg, argn, "%s", url + 9);
-        *allow = "GET, OPTIONS";
-        return R_PRESET;
-    }
-    *allow = NULL;
-    return R_NONE;
-}
-
-static int wants_body(enum route_id r)
-{
-    return r == R_SOLVE || r == R_EVAL;
-}
-
-/* ---- headers ---- */
-
-static void add_cors(srv_server *s, struct MHD_Connection *c, struct MHD_Response *resp)
-{
-    const char *origin = MHD_lookup_connection_value(c, MHD_HEADER_KIND, "Origin");
-    if (!origin || !s->cfg.cors[0])
-        return;
-    int ok = !strcmp(s->cfg.cors, "*");
-    size_t n = strlen(origin);
-    for (const char *p = s->cfg.cors; !ok && *p;) {
-        const char *e = strchr(p, ',');
-        size_t len = e ? (size_t)(e - p) : strlen(p);
-        while (len && *p == ' ')
-            p++, len--;
-        ok = len == n && !strncmp(p, origin, n);
-        p = e ? e + 1 : p + len;
-    }
-    if (!ok)
-        return;
-    MHD_add_response_header(resp, "Access-Control-Allow-Origin", !strcmp(s->cfg.cors, "*") ? "*" : origin);
-    MHD_add_response_header(resp, "Vary", "Origin");
-    MHD_add_response_header(resp, "Access-Control-Expose-Headers", "X-Solid-Id, ETag, Content-Length, Retry-After");
-}
-
-static enum MHD_Result queue(request *r, struct MHD_Response *resp)
-{
-    if (!resp)
-        return MHD_NO;
-    srv_server *s = r->s;
-    add_cors(s, r->conn, resp);
-    if (r->ctype)
-        MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, r->ctype);
-    if (r->id[0])
-        MHD_add_response_header(resp, "X-Solid-Id", r->id);
-    if (r->etag[0]) {
-        MHD_add_response_header(resp, MHD_HTTP_HEADER_ETAG, r->etag);
-        MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
-    }
-    if (r->status == 405)
-        MHD_add_response_header(resp, MHD_HTTP_HEADER_ALLOW, r->allow);
-    if (r->timing[0])
-        MHD_add_response_header(resp, "Server-Timing", r->timing);
-    if (r->retry_after) {
-        char v[16];
-        snprintf(v, sizeof v, "%d", r->retry_after);
-        MHD_add_response_header(resp, MHD_HTTP_HEADER_RETRY_AFTER, v);
-    }
-    if (r->status >= 400 || r->early)
-        MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, r->early ? "close" : "keep-alive");
-    enum MHD_Result ok = MHD_queue_response(r->conn, (unsigned)r->status, resp);
-    MHD_destroy_response(resp);
-    r->phase = DONE;
-    return ok;
-}
-
-/* Queues r's text (or an empty body). */
-static enum MHD_Result respond_text(request *r)
-{
-    struct MHD_Response *resp = MHD_create_response_from_buffer(r->text_len, r->text ? r->text : (char *)"",
-                                                                r->text ? MHD_RESPMEM_MUST_FREE : MHD_RESPMEM_PERSISTENT);
-    if (resp)
-        r->text = NULL;     /* the response owns it now */
-    r->sent = (long long)r->text_len;
-    return queue(r, resp);
-}
-
-static ssize_t stream_read(void *cls, uint64_t pos, char *buf, size_t max)
-{
-    (void)pos;
-    stream *st = cls;
-    double t0 = now();
-    long n = api_output_read(st->out, buf, max);
-    st->seconds += now() - t0;
-    if (n < 0)
-        return MHD_CONTENT_READER_END_WITH_ERROR;
-    if (n == 0)
-        return MHD_CONTENT_READER_END_OF_STREAM;
-    st->bytes += n;
-    if (st->r)
-        st->r->sent = st->bytes;
-    return n;
-}
-
-static void stream_free(void *cls)
-{
-    stream *st = cls;
-    srv_metrics_output(st->s->metrics, st->seconds, (size_t)st->bytes);
-    if (st->r)
-        st->r->live = NULL;
-    api_output_free(st->out);
-    srv_cache_release(st->s->cache, st->entry);
-    free(st);
-}
-
-static enum MHD_Result respond_stream(request *r)
-{
-    stream *st = calloc(1, sizeof *st);
-    if (!st) {
-        set_problem(r, 500, NULL, "out of memory");
-        return respond_text(r);
-    }
-    st->s = r->s;
-    st->out = r->out;
-    st->entry = r->entry;
-    st->r = r;
-    r->out = NULL;
-    r->entry = NULL;
-    long long size = api_output_size(st->out);
-    struct MHD_Response *resp = MHD_create_response_from_callback(size >= 0 ? (uint64_t)size : MHD_SIZE_UNKNOWN,
-                                                                  256 * 1024, stream_read, st, stream_free);
-    if (!resp) {
-        stream_free(st);
-        return MHD_NO;
-    }
-    r->live = st;
-    return queue(r, resp);
-}
-
-/* ---- the cheap routes, on the polling thread ---- */
-
-static enum MHD_Result quick(request *r)
-{
-    srv_server *s = r->s;
-    char *text;
-    switch (r->route) {
-    case R_LIVEZ:
-        set_text(r, 200, "text/plain; charset=utf-8", strdup("ok\n"));
-        break;
-    case R_READYZ: {
-        pthread_mutex_lock(&s->lock);
-        int stopping = s->stopping;
-        pthread_mutex_unlock(&s->lock);
-        if (stopping)
-            set_problem(r, 503, NULL, "shutting down");
-        else
-            set_text(r, 200, "text/plain; charset=utf-8", strdup("ready\n"));
-        break;
-    }
-    case R_VERSION: {
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "name", "pdesolidd");
-        cJSON_AddStringToObject(o, "version", SRV_VERSION);
-        cJSON_AddStringToObject(o, "libmicrohttpd", MHD_get_version());
-        cJSON_AddStringToObject(o, "cjson", cJSON_Version());
-        text = cJSON_PrintUnformatted(o);
-        cJSON_Delete(o);
-        set_text(r, 200, "application/json", text);
-        break;
-    }
-    case R_METRICS: {
-        srv_cache_stats cs;
-        srv_cache_stats_get(s->cache, &cs);
-        pthread_mutex_lock(&s->lock);
-        size_t in_flight = s->in_flight;
-        pthread_mutex_unlock(&s->lock);
-        set_text(r, 200, "text/plain; version=0.0.4; charset=utf-8",
-                 srv_metrics_render(s->metrics, &cs, srv_pool_depth(s->pool), in_flight, srv_rcache_hits(s->rcache)));
-        break;
-    }
-    case R_PRESETS:
-        set_text(r, 200, "application/json", api_presets_json());
-        break;
-    case R_PRESET: {
-        const api_preset *ps = api_preset_find(r->arg);
-        if (!ps)
-            set_problem(r, 404, NULL, "no preset \"%.60s\"; GET /presets lists them", r->arg);
-        else
-            set_text(r, 200, "application/json", api_preset_json(ps));
-        break;
-    }
-    case R_STATIC: {
-        size_t i = (size_t)atoi(r->arg);
-        if (!s->files[i]) {
-            set_problem(r, 404, NULL, "%s is not installed in %s; run `make run`", static_files[i].file, s->cfg.web);
-            break;
-        }
-        struct MHD_Response *resp =
-            MHD_create_response_from_buffer(s->file_len[i], s->files[i], MHD_RESPMEM_PERSISTENT);
-        r->status = 200;
-        r->ctype = static_files[i].type;
-        r->sent = (long long)s->file_len[i];
-        if (resp)
-            MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
-        return queue(r, resp);
-    }
-    default:
-        set_problem(r, 404, NULL, "no such resource: %s; the API is described in docs/API.md", r->url);
-        break;
-    }
-    return respond_text(r);
-}
-
-/* ---- the solver threads' jobs ---- */
+/* ---- the first call: what the headers decide ---- */
 
 typedef struct {
-    api_model *model;
-} solve_arg;
+    int lengths, encodings;
+    srv_req *r;
+    char msg[200];
+    int bad;
+} header_scan;
 
-static int solve_model(void *arg, pde_solution **out, api_error *err)
+static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
 {
-    return api_solve(((solve_arg *)arg)->model, out, err);
+    (void)kind;
+    header_scan *h = cls;
+    if (!strcasecmp(key, MHD_HTTP_HEADER_CONTENT_LENGTH))
+        h->lengths++;
+    if (!strcasecmp(key, MHD_HTTP_HEADER_TRANSFER_ENCODING))
+        h->encodings++;
+    if (!strcasecmp(key, "X-Request-Id") && srv_request_id_ok(value))
+        snprintf(h->r->rid, sizeof h->r->rid, "%s", value);
+    return MHD_YES;
 }
 
-/* format and res from the query; 0, or -1 with the problem set. */
-static int output_args(request *r, api_format *f, unsigned res[3])
+typedef struct {
+    srv_req *r;
+    int bad;
+    char msg[200];
+    size_t used;
+} query_scan;
+
+static enum MHD_Result scan_arg(void *cls, enum MHD_ValueKind kind, const char *key, size_t klen, const char *value,
+                                size_t vlen)
 {
-    const char *fs = MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, "format");
-    const char *rs = MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, "res");
-    api_error err;
-    if (api_format_parse(fs ? fs : "json", f, &err) || api_res_parse(rs, *f, res, &err)) {
-        set_problem(r, 422, NULL, "%s", err.message);
+    (void)kind;
+    query_scan *qs = cls;
+    srv_req *r = qs->r;
+    int n = snprintf(r->query + qs->used, sizeof r->query - qs->used, "%s%.*s%s%.*s", qs->used ? "&" : "", (int)klen,
+                     key, value ? "=" : "", value ? (int)vlen : 0, value ? value : "");
+    qs->used = n < 0 ? qs->used : qs->used + (size_t)n < sizeof r->query ? qs->used + (size_t)n : sizeof r->query - 1;
+    if (!qs->bad && r->route < srv_nroutes &&
+        srv_query_arg(&srv_routes[r->route], &r->q, key, klen, value, vlen, qs->msg, sizeof qs->msg))
+        qs->bad = 1;
+    return MHD_YES;
+}
+
+/* Content-Length as digits only, within uint64; -1 if absent, -2 if malformed. */
+static long long content_length(struct MHD_Connection *c)
+{
+    const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
+    if (!cl)
         return -1;
+    unsigned long long v = 0;
+    if (!*cl)
+        return -2;
+    for (const char *p = cl; *p; p++) {
+        if (*p < '0' || *p > '9' || v > (1ull << 62) / 10)
+            return -2;
+        v = v * 10 + (unsigned)(*p - '0');
+    }
+    return (long long)v;
+}
+
+/* Decides what the headers alone decide; r->decided when the answer is set. Returns 1 to answer now. */
+static int admit(srv_req *r, const char *method)
+{
+    srv_server *s = r->s;
+    header_scan h = { .r = r };
+    MHD_get_connection_values(r->conn, MHD_HEADER_KIND, scan_header, &h);
+    if (!r->rid[0])
+        srv_request_id_make(r->rid);
+    long long cl = content_length(r->conn);
+    /* Framing that cannot be trusted: answer and close without reading a byte of body. */
+    if (h.lengths > 1 || cl == -2 || (h.encodings && h.lengths)) {
+        r->close = r->decided = 1;
+        srv_problem(r, 400, NULL, "%s",
+                    h.lengths > 1 ? "the request has more than one Content-Length header"
+                    : cl == -2    ? "the Content-Length header is not a number of bytes"
+                                  : "the request has both Transfer-Encoding and Content-Length; it may have one");
+        return 1;
+    }
+    pthread_mutex_lock(&s->lock);
+    int stopping = s->stopping;
+    pthread_mutex_unlock(&s->lock);
+    if (cl > (long long)s->cfg.max_body) {
+        const char *expect = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_EXPECT);
+        r->decided = r->close = 1;
+        srv_problem(r, 413, NULL, "the body of %lld bytes is more than the limit of %zu bytes (--max-body)", cl,
+                    s->cfg.max_body);
+        /* Expect: 100-continue: the client waits, and sends nothing. Too large to discard: close. */
+        return (expect && !strcasecmp(expect, "100-continue")) || cl > (long long)DRAIN_BYTES;
+    }
+    if (stopping) {
+        r->decided = r->close = 1;
+        r->retry_after = 1;
+        srv_problem(r, 503, NULL, "the server is shutting down");
+        return 0;
+    }
+    int status = 0;
+    r->route = srv_route_find(method, r->path, r->arg, sizeof r->arg, r->allow, sizeof r->allow, &status);
+    query_scan qs = { .r = r };
+    if (r->route < 0)
+        r->route = srv_nroutes;
+    srv_query_init(&r->q);
+    MHD_get_connection_values_n(r->conn, MHD_GET_ARGUMENT_KIND, scan_arg, &qs);
+    if (r->route == srv_nroutes) {
+        r->decided = 1;
+        if (status == 405)
+            srv_problem(r, 405, NULL, "%s is not allowed on %s; use %s", method, r->path, r->allow);
+        else if (status == 400)
+            srv_problem(r, 400, NULL, "a segment of the path is too long");
+        else
+            srv_problem(r, 404, NULL, "no such resource: %s; the API is described in docs/API.md and /openapi.yaml",
+                        r->path);
+        return 0;
+    }
+    if (qs.bad || srv_query_done(&srv_routes[r->route], &r->q, qs.msg, sizeof qs.msg)) {
+        r->decided = 1;
+        srv_problem(r, 400, NULL, "%s", qs.msg);
+        return 0;
+    }
+    if (!srv_origin_allowed(r)) {
+        r->decided = 1;
+        srv_problem(r, 403, NULL, "cross-origin requests from %s are not allowed here (--cors-origin)",
+                    MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, "Origin"));
+        return 0;
     }
     return 0;
 }
 
-/* The response of a solved entry: 304, or an output stream. Takes over the reference. */
-static void answer_entry(request *r, srv_entry *e, api_format f, const unsigned res[3])
+static srv_req *begin(srv_server *s, struct MHD_Connection *conn, const char *url, const char *method)
 {
-    srv_server *s = r->s;
-    snprintf(r->id, sizeof r->id, "%s", srv_entry_id(e));
-    snprintf(r->etag, sizeof r->etag, "\"%s.%s.%ux%ux%u\"", r->id, api_format_info_of(f)->name, res[0], res[1], res[2]);
-    const char *inm = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
-    if (inm && (strstr(inm, r->etag) || !strcmp(inm, "*"))) {
-        r->status = 304;
-        r->ctype = NULL;
-        srv_cache_release(s->cache, e);
-        return;
-    }
-    const pde_props *props = NULL;
-    if (f == API_FMT_JSON || f == API_FMT_GLTF || f == API_FMT_GLB)
-        props = srv_entry_props(e);
-    api_error err;
-    double t0 = now();
-    api_output *o = api_output_open(srv_entry_solution(e), r->id, props, f, res, &err);
-    size_t tl = strlen(r->timing);
-    if (!o) {
-        srv_cache_release(s->cache, e);
-        set_problem(r, err.status == 422 ? 422 : 500, NULL, "%s", err.message);
-        return;
-    }
-    r->status = 200;
-    r->ctype = api_format_info_of(f)->mime;
-    long long size = api_output_size(o);
-    if (r->key && size >= 0 && size <= (long long)SRV_RCACHE_MAX_ITEM) {
-        /* Small and of known size: render it here, and keep it for the next identical request. */
-        char *bytes = malloc((size_t)size + 1);
-        long n = bytes ? api_output_read(o, bytes, (size_t)size) : -1;
-        api_output_free(o);
-        srv_cache_release(s->cache, e);
-        srv_metrics_output(s->metrics, now() - t0, n > 0 ? (size_t)n : 0);
-        snprintf(r->timing + tl, sizeof r->timing - tl, "%soutput;dur=%.3f", tl ? ", " : "", (now() - t0) * 1e3);
-        if (n != size) {
-            free(bytes);
-            set_problem(r, 500, NULL, "out of memory");
-            return;
-        }
-        bytes[n] = '\0';
-        srv_rcache_put(s->rcache, r->key, r->klen, bytes, (size_t)n, r->ctype, r->id, r->etag);
-        r->text = bytes;
-        r->text_len = (size_t)n;
-        return;
-    }
-    srv_metrics_output(s->metrics, now() - t0, 0);
-    snprintf(r->timing + tl, sizeof r->timing - tl, "%soutput;desc=\"streamed\";dur=%.3f", tl ? ", " : "",
-             (now() - t0) * 1e3);
-    r->out = o;
-    r->entry = e;
-}
-
-static void job_solve(request *r)
-{
-    srv_server *s = r->s;
-    api_format f;
-    unsigned res[3];
-    if (output_args(r, &f, res))
-        return;
-    api_error err;
-    pthread_mutex_lock(&s->json_lock);
-    api_model *m = api_model_parse(r->body ? r->body : "", r->len, &err);
-    pthread_mutex_unlock(&s->json_lock);
-    if (!m) {
-        set_api_error(r, &err);
-        return;
-    }
-    char id[API_ID_LEN + 1];
-    pde_diag d;
-    if (api_model_id(api_model_get(m), id, &d) != PDE_OK) {
-        /* Invalid in a way the solve reports with a pointer. */
-        pde_solution *sol = NULL;
-        api_solve(m, &sol, &err);
-        pde_solution_free(sol);
-        api_model_free(m);
-        set_api_error(r, &err);
-        return;
-    }
-    solve_arg sa = { m };
-    int hit;
-    double t0 = now();
-    srv_entry *e = srv_cache_get(s->cache, id, solve_model, &sa, &hit, &err);
-    double dt = now() - t0;
-    if (!hit)
-        srv_metrics_solve(s->metrics, dt);
-    if (hit)
-        snprintf(r->timing, sizeof r->timing, "solve;desc=\"cached\";dur=%.3f", dt * 1e3);
-    else
-        snprintf(r->timing, sizeof r->timing, "solve;dur=%.3f", dt * 1e3);
-    api_model_free(m);
-    if (!e) {
-        set_api_error(r, &err);
-        return;
-    }
-    answer_entry(r, e, f, res);
-}
-
-static void job_solid(request *r)
-{
-    api_format f;
-    unsigned res[3];
-    if (output_args(r, &f, res))
-        return;
-    srv_entry *e = valid_id(r->arg) ? srv_cache_find(r->s->cache, r->arg) : NULL;
-    if (!e) {
-        set_problem(r, 404, NULL,
-                    "no solid %.40s in the cache: it was never solved here, or was evicted; POST its model to /solve",
-                    r->arg);
-        return;
-    }
-    answer_entry(r, e, f, res);
-}
-
-static void job_eval(request *r)
-{
-    srv_server *s = r->s;
-    srv_entry *e = valid_id(r->arg) ? srv_cache_find(s->cache, r->arg) : NULL;
-    if (!e) {
-        set_problem(r, 404, NULL, "no solid %.40s in the cache: POST its model to /solve first", r->arg);
-        return;
-    }
-    api_error err;
-    double *pts = NULL;
-    size_t n = 0;
-    int derivs = 0;
-    pthread_mutex_lock(&s->json_lock);
-    int rc = api_eval_parse(r->body ? r->body : "", r->len, s->cfg.max_points, &pts, &n, &derivs, &err);
-    pthread_mutex_unlock(&s->json_lock);
-    if (rc) {
-        srv_cache_release(s->cache, e);
-        set_api_error(r, &err);
-        return;
-    }
-    const pde_solution *sol = srv_entry_solution(e);
-    double *v = malloc((n ? n : 1) * 12 * sizeof *v);
-    if (!v) {
-        free(pts);
-        srv_cache_release(s->cache, e);
-        set_problem(r, 500, NULL, "out of memory");
-        return;
-    }
-    double *du = v + 3 * n, *dv = v + 6 * n, *dw = v + 9 * n;
-    for (size_t i = 0; i < n; i++)
-        pde_eval_d(sol, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], v + 3 * i, derivs ? du + 3 * i : NULL,
-                   derivs ? dv + 3 * i : NULL, derivs ? dw + 3 * i : NULL);
-    snprintf(r->id, sizeof r->id, "%s", srv_entry_id(e));
-    srv_cache_release(s->cache, e);
-    char *json = api_eval_json(r->id, v, derivs ? du : NULL, derivs ? dv : NULL, derivs ? dw : NULL, n);
-    free(pts);
-    free(v);
-    set_text(r, 200, "application/json", json);
-}
-
-static void run_job(void *arg)
-{
-    request *r = arg;
-    switch (r->route) {
-    case R_SOLVE: job_solve(r); break;
-    case R_SOLID: job_solid(r); break;
-    case R_EVAL: job_eval(r); break;
-    default: set_problem(r, 500, NULL, "no job for this route"); break;
-    }
-    r->phase = DONE;
-    MHD_resume_connection(r->conn);   /* the last act: the polling thread may free r from here on */
-}
-
-/* ---- the handler ---- */
-
-static enum MHD_Result count_length(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
-{
-    (void)kind;
-    (void)value;
-    if (!strcasecmp(key, MHD_HTTP_HEADER_CONTENT_LENGTH))
-        (*(int *)cls)++;
-    return MHD_YES;
-}
-
-/* Appends the query's arguments to the URL kept for the access log. */
-static enum MHD_Result add_arg(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
-{
-    (void)kind;
-    request *r = cls;
-    size_t n = strlen(r->url);
-    snprintf(r->url + n, sizeof r->url - n, "%c%s%s%s", strchr(r->url, '?') ? '&' : '?', key, value ? "=" : "",
-             value ? value : "");
-    return MHD_YES;
-}
-
-static request *begin(srv_server *s, struct MHD_Connection *conn, const char *url, const char *method)
-{
-    request *r = calloc(1, sizeof *r);
+    srv_req *r = calloc(1, sizeof *r);
     if (!r)
         return NULL;
     r->s = s;
     r->conn = conn;
-    r->t0 = now();
+    r->t0 = srv_now();
+    r->route = srv_nroutes;
+    r->phase = SRV_BODY;
     snprintf(r->method, sizeof r->method, "%s", method);
-    snprintf(r->url, sizeof r->url, "%s", url);
-    r->route = route_of(url, r->arg, sizeof r->arg, &r->allow);
-    MHD_get_connection_values(conn, MHD_GET_ARGUMENT_KIND, add_arg, r);
+    snprintf(r->path, sizeof r->path, "%s", url);
     pthread_mutex_lock(&s->lock);
     s->in_flight++;
-    int stopping = s->stopping;
     pthread_mutex_unlock(&s->lock);
-    int lengths = 0;
-    MHD_get_connection_values(conn, MHD_HEADER_KIND, count_length, &lengths);
-    const char *cl = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
-    if (lengths > 1) {
-        r->early = 400;
-        snprintf(r->early_msg, sizeof r->early_msg, "the request has %d Content-Length headers; it may have one",
-                 lengths);
-    } else if (cl && strtoull(cl, NULL, 10) > s->cfg.max_body) {
-        r->early = 413;
-        snprintf(r->early_msg, sizeof r->early_msg, "the body of %s bytes is more than the limit of %zu bytes (--max-body)",
-                 cl, s->cfg.max_body);
-    } else if (stopping) {
-        r->early = 503;
-        snprintf(r->early_msg, sizeof r->early_msg, "the server is shutting down");
-    }
     return r;
+}
+
+/* ---- the last call: the answer ---- */
+
+static enum MHD_Result preflight(srv_req *r)
+{
+    r->status = 204;
+    struct MHD_Response *resp = MHD_create_response_from_buffer(0, (void *)"", MHD_RESPMEM_PERSISTENT);
+    if (resp) {
+        char allow[80];
+        snprintf(allow, sizeof allow, "%s, OPTIONS", srv_routes[r->route].method);
+        MHD_add_response_header(resp, "Access-Control-Allow-Methods", allow);
+        MHD_add_response_header(resp, "Access-Control-Allow-Headers", "Content-Type, If-None-Match, X-Request-Id");
+        MHD_add_response_header(resp, "Access-Control-Max-Age", "600");
+    }
+    return srv_queue(r, resp);
+}
+
+/* A job row: from the response cache, or queued for a solver thread. */
+static enum MHD_Result dispatch_job(srv_req *r)
+{
+    srv_server *s = r->s;
+    const srv_route *rt = &srv_routes[r->route];
+    if (rt->flags & SRV_RT_CACHE) {
+        make_key(r);
+        srv_rhit h;
+        if (r->key && srv_rcache_get(s->rcache, r->key, r->klen, &h)) {
+            /* A request answered before: its kept bytes, with this request's own headers. */
+            snprintf(r->id, sizeof r->id, "%.32s", h.id);
+            snprintf(r->etag, sizeof r->etag, "%s", h.etag);
+            r->ctype = h.ctype;
+            const char *inm = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
+            if (inm && (strstr(inm, h.etag) || !strcmp(inm, "*"))) {
+                srv_rcache_unpin(h.body);
+                r->status = 304;
+                r->ctype = NULL;
+                return srv_respond_text(r);
+            }
+            r->status = 200;
+            r->sent = (long long)h.len;
+            struct MHD_Response *resp = MHD_create_response_from_buffer_with_free_callback_cls(
+                h.len, (void *)h.bytes, srv_rcache_unpin, h.body);
+            if (!resp)
+                srv_rcache_unpin(h.body);
+            return srv_queue(r, resp);
+        }
+    }
+    if (srv_pool_reserve(s->pool)) {
+        r->retry_after = 1;
+        pthread_mutex_lock(&s->lock);
+        int stopping = s->stopping;
+        pthread_mutex_unlock(&s->lock);
+        if (stopping)
+            srv_problem(r, 503, NULL, "the server is shutting down");
+        else
+            srv_problem(r, 503, NULL, "all %d solver threads are busy and %zu jobs are waiting (--queue); try again",
+                        s->cfg.threads, s->cfg.queue);
+        return srv_respond_text(r);
+    }
+    r->phase = SRV_QUEUED;
+    r->queued_at = srv_now();
+    MHD_suspend_connection(r->conn);   /* before the job exists, so that its resume finds it suspended */
+    srv_pool_submit(s->pool, srv_run_job, r);
+    return MHD_YES;
+}
+
+static enum MHD_Result answer(srv_req *r, const char *method)
+{
+    if (r->decided)
+        return srv_respond_text(r);
+    if (!strcmp(method, MHD_HTTP_METHOD_OPTIONS))
+        return preflight(r);
+    const srv_route *rt = &srv_routes[r->route];
+    if (rt->flags & SRV_RT_JOB)
+        return dispatch_job(r);
+    rt->handler(r);
+    return srv_respond_text(r);
+}
+
+/* Takes a piece of body; MHD_NO closes the connection. */
+static enum MHD_Result take_body(srv_req *r, const char *upload, size_t n)
+{
+    srv_server *s = r->s;
+    double age = srv_now() - r->t0;
+    if (r->decided) {
+        /* Discarding the body of a refused request, so that its answer can be read. */
+        r->drained += n;
+        return r->drained <= DRAIN_BYTES && age <= DRAIN_SECONDS ? MHD_YES : MHD_NO;
+    }
+    if (age > s->cfg.request_timeout)
+        return MHD_NO;   /* the whole request, headers and body, has a deadline (--request-timeout) */
+    if (!(srv_routes[r->route].flags & SRV_RT_BODY) || strcmp(r->method, srv_routes[r->route].method)) {
+        r->drained += n;
+        return r->drained <= DRAIN_BYTES ? MHD_YES : MHD_NO;
+    }
+    if (r->len + n > s->cfg.max_body) {
+        r->decided = r->close = 1;
+        free(r->body);
+        r->body = NULL;
+        srv_problem(r, 413, NULL, "the body is more than the limit of %zu bytes (--max-body)", s->cfg.max_body);
+        r->drained = r->len + n;
+        r->len = r->cap = 0;
+        return MHD_YES;
+    }
+    if (r->len + n + 1 > r->cap) {
+        size_t cap = r->cap ? r->cap : 4096;
+        while (cap < r->len + n + 1)
+            cap *= 2;
+        char *b = realloc(r->body, cap);
+        if (!b)
+            return MHD_NO;
+        r->body = b;
+        r->cap = cap;
+    }
+    memcpy(r->body + r->len, upload, n);
+    r->len += n;
+    r->body[r->len] = '\0';
+    return MHD_YES;
 }
 
 static enum MHD_Result handler(void *cls, struct MHD_Connection *conn, const char *url, const char *method,
@@ -717,122 +320,60 @@ static enum MHD_Result handler(void *cls, struct MHD_Connection *conn, const cha
 {
     (void)version;
     srv_server *s = cls;
-    request *r = *con_cls;
+    srv_req *r = *con_cls;
     if (!r) {
         if (!(r = begin(s, conn, url, method)))
             return MHD_NO;
         *con_cls = r;
-        r->phase = BODY;
-        /* An early answer needs no body: give it now, and the connection closes. */
-        if (r->early == 413 || r->early == 400) {
-            set_problem(r, r->early, NULL, "%s", r->early_msg);
-            return respond_text(r);
-        }
+        if (admit(r, method))
+            return srv_respond_text(r);
         return MHD_YES;
     }
     if (*upload_size) {
-        if (!r->early && wants_body(r->route)) {
-            if (r->len + *upload_size > s->cfg.max_body) {
-                r->early = 413;
-                snprintf(r->early_msg, sizeof r->early_msg, "the body is more than the limit of %zu bytes (--max-body)",
-                         s->cfg.max_body);
-            } else {
-                if (r->len + *upload_size + 1 > r->cap) {
-                    size_t cap = r->cap ? r->cap : 4096;
-                    while (cap < r->len + *upload_size + 1)
-                        cap *= 2;
-                    char *b = realloc(r->body, cap);
-                    if (!b)
-                        return MHD_NO;
-                    r->body = b;
-                    r->cap = cap;
-                }
-                memcpy(r->body + r->len, upload, *upload_size);
-                r->len += *upload_size;
-                r->body[r->len] = '\0';
-            }
-        }
+        size_t n = *upload_size;
         *upload_size = 0;
-        return MHD_YES;
+        return take_body(r, upload, n);
     }
-    if (r->phase == DONE)      /* resumed: the job's result is ready */
-        return r->out ? respond_stream(r) : respond_text(r);
+    if (r->phase == SRV_DONE)   /* resumed: the job's result is ready */
+        return r->stream ? srv_stream_respond(r) : srv_respond_text(r);
+    return answer(r, method);
+}
 
-    if (r->early) {
-        set_problem(r, r->early, NULL, "%s", r->early_msg);
-        if (r->early == 503)
-            r->retry_after = 1;
-        return respond_text(r);
-    }
-    if (!strcmp(method, MHD_HTTP_METHOD_OPTIONS) && r->route != R_NONE) {
-        r->status = 204;
-        struct MHD_Response *resp = MHD_create_response_from_buffer(0, (void *)"", MHD_RESPMEM_PERSISTENT);
-        if (resp) {
-            MHD_add_response_header(resp, "Access-Control-Allow-Methods", r->allow);
-            MHD_add_response_header(resp, "Access-Control-Allow-Headers", "Content-Type, If-None-Match");
-            MHD_add_response_header(resp, "Access-Control-Max-Age", "600");
-        }
-        return queue(r, resp);
-    }
-    if (r->route != R_NONE) {
-        int get = !strcmp(method, MHD_HTTP_METHOD_GET) || !strcmp(method, MHD_HTTP_METHOD_HEAD);
-        int post = !strcmp(method, MHD_HTTP_METHOD_POST);
-        if ((wants_body(r->route) && !post) || (!wants_body(r->route) && !get)) {
-            set_problem(r, 405, NULL, "%s is not allowed on %s; use %s", method, url, r->allow);
-            return respond_text(r);
+static int hexval(char c)
+{
+    return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+}
+
+/* libmicrohttpd's %-decoding, except that %00 stays as it is: a NUL never hides the rest of a path or a value. */
+static size_t unescape(void *cls, struct MHD_Connection *c, char *s)
+{
+    (void)cls;
+    (void)c;
+    char *w = s;
+    for (const char *p = s; *p;) {
+        int hi, lo;
+        if (p[0] == '%' && (hi = hexval(p[1])) >= 0 && (lo = hexval(p[2])) >= 0 && (hi | lo)) {
+            *w++ = (char)(hi << 4 | lo);
+            p += 3;
+        } else {
+            *w++ = *p++;
         }
     }
-    if (r->route != R_SOLVE && r->route != R_SOLID && r->route != R_EVAL)
-        return quick(r);
-    if (r->route != R_EVAL) {
-        /* A request answered before: its response is kept, no solver thread needed. */
-        make_key(r);
-        const char *inm = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
-        int cors = s->cfg.cors[0] && MHD_lookup_connection_value(conn, MHD_HEADER_KIND, "Origin");
-        srv_rhit h;
-        if (r->key && !inm && !cors && srv_rcache_queue(s->rcache, r->key, r->klen, conn, &h)) {
-            r->status = 200;
-            r->sent = (long long)h.len;
-            snprintf(r->id, sizeof r->id, "%.32s", h.id);
-            r->phase = DONE;
-            return MHD_YES;
-        }
-        if (r->key && (inm || cors) && srv_rcache_copy(s->rcache, r->key, r->klen, &h)) {
-            snprintf(r->id, sizeof r->id, "%.32s", h.id);
-            snprintf(r->etag, sizeof r->etag, "%s", h.etag);
-            if (inm && (strstr(inm, h.etag) || !strcmp(inm, "*"))) {
-                free(h.copy);
-                r->status = 304;
-                return respond_text(r);
-            }
-            set_text(r, 200, h.ctype, h.copy);
-            r->text_len = h.len;
-            return respond_text(r);
-        }
-    }
-    if (srv_pool_reserve(s->pool)) {
-        r->retry_after = 1;
-        set_problem(r, 503, NULL, "all %d solver threads are busy and %zu jobs are waiting (--queue); try again",
-                    s->cfg.threads, s->cfg.queue);
-        return respond_text(r);
-    }
-    r->phase = QUEUED;
-    MHD_suspend_connection(conn);      /* before the job exists, so that its resume finds it suspended */
-    srv_pool_submit(s->pool, run_job, r);
-    return MHD_YES;
+    *w = '\0';
+    return (size_t)(w - s);
 }
 
 static void completed(void *cls, struct MHD_Connection *conn, void **con_cls, enum MHD_RequestTerminationCode toe)
 {
     srv_server *s = cls;
-    request *r = *con_cls;
+    srv_req *r = *con_cls;
     if (!r)
         return;
     *con_cls = NULL;
-    double dt = now() - r->t0;
+    double dt = srv_now() - r->t0;
     int status = r->status ? r->status : 500;
     srv_metrics_request(s->metrics, r->route, status, dt);
-    if (!s->cfg.quiet) {
+    if (s->log) {
         char ip[INET6_ADDRSTRLEN] = "-";
         const union MHD_ConnectionInfo *ci = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
         if (ci && ci->client_addr) {
@@ -842,13 +383,12 @@ static void completed(void *cls, struct MHD_Connection *conn, void **con_cls, en
             else if (sa->sa_family == AF_INET6)
                 inet_ntop(AF_INET6, &((const struct sockaddr_in6 *)sa)->sin6_addr, ip, sizeof ip);
         }
-        fprintf(stderr, "%s \"%s %s\" %d %lld %.2fms%s%s%s\n", ip, r->method, r->url, status, r->sent, dt * 1e3,
-                r->id[0] ? " id=" : "", r->id, toe == MHD_REQUEST_TERMINATED_COMPLETED_OK ? "" : " (aborted)");
+        srv_log_rec rec = { .ip = ip, .method = r->method, .path = r->path, .query = r->query[0] ? r->query : NULL,
+                            .request_id = r->rid, .solid_id = r->id, .status = status, .bytes = r->sent,
+                            .seconds = dt, .aborted = toe != MHD_REQUEST_TERMINATED_COMPLETED_OK };
+        srv_log_request(s->log, &rec);
     }
-    if (r->live)
-        r->live->r = NULL;
-    api_output_free(r->out);
-    srv_cache_release(s->cache, r->entry);
+    srv_stream_release(r);
     free(r->body);
     free(r->text);
     free(r->key);
@@ -870,33 +410,14 @@ static void connection_event(void *cls, struct MHD_Connection *conn, void **sock
 
 /* ---- start and stop ---- */
 
-static void load_static(srv_server *s)
-{
-    for (size_t i = 0; i < NSTATIC; i++) {
-        char path[2048];
-        snprintf(path, sizeof path, "%s/%s", s->cfg.web, static_files[i].file);
-        FILE *f = fopen(path, "rb");
-        if (!f)
-            continue;
-        if (fseek(f, 0, SEEK_END) == 0) {
-            long n = ftell(f);
-            if (n >= 0 && fseek(f, 0, SEEK_SET) == 0 && (s->files[i] = malloc((size_t)n + 1))) {
-                s->file_len[i] = fread(s->files[i], 1, (size_t)n, f);
-            }
-        }
-        fclose(f);
-    }
-}
-
 static void free_server(srv_server *s)
 {
-    if (s->pool)
-        srv_pool_destroy(s->pool);
+    srv_pool_destroy(s->pool);
     srv_cache_destroy(s->cache);
     srv_rcache_destroy(s->rcache);
     srv_metrics_destroy(s->metrics);
-    for (size_t i = 0; i < NSTATIC; i++)
-        free(s->files[i]);
+    srv_static_free(s->web);
+    srv_log_destroy(s->log);
     pthread_mutex_destroy(&s->json_lock);
     pthread_mutex_destroy(&s->lock);
     pthread_cond_destroy(&s->idle);
@@ -905,6 +426,7 @@ static void free_server(srv_server *s)
 
 srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
 {
+    static const char *names[64];
     srv_server *s = calloc(1, sizeof *s);
     if (!s) {
         snprintf(err, errlen, "out of memory");
@@ -914,17 +436,22 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
     pthread_mutex_init(&s->json_lock, NULL);
     pthread_mutex_init(&s->lock, NULL);
     pthread_cond_init(&s->idle, NULL);
+    for (int i = 0; i < srv_nroutes; i++)
+        names[i] = srv_routes[i].name;
+    names[srv_nroutes] = "none";
     s->cache = srv_cache_create(c->cache_bytes);
     /* Finished responses: an eighth of the solution cache's bound, at least 4 MiB. */
     s->rcache = srv_rcache_create(c->cache_bytes / 8 > (4u << 20) ? c->cache_bytes / 8 : 4u << 20);
-    s->metrics = srv_metrics_create(route_names, R_COUNT);
-    s->pool = srv_pool_create(c->threads, c->queue);
-    if (!s->cache || !s->rcache || !s->metrics || !s->pool) {
+    s->metrics = srv_metrics_create(names, srv_nroutes + 1);
+    /* Continuations of streams: at most one per connection. */
+    s->pool = srv_pool_create(c->threads, c->queue, c->max_conns);
+    s->log = c->quiet ? NULL : srv_log_create(2, c->log_format);
+    s->web = srv_static_load(c->web, err, errlen);
+    if (!s->cache || !s->rcache || !s->metrics || !s->pool || (!c->quiet && !s->log) || !s->web) {
         snprintf(err, errlen, "out of memory, or a solver thread could not start");
         free_server(s);
         return NULL;
     }
-    load_static(s);
     struct addrinfo hints = { .ai_flags = AI_PASSIVE | AI_NUMERICHOST, .ai_socktype = SOCK_STREAM }, *ai;
     char port[8];
     snprintf(port, sizeof port, "%u", c->port);
@@ -938,8 +465,10 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
     if (ai->ai_family == AF_INET6)
         flags |= MHD_USE_IPv6;
     s->d = MHD_start_daemon(flags, (uint16_t)c->port, NULL, NULL, handler, s, MHD_OPTION_SOCK_ADDR, ai->ai_addr,
+                            MHD_OPTION_THREAD_POOL_SIZE, (unsigned)(c->http_threads > 1 ? c->http_threads : 0),
                             MHD_OPTION_CONNECTION_TIMEOUT, c->timeout, MHD_OPTION_PER_IP_CONNECTION_LIMIT, c->per_ip,
-                            MHD_OPTION_CONNECTION_LIMIT, c->max_conns, MHD_OPTION_NOTIFY_COMPLETED, completed, s,
+                            MHD_OPTION_CONNECTION_LIMIT, c->max_conns, MHD_OPTION_STRICT_FOR_CLIENT, (int)1,
+                            MHD_OPTION_UNESCAPE_CALLBACK, unescape, NULL, MHD_OPTION_NOTIFY_COMPLETED, completed, s,
                             MHD_OPTION_NOTIFY_CONNECTION, connection_event, s, MHD_OPTION_END);
     freeaddrinfo(ai);
     if (!s->d) {
@@ -963,10 +492,10 @@ void srv_stop(srv_server *s)
     pthread_mutex_lock(&s->lock);
     s->stopping = 1;
     pthread_mutex_unlock(&s->lock);
-    int fd = MHD_quiesce_daemon(s->d);     /* no new connections */
+    int fd = MHD_quiesce_daemon(s->d);   /* no new connections */
     if (fd >= 0)
         close(fd);
-    /* Requests in flight finish: the solver threads resume theirs, streams run out. */
+    /* Requests in flight may finish within the grace period. */
     struct timespec until;
     clock_gettime(CLOCK_REALTIME, &until);
     until.tv_sec += s->cfg.grace;
@@ -975,9 +504,10 @@ void srv_stop(srv_server *s)
         if (pthread_cond_timedwait(&s->idle, &s->lock, &until))
             break;
     pthread_mutex_unlock(&s->lock);
-    /* Every queued job resumes its connection before the pool stops, so none stays suspended. */
-    srv_pool_destroy(s->pool);
-    s->pool = NULL;
+    /* Then the rest ends: running jobs stop at their next poll, queued ones answer 503, streams end.
+     * Every queued job resumes its connection before the pool stops, so none stays suspended. */
+    atomic_store(&s->aborting, 1);
+    srv_pool_stop(s->pool);
     MHD_stop_daemon(s->d);
     free_server(s);
 }

@@ -16,8 +16,8 @@ struct srv_pool {
     pthread_mutex_t lock;
     pthread_cond_t work;
     job *ring;
-    size_t cap, head, count, reserved, running;
-    int stopping, nthreads;
+    size_t cap, limit, head, count, reserved, running;   /* limit: places for reserve; cap adds extra */
+    int stopping, nthreads, alive;   /* alive: workers not yet past their last job */
     pthread_t *threads;
 };
 
@@ -26,10 +26,12 @@ static void *worker(void *arg)
     srv_pool *p = arg;
     pthread_mutex_lock(&p->lock);
     for (;;) {
-        while (p->count == 0 && !p->stopping)
+        while (p->count == 0 && (!p->stopping || p->reserved))
             pthread_cond_wait(&p->work, &p->lock);
-        if (p->count == 0)
-            break;     /* stopping and drained */
+        if (p->count == 0) {
+            p->alive--;   /* stopping and drained: a push from now on is refused, not lost */
+            break;
+        }
         job j = p->ring[p->head];
         p->head = (p->head + 1) % p->cap;
         p->count--;
@@ -43,12 +45,13 @@ static void *worker(void *arg)
     return NULL;
 }
 
-srv_pool *srv_pool_create(int threads, size_t queue)
+srv_pool *srv_pool_create(int threads, size_t queue, size_t extra)
 {
     srv_pool *p = calloc(1, sizeof *p);
     if (!p)
         return NULL;
-    p->cap = queue ? queue : 1;
+    p->limit = queue ? queue : 1;
+    p->cap = p->limit + extra;
     p->ring = malloc(p->cap * sizeof *p->ring);
     p->threads = malloc((size_t)threads * sizeof *p->threads);
     if (!p->ring || !p->threads || pthread_mutex_init(&p->lock, NULL) || pthread_cond_init(&p->work, NULL)) {
@@ -57,8 +60,10 @@ srv_pool *srv_pool_create(int threads, size_t queue)
         free(p);
         return NULL;
     }
+    p->alive = threads;
     for (p->nthreads = 0; p->nthreads < threads; p->nthreads++)
         if (pthread_create(&p->threads[p->nthreads], NULL, worker, p)) {
+            p->alive = p->nthreads;
             srv_pool_destroy(p);
             return NULL;
         }
@@ -68,7 +73,7 @@ srv_pool *srv_pool_create(int threads, size_t queue)
 int srv_pool_reserve(srv_pool *p)
 {
     pthread_mutex_lock(&p->lock);
-    int ok = !p->stopping && p->count + p->reserved < p->cap;
+    int ok = !p->stopping && p->count + p->reserved < p->limit;
     if (ok)
         p->reserved++;
     pthread_mutex_unlock(&p->lock);
@@ -85,6 +90,19 @@ void srv_pool_submit(srv_pool *p, srv_job_fn fn, void *arg)
     pthread_mutex_unlock(&p->lock);
 }
 
+int srv_pool_push(srv_pool *p, srv_job_fn fn, void *arg)
+{
+    pthread_mutex_lock(&p->lock);
+    int ok = p->alive > 0 && p->count + p->reserved < p->cap;
+    if (ok) {
+        p->ring[(p->head + p->count) % p->cap] = (job){ fn, arg };
+        p->count++;
+        pthread_cond_signal(&p->work);
+    }
+    pthread_mutex_unlock(&p->lock);
+    return ok ? 0 : -1;
+}
+
 size_t srv_pool_depth(srv_pool *p)
 {
     pthread_mutex_lock(&p->lock);
@@ -93,16 +111,28 @@ size_t srv_pool_depth(srv_pool *p)
     return d;
 }
 
+void srv_pool_stop(srv_pool *p)
+{
+    pthread_mutex_lock(&p->lock);
+    int joined = p->stopping == 2;
+    if (!joined)
+        p->stopping = 1;
+    pthread_cond_broadcast(&p->work);
+    pthread_mutex_unlock(&p->lock);
+    if (joined)
+        return;
+    for (int i = 0; i < p->nthreads; i++)
+        pthread_join(p->threads[i], NULL);
+    pthread_mutex_lock(&p->lock);
+    p->stopping = 2;
+    pthread_mutex_unlock(&p->lock);
+}
+
 void srv_pool_destroy(srv_pool *p)
 {
     if (!p)
         return;
-    pthread_mutex_lock(&p->lock);
-    p->stopping = 1;
-    pthread_cond_broadcast(&p->work);
-    pthread_mutex_unlock(&p->lock);
-    for (int i = 0; i < p->nthreads; i++)
-        pthread_join(p->threads[i], NULL);
+    srv_pool_stop(p);
     pthread_cond_destroy(&p->work);
     pthread_mutex_destroy(&p->lock);
     free(p->ring);

@@ -12,15 +12,26 @@
 typedef struct srv_pool srv_pool;
 typedef void (*srv_job_fn)(void *arg);
 
-/* NULL if out of memory or a thread cannot start. */
-srv_pool *srv_pool_create(int threads, size_t queue);
+/*
+ * queue: jobs that may wait (srv_pool_reserve); extra: places kept for
+ * continuations (srv_pool_push), at most one per connection. NULL if out of
+ * memory or a thread cannot start.
+ */
+srv_pool *srv_pool_create(int threads, size_t queue, size_t extra);
 /* Takes a place in the queue; 0, or -1 when the queue is full or the pool is stopping. */
 int srv_pool_reserve(srv_pool *p);
 /* Queues a job in a reserved place. Cannot fail. */
 void srv_pool_submit(srv_pool *p, srv_job_fn fn, void *arg);
+/* Queues a continuation of work already admitted (the next piece of a stream), outside the
+ * reserved places; 0, or -1 when all extra places are taken. */
+int srv_pool_push(srv_pool *p, srv_job_fn fn, void *arg);
 /* Jobs waiting or running now. */
 size_t srv_pool_depth(srv_pool *p);
-/* Runs every queued job to the end, then stops the threads and frees the pool. */
+/* Refuses new jobs, runs every queued and reserved one to the end (a job sees the server
+ * stopping and ends at once) and stops the threads. The pool stays valid: reserve and push
+ * answer -1 from now on. */
+void srv_pool_stop(srv_pool *p);
+/* srv_pool_stop(), then frees the pool. NULL does nothing. */
 void srv_pool_destroy(srv_pool *p);
 
 #endif

@@ -8,15 +8,23 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <stdatomic.h>
+
 #include "rcache.h"
+
+/* The kept bytes, shared by the cache and the responses that send them. */
+struct srv_rbody {
+    atomic_int refs;
+    size_t len;
+    char bytes[];
+};
 
 typedef struct item item;
 struct item {
     char *key;
     size_t klen;
     uint64_t hash;
-    struct MHD_Response *resp;
-    const char *bytes;           /* owned by resp */
+    srv_rbody *body;
     size_t len;
     char id[40], etag[96];
     const char *ctype;
@@ -68,7 +76,7 @@ static void unlink_item(srv_rcache *c, item *it)
     else
         c->tail = it->prev;
     c->bytes -= it->len + it->klen;
-    MHD_destroy_response(it->resp);
+    srv_rcache_unpin(it->body);
     free(it->key);
     free(it);
 }
@@ -109,7 +117,9 @@ static item *hit(srv_rcache *c, const char *key, size_t klen, srv_rhit *h)
         c->head->prev = it;
         c->head = it;
     }
-    h->copy = NULL;
+    atomic_fetch_add(&it->body->refs, 1);
+    h->body = it->body;
+    h->bytes = it->body->bytes;
     h->len = it->len;
     memcpy(h->id, it->id, sizeof h->id);
     memcpy(h->etag, it->etag, sizeof h->etag);
@@ -117,23 +127,19 @@ static item *hit(srv_rcache *c, const char *key, size_t klen, srv_rhit *h)
     return it;
 }
 
-int srv_rcache_queue(srv_rcache *c, const char *key, size_t klen, struct MHD_Connection *conn, srv_rhit *h)
+int srv_rcache_get(srv_rcache *c, const char *key, size_t klen, srv_rhit *h)
 {
     pthread_mutex_lock(&c->lock);
     item *it = hit(c, key, klen, h);
-    int ok = it && MHD_queue_response(conn, MHD_HTTP_OK, it->resp) == MHD_YES;
     pthread_mutex_unlock(&c->lock);
-    return ok;
+    return it != NULL;
 }
 
-int srv_rcache_copy(srv_rcache *c, const char *key, size_t klen, srv_rhit *h)
+void srv_rcache_unpin(void *body)
 {
-    pthread_mutex_lock(&c->lock);
-    item *it = hit(c, key, klen, h);
-    if (it && (h->copy = malloc(it->len + 1)))
-        memcpy(h->copy, it->bytes, it->len);
-    pthread_mutex_unlock(&c->lock);
-    return it && h->copy;
+    srv_rbody *b = body;
+    if (b && atomic_fetch_sub(&b->refs, 1) == 1)
+        free(b);
 }
 
 void srv_rcache_put(srv_rcache *c, const char *key, size_t klen, const char *bytes, size_t len, const char *ctype,
@@ -142,29 +148,22 @@ void srv_rcache_put(srv_rcache *c, const char *key, size_t klen, const char *byt
     if (len > SRV_RCACHE_MAX_ITEM || klen > SRV_RCACHE_MAX_KEY || len + klen > c->max_bytes)
         return;
     item *it = calloc(1, sizeof *it);
-    char *b = malloc(len ? len : 1);
+    srv_rbody *b = malloc(sizeof *b + (len ? len : 1));
     char *k = malloc(klen ? klen : 1);
-    struct MHD_Response *resp = b ? MHD_create_response_from_buffer_with_free_callback(len, b, free) : NULL;
-    if (!it || !k || !resp) {
-        if (resp)
-            MHD_destroy_response(resp);
-        else
-            free(b);
+    if (!it || !k || !b) {
+        free(b);
         free(k);
         free(it);
         return;
     }
-    memcpy(b, bytes, len);
+    atomic_init(&b->refs, 1);
+    b->len = len;
+    memcpy(b->bytes, bytes, len);
     memcpy(k, key, klen);
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, ctype);
-    MHD_add_response_header(resp, "X-Solid-Id", id);
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_ETAG, etag);
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
     it->key = k;
     it->klen = klen;
     it->hash = hash_of(key, klen);
-    it->resp = resp;
-    it->bytes = b;
+    it->body = b;
     it->len = len;
     it->ctype = ctype;
     snprintf(it->id, sizeof it->id, "%s", id);

@@ -1,0 +1,426 @@
+/*
+ * routes.c: the route table (route.h), the handlers, and the jobs that run
+ * on the solver threads.
+ *
+ * A row's handler runs on the polling thread unless the row has SRV_RT_JOB;
+ * then http.c queues it and srv_run_job() calls it on a solver thread,
+ * times it, and resumes the connection. Handlers only set the request's
+ * result (srv_set_text, srv_problem, r->stream); http.c sends it.
+ * Every job checks its cost before the work (--max-work, --max-mem-mb) and
+ * polls srv_job_stop() in its long loops (--job-timeout, shutdown).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <cJSON.h>
+
+#include "catalog.h"
+#include "internal.h"
+#include "model.h"
+#include "strict.h"
+#include "template.h"
+
+double srv_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* ---- the cheap routes, on the polling thread ---- */
+
+static void get_livez(srv_req *r)
+{
+    srv_set_text(r, 200, "text/plain; charset=utf-8", strdup("ok\n"));
+}
+
+static void get_readyz(srv_req *r)
+{
+    srv_server *s = r->s;
+    pthread_mutex_lock(&s->lock);
+    int stopping = s->stopping;
+    pthread_mutex_unlock(&s->lock);
+    if (stopping) {
+        r->retry_after = 1;
+        srv_problem(r, 503, NULL, "shutting down");
+    } else {
+        srv_set_text(r, 200, "text/plain; charset=utf-8", strdup("ready\n"));
+    }
+}
+
+static void get_version(srv_req *r)
+{
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "name", "pdesolidd");
+    cJSON_AddStringToObject(o, "version", SRV_VERSION);
+    cJSON_AddStringToObject(o, "libmicrohttpd", MHD_get_version());
+    cJSON_AddStringToObject(o, "cjson", cJSON_Version());
+    char *text = cJSON_PrintUnformatted(o);
+    cJSON_Delete(o);
+    srv_set_text(r, 200, "application/json", text);
+}
+
+static void get_metrics(srv_req *r)
+{
+    srv_server *s = r->s;
+    srv_cache_stats cs;
+    srv_cache_stats_get(s->cache, &cs);
+    pthread_mutex_lock(&s->lock);
+    size_t in_flight = s->in_flight;
+    pthread_mutex_unlock(&s->lock);
+    srv_set_text(r, 200, "text/plain; version=0.0.4; charset=utf-8",
+                 srv_metrics_render(s->metrics, &cs, srv_pool_depth(s->pool), in_flight, srv_rcache_hits(s->rcache)));
+}
+
+static void get_presets(srv_req *r)
+{
+    srv_set_text(r, 200, "application/json", api_presets_json());
+}
+
+static void get_preset(srv_req *r)
+{
+    const api_preset *ps = api_preset_find(r->arg);
+    if (!ps)
+        srv_problem(r, 404, NULL, "no preset \"%s\"; GET /presets lists them", r->arg);
+    else
+        srv_set_text(r, 200, "application/json", api_preset_json(ps));
+}
+
+/* ---- the solver threads' jobs ---- */
+
+int srv_job_stop(void *arg)
+{
+    srv_req *r = arg;
+    return atomic_load(&r->s->aborting) || r->work + (srv_now() - r->run_start) > r->s->cfg.job_timeout;
+}
+
+/* The problem of a job that stopped: the deadline, or shutdown. */
+static void stopped(srv_req *r)
+{
+    r->retry_after = 1;
+    if (atomic_load(&r->s->aborting))
+        srv_problem(r, 503, NULL, "the server is shutting down");
+    else
+        srv_problem(r, 503, NULL, "the request ran past its deadline of %g s of solver time (--job-timeout)",
+                    r->s->cfg.job_timeout);
+}
+
+typedef struct {
+    api_model *model;
+} solve_arg;
+
+static int solve_model(void *arg, pde_solution **out, api_error *err)
+{
+    return api_solve(((solve_arg *)arg)->model, out, err);
+}
+
+/* The response of a solved entry: 304, a whole body, or a stream. Takes over the reference. */
+static void answer_entry(srv_req *r, srv_entry *e)
+{
+    srv_server *s = r->s;
+    api_format f = r->q.fmt;
+    const unsigned *res = r->q.res3;
+    snprintf(r->id, sizeof r->id, "%s", srv_entry_id(e));
+    snprintf(r->etag, sizeof r->etag, "\"%s.%s.%ux%ux%u\"", r->id, api_format_info_of(f)->name, res[0], res[1], res[2]);
+    const char *inm = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
+    if (inm && (strstr(inm, r->etag) || !strcmp(inm, "*"))) {
+        r->status = 304;
+        r->ctype = NULL;
+        srv_cache_release(s->cache, e);
+        return;
+    }
+    const pde_props *props = NULL;
+    double t0 = srv_now();
+    if (f == API_FMT_JSON || f == API_FMT_GLTF || f == API_FMT_GLB)
+        props = srv_entry_props(e);
+    r->tm.props = srv_now() - t0;
+    if (srv_job_stop(r)) {
+        srv_cache_release(s->cache, e);
+        stopped(r);
+        return;
+    }
+    api_error err;
+    t0 = srv_now();
+    api_output *o = api_output_open(srv_entry_solution(e), r->id, props, f, res, &err);
+    r->tm.output = srv_now() - t0;
+    if (!o) {
+        srv_cache_release(s->cache, e);
+        srv_problem(r, err.status == 422 ? 422 : 500, NULL, "%s", err.message);
+        return;
+    }
+    r->status = 200;
+    r->ctype = api_format_info_of(f)->mime;
+    int whole = 0;
+    r->stream = srv_stream_start(r, o, e, &whole);
+    if (whole && r->status == 200 && r->key && r->text_len <= SRV_RCACHE_MAX_ITEM)
+        srv_rcache_put(s->rcache, r->key, r->klen, r->text, r->text_len, r->ctype, r->id, r->etag);
+}
+
+static void post_solve(srv_req *r)
+{
+    srv_server *s = r->s;
+    api_error err;
+    double t0 = srv_now();
+    pthread_mutex_lock(&s->json_lock);
+    api_model *m = api_model_parse(r->body ? r->body : "", r->len, &err);
+    pthread_mutex_unlock(&s->json_lock);
+    r->tm.parse = srv_now() - t0;
+    if (!m) {
+        srv_problem_api(r, &err);
+        return;
+    }
+    char id[API_ID_LEN + 1];
+    pde_diag d;
+    if (api_model_id(api_model_get(m), id, &d) != PDE_OK) {
+        /* Invalid in a way the solve reports with a pointer. */
+        pde_solution *sol = NULL;
+        api_solve(m, &sol, &err);
+        pde_solution_free(sol);
+        api_model_free(m);
+        srv_problem_api(r, &err);
+        return;
+    }
+    solve_arg sa = { m };
+    int hit;
+    t0 = srv_now();
+    srv_entry *e = srv_cache_get(s->cache, id, solve_model, &sa, &hit, &err);
+    r->tm.solve = srv_now() - t0;
+    r->tm.cached = hit;
+    if (!hit)
+        srv_metrics_solve(s->metrics, r->tm.solve);
+    api_model_free(m);
+    if (!e) {
+        srv_problem_api(r, &err);
+        return;
+    }
+    answer_entry(r, e);
+}
+
+static srv_entry *find_solid(srv_req *r)
+{
+    srv_entry *e = api_id_valid(r->arg) ? srv_cache_find(r->s->cache, r->arg) : NULL;
+    if (!e)
+        srv_problem(r, 404, NULL,
+                    "no solid %s in the cache: it was never solved here, or was evicted; POST its model to /solve",
+                    api_id_valid(r->arg) ? r->arg : "with that id (an id is 32 hex digits)");
+    return e;
+}
+
+static void get_solid(srv_req *r)
+{
+    srv_entry *e = find_solid(r);
+    if (e)
+        answer_entry(r, e);
+}
+
+static void post_eval(srv_req *r)
+{
+    srv_server *s = r->s;
+    srv_entry *e = find_solid(r);
+    if (!e)
+        return;
+    api_error err;
+    double *pts = NULL;
+    size_t n = 0;
+    int derivs = 0;
+    double t0 = srv_now();
+    pthread_mutex_lock(&s->json_lock);
+    int rc = api_eval_parse(r->body ? r->body : "", r->len, s->cfg.max_points, &pts, &n, &derivs, &err);
+    pthread_mutex_unlock(&s->json_lock);
+    r->tm.parse = srv_now() - t0;
+    if (rc) {
+        srv_cache_release(s->cache, e);
+        srv_problem_api(r, &err);
+        return;
+    }
+    const pde_solution *sol = srv_entry_solution(e);
+    double *v = malloc((n ? n : 1) * 12 * sizeof *v);
+    if (!v) {
+        free(pts);
+        srv_cache_release(s->cache, e);
+        srv_problem(r, 500, NULL, "out of memory");
+        return;
+    }
+    double *du = v + 3 * n, *dv = v + 6 * n, *dw = v + 9 * n;
+    t0 = srv_now();
+    size_t i = 0;
+    for (; i < n; i++) {
+        if (i % 256 == 0 && srv_job_stop(r))
+            break;
+        pde_eval_d(sol, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], v + 3 * i, derivs ? du + 3 * i : NULL,
+                   derivs ? dv + 3 * i : NULL, derivs ? dw + 3 * i : NULL);
+    }
+    r->tm.solve = srv_now() - t0;
+    snprintf(r->id, sizeof r->id, "%s", srv_entry_id(e));
+    srv_cache_release(s->cache, e);
+    free(pts);
+    if (i < n) {
+        free(v);
+        stopped(r);
+        return;
+    }
+    t0 = srv_now();
+    char *json = api_eval_json(r->id, v, derivs ? du : NULL, derivs ? dv : NULL, derivs ? dw : NULL, n);
+    r->tm.output = srv_now() - t0;
+    free(v);
+    srv_set_text(r, 200, "application/json", json);
+}
+
+void srv_run_job(void *arg)
+{
+    srv_req *r = arg;
+    r->run_start = srv_now();
+    r->tm.queue = r->run_start - r->queued_at;
+    if (atomic_load(&r->s->aborting))
+        stopped(r);
+    else
+        srv_routes[r->route].handler(r);
+    r->work += srv_now() - r->run_start;
+    r->phase = SRV_DONE;
+    MHD_resume_connection(r->conn);   /* the last act: the polling thread may free r from here on */
+}
+
+/* ---- the table ---- */
+
+const srv_route srv_routes[] = {
+    { "solve", "POST", "/solve", post_solve, SRV_RT_BODY | SRV_RT_JOB | SRV_RT_CACHE | SRV_RT_OUTPUT },
+    { "solids", "GET", "/solids/{}", get_solid, SRV_RT_JOB | SRV_RT_CACHE | SRV_RT_OUTPUT },
+    { "eval", "POST", "/solids/{}/eval", post_eval, SRV_RT_BODY | SRV_RT_JOB },
+    { "presets", "GET", "/presets", get_presets, 0 },
+    { "preset", "GET", "/presets/{}", get_preset, 0 },
+    { "livez", "GET", "/livez", get_livez, 0 },
+    { "readyz", "GET", "/readyz", get_readyz, 0 },
+    { "version", "GET", "/version", get_version, 0 },
+    { "metrics", "GET", "/metrics", get_metrics, 0 },
+    { "static", "GET", "*", srv_static_get, 0 },
+};
+const int srv_nroutes = (int)(sizeof srv_routes / sizeof *srv_routes);
+
+/* 1 if path matches pattern, with the {} segment in arg; -1 if that segment is longer than argn. */
+static int match(const char *pattern, const char *path, char *arg, size_t argn)
+{
+    if (!strcmp(pattern, "*"))
+        return srv_static_find(path) >= 0;
+    const char *brace = strstr(pattern, "{}");
+    if (!brace)
+        return !strcmp(pattern, path);
+    size_t pre = (size_t)(brace - pattern);
+    if (strncmp(pattern, path, pre))
+        return 0;
+    const char *seg = path + pre, *end = strchr(seg, '/');
+    size_t n = end ? (size_t)(end - seg) : strlen(seg);
+    if (n == 0 || strcmp(brace + 2, seg + n))
+        return 0;
+    if (n >= argn)
+        return -1;
+    memcpy(arg, seg, n);
+    arg[n] = '\0';
+    return 1;
+}
+
+int srv_route_find(const char *method, const char *path, char *arg, size_t argn, char *allow, size_t allown,
+                   int *status)
+{
+    int found = -1, any = 0;
+    size_t used = 0;
+    allow[0] = '\0';
+    for (int i = 0; i < srv_nroutes; i++) {
+        int m = match(srv_routes[i].path, path, arg, argn);
+        if (m < 0) {
+            *status = 400;
+            return -1;
+        }
+        if (!m)
+            continue;
+        any = 1;
+        const char *rm = srv_routes[i].method;
+        if (!strcmp(method, rm) || !strcmp(method, "OPTIONS") || (!strcmp(rm, "GET") && !strcmp(method, "HEAD"))) {
+            if (found < 0)
+                found = i;
+        }
+        used += (size_t)snprintf(allow + used, used < allown ? allown - used : 0, "%s%s", used ? ", " : "", rm);
+        if (used >= allown)
+            used = allown - 1;
+    }
+    if (found >= 0)
+        return found;
+    if (any)
+        snprintf(allow + used, used < allown ? allown - used : 0, "%sOPTIONS", used ? ", " : "");
+    *status = any ? 405 : 404;
+    return -1;
+}
+
+/* ---- the query ---- */
+
+static const struct {
+    const char *name;
+    unsigned bit;
+    size_t off, size;
+} params[] = {
+    { "format", 1, offsetof(srv_query, format), sizeof ((srv_query *)0)->format },
+    { "res", 2, offsetof(srv_query, res), sizeof ((srv_query *)0)->res },
+};
+#define NPARAMS (sizeof params / sizeof *params)
+
+void srv_query_init(srv_query *q)
+{
+    memset(q, 0, sizeof *q);
+}
+
+static int bad_text(const char *s, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
+            return 1;
+    return 0;
+}
+
+int srv_query_arg(const srv_route *rt, srv_query *q, const char *key, size_t klen, const char *value, size_t vlen,
+                  char *msg, size_t n)
+{
+    size_t i = 0;
+    if (rt->flags & SRV_RT_OUTPUT)
+        for (; i < NPARAMS; i++)
+            if (strlen(params[i].name) == klen && !memcmp(params[i].name, key, klen))
+                break;
+    if (!(rt->flags & SRV_RT_OUTPUT) || i == NPARAMS) {
+        char shown[64];
+        api_text_clean(shown, sizeof shown, key, klen);
+        snprintf(msg, n, "unknown query parameter \"%s\"; %s takes %s", shown, rt->path,
+                 rt->flags & SRV_RT_OUTPUT ? "format and res" : "none");
+        return -1;
+    }
+    if (q->seen & params[i].bit) {
+        snprintf(msg, n, "the query parameter %s is given twice", params[i].name);
+        return -1;
+    }
+    q->seen |= params[i].bit;
+    if (!value)
+        value = "", vlen = 0;
+    if (bad_text(value, vlen) || strlen(value) != vlen) {
+        snprintf(msg, n, "the query parameter %s holds a control character or a NUL", params[i].name);
+        return -1;
+    }
+    if (vlen >= params[i].size) {
+        snprintf(msg, n, "the query parameter %s is longer than %zu characters", params[i].name, params[i].size - 1);
+        return -1;
+    }
+    memcpy((char *)q + params[i].off, value, vlen + 1);
+    return 0;
+}
+
+int srv_query_done(const srv_route *rt, srv_query *q, char *msg, size_t n)
+{
+    if (!(rt->flags & SRV_RT_OUTPUT))
+        return 0;
+    api_error err;
+    if (api_format_parse(q->format[0] ? q->format : "json", &q->fmt, &err) ||
+        api_res_parse(q->res[0] ? q->res : NULL, q->fmt, q->res3, &err)) {
+        snprintf(msg, n, "%s", err.message);
+        return -1;
+    }
+    return 0;
+}
