@@ -736,6 +736,14 @@ raw_reply raw_exchange(int fd, const void *req, size_t len, int timeout_ms)
         free(b);
         off += (size_t)span;
     }
+    /* A status line inside what a Content-Length claimed (libmicrohttpd 0.9.75 sends its head twice). */
+    int lines = 0;
+    for (size_t i = 0; i + 13 <= n; i++)
+        if ((i == 0 || buf[i - 1] == '\n') && !strncmp(buf + i, "HTTP/1.", 7) && buf[i + 8] == ' ' &&
+            buf[i + 9] >= '1' && buf[i + 9] <= '5' && buf[i + 12] == ' ' && buf[i + 9] != '1')
+            lines++;
+    if (lines > r.responses)
+        r.responses = lines;
     if (!r.head)
         r.head = calloc(1, 1);
     if (!r.body)

@@ -95,7 +95,8 @@ void daemon_stop(daemon_t *d);
  * reads until the peer closes, or until a complete response is in and
  * 300 ms pass quietly, or until timeout_ms in all. An interim 100 Continue
  * is skipped. responses counts the status lines of final responses seen,
- * so a doubled status line shows as 2. status is the first final response's
+ * at the start of any line of what came (so a status line sent twice, or
+ * hidden in a body, shows as 2). status is the first final response's
  * status, or 0 if none came; body is NUL-terminated (de-chunked if chunked),
  * head holds the status line and headers. Free with raw_reply_free.
  */
