@@ -583,9 +583,76 @@ static void every_malformed_request_should_get_one_4xx_problem_or_a_documented_c
         fail_msg("%d of %zu malformed requests were answered wrongly", failed, NROWS);
 }
 
+/* The judge's own check, against texts RFC 8259 and RFC 3629 accept and refuse. */
+static void the_strict_json_check_should_take_what_rfc_8259_takes_and_nothing_else(void **state)
+{
+    (void)state;
+#define J(ok, text) { ok, text, sizeof text - 1 }
+    static const struct {
+        int ok;
+        const char *text;
+        size_t len;
+    } cases[] = {
+        J(1, "{}"), J(1, "[]"), J(1, "0"), J(1, "-0.5e+10"), J(1, " 1 "), J(1, "\"caf\\u00e9\""),
+        J(1, "\"\\ud83d\\ude00\""), J(1, "{\"a\":[1,true,false,null],\"b\":{\"c\":\"d\"}}"),
+        J(1, "\"caf\xc3\xa9 \xf0\x9f\x98\x80\""), J(1, "\"\\\"\\\\\\/\\b\\f\\n\\r\\t\""), J(1, "1E5"),
+        J(0, ""), J(0, " "), J(0, "01"), J(0, "-01"), J(0, "1."), J(0, ".5"), J(0, "+1"), J(0, "1e"), J(0, "NaN"),
+        J(0, "-nan"), J(0, "inf"), J(0, "[1,]"), J(0, "{\"a\":1,}"), J(0, "{'a':1}"), J(0, "{a:1}"),
+        J(0, "{\"a\" 1}"), J(0, "\"\\x41\""), J(0, "\"a\tb\""), J(0, "\"a\nb\""), J(0, "\"\\ud800\""),
+        J(0, "\"\\udc00\""), J(0, "\"\\ud800\\u0041\""), J(0, "\"\xff\""), J(0, "\"\xc0\xaf\""),
+        J(0, "\"\xed\xa0\x80\""), J(0, "\"\xf4\x90\x80\x80\""), J(0, "\"\xe2\x82\""), J(0, "[1] x"),
+        J(0, "1\0"), J(0, "\"abc"), J(0, "["), J(0, "{\"a\":}"), J(0, "tru"), J(0, "nulls"), J(0, "[1 2]"),
+        J(0, "\xef\xbb\xbf{}"),
+    };
+#undef J
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++)
+        if (json_strict_valid(cases[i].text, cases[i].len) != cases[i].ok)
+            fail_msg("case %zu (%.*s): strict JSON check says %d", i, (int)cases[i].len, cases[i].text, !cases[i].ok);
+    /* And a deep but valid text. */
+    char deep[1001];
+    memset(deep, '[', 500);
+    memset(deep + 500, ']', 500);
+    assert_true(json_strict_valid(deep, 1000));
+}
+
+/* The judge's reader, on responses written by hand into a socket pair. */
+static void the_raw_reader_should_count_responses_as_a_client_sees_them(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *bytes;
+        int status, responses;
+        const char *body;
+    } cases[] = {
+        { "HTTP/1.1 404 Not Found\r\nContent-Length: 2\r\n\r\n{}", 404, 1, "{}" },
+        { "HTTP/1.1 200 OK\r\nTransfer-Encoding: chunked\r\n\r\n3\r\nabc\r\n2\r\nde\r\n0\r\n\r\n", 200, 1, "abcde" },
+        { "HTTP/1.1 100 Continue\r\n\r\nHTTP/1.1 413 Content Too Large\r\nContent-Length: 0\r\n\r\n", 413, 1, "" },
+        { "HTTP/1.1 400 Bad Request\r\nContent-Length: 40\r\n\r\nHTTP/1.1 400 Bad Request\r\nContent-Length: 40\r\n\r\n<html></html>",
+          400, 2, NULL },
+        { "HTTP/1.1 400 Bad Request\r\nContent-Length: 1\r\n\r\nxHTTP/1.1 200 OK\r\nContent-Length: 0\r\n\r\n", 400, 2, "x" },
+        { "HTTP/1.0 200 OK\r\n\r\nuntil the close", 200, 1, "until the close" },
+        { "", 0, 0, "" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        int sv[2];
+        assert_int_equal(socketpair(AF_UNIX, SOCK_STREAM, 0, sv), 0);
+        assert_int_equal(write(sv[1], cases[i].bytes, strlen(cases[i].bytes)), (ssize_t)strlen(cases[i].bytes));
+        close(sv[1]);
+        raw_reply r = raw_exchange(sv[0], "", 0, 2000);
+        close(sv[0]);
+        if (r.status != cases[i].status || r.responses != cases[i].responses || !r.closed ||
+            (cases[i].body && strcmp(r.body, cases[i].body)))
+            fail_msg("case %zu: status %d, %d responses, closed %d, body \"%s\"", i, r.status, r.responses, r.closed,
+                     r.body);
+        raw_reply_free(&r);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(the_strict_json_check_should_take_what_rfc_8259_takes_and_nothing_else),
+        cmocka_unit_test(the_raw_reader_should_count_responses_as_a_client_sees_them),
         cmocka_unit_test(every_malformed_request_should_get_one_4xx_problem_or_a_documented_close),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
