@@ -487,3 +487,503 @@ void daemon_stop(daemon_t *d)
         fail_msg("pdesolidd exited with status %d:\n%s", WIFEXITED(st) ? WEXITSTATUS(st) : -1, log ? log : "");
     }
 }
+
+/* ---- raw HTTP over loopback sockets, and a strict JSON check ---- */
+
+#include <arpa/inet.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <strings.h>
+#include <sys/socket.h>
+#include <time.h>
+
+double mono_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+int raw_dial(int port)
+{
+    int fd = socket(AF_INET, SOCK_STREAM, 0);
+    if (fd < 0)
+        return -1;
+    struct sockaddr_in a = { .sin_family = AF_INET, .sin_port = htons((uint16_t)port) };
+    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    if (connect(fd, (struct sockaddr *)&a, sizeof a) != 0) {
+        close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+/* Case-insensitive search for a header in a head block; its value's start and length. */
+static const char *head_find(const char *head, size_t hlen, const char *name, size_t *vlen)
+{
+    size_t nl = strlen(name);
+    for (size_t i = 0; i + nl < hlen; i++) {
+        if ((i == 0 || head[i - 1] == '\n') && !strncasecmp(head + i, name, nl) && head[i + nl] == ':') {
+            const char *v = head + i + nl + 1;
+            while (v < head + hlen && (*v == ' ' || *v == '\t'))
+                v++;
+            const char *e = v;
+            while (e < head + hlen && *e != '\r' && *e != '\n')
+                e++;
+            *vlen = (size_t)(e - v);
+            return v;
+        }
+    }
+    return NULL;
+}
+
+/*
+ * Parses one response at buf[0..n): returns the bytes it spans (head and
+ * body), 0 if incomplete, or -1 if buf does not start with a status line.
+ * to_close: the body runs to the close (no length, not chunked).
+ */
+static long parse_response(const char *buf, size_t n, int closed, int *status, size_t *head_len, char **body,
+                           size_t *blen)
+{
+    if (n < 5)
+        return closed && n ? -1 : 0;
+    if (strncmp(buf, "HTTP/", 5))
+        return -1;
+    const char *end = NULL;
+    for (size_t i = 0; i + 3 < n; i++)
+        if (!memcmp(buf + i, "\r\n\r\n", 4)) {
+            end = buf + i + 4;
+            break;
+        }
+    if (!end)
+        return 0;
+    *head_len = (size_t)(end - buf);
+    const char *sp = memchr(buf, ' ', *head_len);
+    *status = sp ? atoi(sp + 1) : 0;
+    size_t vlen;
+    const char *te = head_find(buf, *head_len, "Transfer-Encoding", &vlen);
+    const char *cl = head_find(buf, *head_len, "Content-Length", &vlen);
+    size_t off = *head_len;
+    *body = NULL;
+    *blen = 0;
+    if ((*status >= 100 && *status < 200) || *status == 204 || *status == 304) {
+        *body = calloc(1, 1);
+        return (long)off;
+    }
+    if (te && strstr(te, "chunked") && strstr(te, "chunked") < te + vlen) {
+        size_t cap = 1;
+        char *b = calloc(1, cap);
+        size_t bl = 0;
+        for (;;) {
+            const char *line = buf + off, *crlf = NULL;
+            for (size_t i = off; i + 1 < n; i++)
+                if (buf[i] == '\r' && buf[i + 1] == '\n') {
+                    crlf = buf + i;
+                    break;
+                }
+            if (!crlf) {
+                free(b);
+                return 0;
+            }
+            unsigned long long k = strtoull(line, NULL, 16);
+            off = (size_t)(crlf - buf) + 2;
+            if (k == 0) {
+                /* Trailers, then an empty line. */
+                for (;;) {
+                    const char *c2 = NULL;
+                    for (size_t i = off; i + 1 < n; i++)
+                        if (buf[i] == '\r' && buf[i + 1] == '\n') {
+                            c2 = buf + i;
+                            break;
+                        }
+                    if (!c2) {
+                        free(b);
+                        return 0;
+                    }
+                    int empty = c2 == buf + off;
+                    off = (size_t)(c2 - buf) + 2;
+                    if (empty)
+                        break;
+                }
+                *body = b;
+                *blen = bl;
+                return (long)off;
+            }
+            if (k > n || off + k + 2 > n) {
+                free(b);
+                return 0;
+            }
+            b = realloc(b, bl + k + 1);
+            memcpy(b + bl, buf + off, k);
+            bl += k;
+            b[bl] = '\0';
+            off += k + 2;
+        }
+    }
+    size_t want;
+    if (cl)
+        want = (size_t)strtoull(cl, NULL, 10);
+    else if (closed)
+        want = n - off;
+    else
+        return 0;
+    if (n - off < want)
+        return 0;
+    *body = malloc(want + 1);
+    memcpy(*body, buf + off, want);
+    (*body)[want] = '\0';
+    *blen = want;
+    return (long)(off + want);
+}
+
+raw_reply raw_exchange(int fd, const void *req, size_t len, int timeout_ms)
+{
+    raw_reply r = { 0 };
+    double t0 = mono_now(), deadline = t0 + timeout_ms / 1000.0;
+    int fl = fcntl(fd, F_GETFL);
+    fcntl(fd, F_SETFL, fl | O_NONBLOCK);
+    size_t cap = 65536, n = 0, sent = 0, whole = len;
+    char *buf = malloc(cap + 1);
+    int complete = 0, reading_closed = 0;
+    double quiet_until = 0;
+    while (!reading_closed) {
+        double t = mono_now();
+        if (t >= deadline)
+            break;
+        if (complete && t >= quiet_until)
+            break;
+        double until = complete && quiet_until < deadline ? quiet_until : deadline;
+        struct pollfd p = { fd, (short)(POLLIN | (sent < len ? POLLOUT : 0)), 0 };
+        int ms = (int)((until - t) * 1000) + 1;
+        if (poll(&p, 1, ms) <= 0)
+            continue;
+        if ((p.revents & POLLOUT) && sent < len) {
+            ssize_t k = send(fd, (const char *)req + sent, len - sent, MSG_NOSIGNAL);
+            if (k > 0)
+                sent += (size_t)k;
+            else if (k < 0 && errno != EAGAIN && errno != EWOULDBLOCK)
+                len = sent;   /* the peer is gone: read what it said */
+        }
+        if (p.revents & (POLLIN | POLLHUP | POLLERR)) {
+            if (n == cap)
+                buf = realloc(buf, (cap *= 2) + 1);
+            ssize_t k = recv(fd, buf + n, cap - n, 0);
+            if (k > 0) {
+                n += (size_t)k;
+            } else if (k == 0 || (errno != EAGAIN && errno != EWOULDBLOCK)) {
+                reading_closed = 1;
+                r.closed = 1;
+            }
+        }
+        /* Complete once a final response has fully arrived. */
+        size_t off = 0;
+        int fin = 0;
+        for (;;) {
+            int st;
+            size_t hl, bl;
+            char *b;
+            long span = parse_response(buf + off, n - off, r.closed, &st, &hl, &b, &bl);
+            if (span <= 0)
+                break;
+            free(b);
+            off += (size_t)span;
+            if (st >= 200) {
+                fin = 1;
+                break;
+            }
+        }
+        if (fin && !complete) {
+            complete = 1;
+            r.first_response = mono_now() - t0;
+            quiet_until = mono_now() + 0.3;
+        }
+    }
+    buf[n] = '\0';
+    r.sent_all = sent == whole;
+    r.timed_out = !complete && !r.closed;
+    /* Walk the responses: the first final one is the answer; count the rest. */
+    size_t off = 0;
+    for (;;) {
+        int st;
+        size_t hl, bl;
+        char *b;
+        long span = parse_response(buf + off, n - off, r.closed, &st, &hl, &b, &bl);
+        if (span < 0) {
+            /* Junk after a response: count any status line in it. */
+            for (const char *q = buf + off; (q = strstr(q, "HTTP/1.")); q++)
+                if (q == buf + off || q[-1] == '\n')
+                    r.responses++;
+            break;
+        }
+        if (span == 0) {
+            if (n > off && !strncmp(buf + off, "HTTP/", 5))
+                r.responses++;   /* a partial response still has a status line */
+            break;
+        }
+        if (st >= 200) {
+            r.responses++;
+            if (!r.head) {
+                r.status = st;
+                r.head = malloc(hl + 1);
+                memcpy(r.head, buf + off, hl);
+                r.head[hl] = '\0';
+                r.body = b;
+                r.body_len = bl;
+                b = NULL;
+            }
+        }
+        free(b);
+        off += (size_t)span;
+    }
+    /* A status line inside what a Content-Length claimed (libmicrohttpd 0.9.75 sends its head twice). */
+    int lines = 0;
+    for (size_t i = 0; i + 13 <= n; i++)
+        if ((i == 0 || buf[i - 1] == '\n') && !strncmp(buf + i, "HTTP/1.", 7) && buf[i + 8] == ' ' &&
+            buf[i + 9] >= '1' && buf[i + 9] <= '5' && buf[i + 12] == ' ' && buf[i + 9] != '1')
+            lines++;
+    if (lines > r.responses)
+        r.responses = lines;
+    if (!r.head)
+        r.head = calloc(1, 1);
+    if (!r.body)
+        r.body = calloc(1, 1);
+    free(buf);
+    r.seconds = mono_now() - t0;
+    return r;
+}
+
+raw_reply raw_request(int port, const void *req, size_t len, int timeout_ms)
+{
+    int fd = raw_dial(port);
+    if (fd < 0) {
+        raw_reply r = { 0 };
+        r.head = calloc(1, 1);
+        r.body = calloc(1, 1);
+        r.closed = 1;
+        return r;
+    }
+    raw_reply r = raw_exchange(fd, req, len, timeout_ms);
+    close(fd);
+    return r;
+}
+
+void raw_reply_free(raw_reply *r)
+{
+    free(r->head);
+    free(r->body);
+    r->head = r->body = NULL;
+}
+
+int raw_header(const raw_reply *r, const char *name, char *out, size_t n)
+{
+    size_t vlen;
+    const char *v = head_find(r->head, strlen(r->head), name, &vlen);
+    if (!v)
+        return 0;
+    snprintf(out, n, "%.*s", (int)(vlen < n ? vlen : n - 1), v);
+    return 1;
+}
+
+int utf8_valid(const char *s, size_t n)
+{
+    const unsigned char *p = (const unsigned char *)s, *e = p + n;
+    while (p < e) {
+        unsigned c = *p;
+        int k;
+        unsigned cp, min;
+        if (c < 0x80) {
+            p++;
+            continue;
+        } else if ((c & 0xe0) == 0xc0) {
+            k = 1, cp = c & 0x1f, min = 0x80;
+        } else if ((c & 0xf0) == 0xe0) {
+            k = 2, cp = c & 0x0f, min = 0x800;
+        } else if ((c & 0xf8) == 0xf0) {
+            k = 3, cp = c & 0x07, min = 0x10000;
+        } else {
+            return 0;
+        }
+        if (e - p <= k)
+            return 0;
+        for (int i = 1; i <= k; i++) {
+            if ((p[i] & 0xc0) != 0x80)
+                return 0;
+            cp = cp << 6 | (p[i] & 0x3f);
+        }
+        if (cp < min || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff))
+            return 0;
+        p += k + 1;
+    }
+    return 1;
+}
+
+typedef struct {
+    const char *p, *e;
+    int depth;
+} jscan;
+
+static void j_ws(jscan *j)
+{
+    while (j->p < j->e && (*j->p == ' ' || *j->p == '\t' || *j->p == '\n' || *j->p == '\r'))
+        j->p++;
+}
+
+static int j_hex4(jscan *j, unsigned *v)
+{
+    if (j->e - j->p < 4)
+        return 0;
+    *v = 0;
+    for (int i = 0; i < 4; i++) {
+        char c = j->p[i];
+        int d = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+        if (d < 0)
+            return 0;
+        *v = *v << 4 | (unsigned)d;
+    }
+    j->p += 4;
+    return 1;
+}
+
+static int j_string(jscan *j)
+{
+    if (j->p >= j->e || *j->p != '"')
+        return 0;
+    j->p++;
+    const char *run = j->p;
+    while (j->p < j->e) {
+        unsigned char c = (unsigned char)*j->p;
+        if (c == '"') {
+            if (!utf8_valid(run, (size_t)(j->p - run)))
+                return 0;
+            j->p++;
+            return 1;
+        }
+        if (c < 0x20)
+            return 0;
+        if (c == '\\') {
+            if (!utf8_valid(run, (size_t)(j->p - run)))
+                return 0;
+            j->p++;
+            if (j->p >= j->e)
+                return 0;
+            char x = *j->p++;
+            if (x == 'u') {
+                unsigned v, w;
+                if (!j_hex4(j, &v))
+                    return 0;
+                if (v >= 0xdc00 && v <= 0xdfff)
+                    return 0;   /* a lone low surrogate */
+                if (v >= 0xd800 && v <= 0xdbff) {
+                    if (j->e - j->p < 6 || j->p[0] != '\\' || j->p[1] != 'u')
+                        return 0;
+                    j->p += 2;
+                    if (!j_hex4(j, &w) || w < 0xdc00 || w > 0xdfff)
+                        return 0;
+                }
+            } else if (!strchr("\"\\/bfnrt", x) || x == 0) {
+                return 0;
+            }
+            run = j->p;
+            continue;
+        }
+        j->p++;
+    }
+    return 0;
+}
+
+static int j_digits(jscan *j)
+{
+    const char *s = j->p;
+    while (j->p < j->e && *j->p >= '0' && *j->p <= '9')
+        j->p++;
+    return j->p > s;
+}
+
+static int j_number(jscan *j)
+{
+    if (j->p < j->e && *j->p == '-')
+        j->p++;
+    if (j->p < j->e && *j->p == '0')
+        j->p++;
+    else if (!j_digits(j))
+        return 0;
+    if (j->p < j->e && *j->p == '.') {
+        j->p++;
+        if (!j_digits(j))
+            return 0;
+    }
+    if (j->p < j->e && (*j->p == 'e' || *j->p == 'E')) {
+        j->p++;
+        if (j->p < j->e && (*j->p == '+' || *j->p == '-'))
+            j->p++;
+        if (!j_digits(j))
+            return 0;
+    }
+    return 1;
+}
+
+static int j_value(jscan *j)
+{
+    j_ws(j);
+    if (j->p >= j->e || ++j->depth > 512)
+        return 0;
+    int ok = 0;
+    char c = *j->p;
+    if (c == '{' || c == '[') {
+        char close_c = c == '{' ? '}' : ']';
+        j->p++;
+        j_ws(j);
+        if (j->p < j->e && *j->p == close_c) {
+            j->p++;
+            ok = 1;
+        } else {
+            for (;;) {
+                if (c == '{') {
+                    j_ws(j);
+                    if (!j_string(j))
+                        break;
+                    j_ws(j);
+                    if (j->p >= j->e || *j->p++ != ':')
+                        break;
+                }
+                if (!j_value(j))
+                    break;
+                j_ws(j);
+                if (j->p < j->e && *j->p == ',') {
+                    j->p++;
+                    continue;
+                }
+                if (j->p < j->e && *j->p == close_c) {
+                    j->p++;
+                    ok = 1;
+                }
+                break;
+            }
+        }
+    } else if (c == '"') {
+        ok = j_string(j);
+    } else if (c == '-' || (c >= '0' && c <= '9')) {
+        ok = j_number(j);
+    } else {
+        static const char *const lit[] = { "true", "false", "null" };
+        for (int i = 0; i < 3 && !ok; i++) {
+            size_t l = strlen(lit[i]);
+            if ((size_t)(j->e - j->p) >= l && !memcmp(j->p, lit[i], l)) {
+                j->p += l;
+                ok = 1;
+            }
+        }
+    }
+    j->depth--;
+    return ok;
+}
+
+int json_strict_valid(const char *s, size_t n)
+{
+    jscan j = { s, s + n, 0 };
+    if (!j_value(&j))
+        return 0;
+    j_ws(&j);
+    return j.p == j.e;
+}

@@ -86,3 +86,43 @@ void daemon_start(daemon_t *d, const char *dir, const char *args);
 void daemon_stop(daemon_t *d);
 
 #endif
+
+/* ---- raw HTTP over loopback sockets, and a strict JSON check (test_hostile, test_badreq) ---- */
+
+/*
+ * One exchange on a new connection to 127.0.0.1:port: sends len bytes of req
+ * (non-blocking, stopping early if the peer closes or stops reading), then
+ * reads until the peer closes, or until a complete response is in and
+ * 300 ms pass quietly, or until timeout_ms in all. An interim 100 Continue
+ * is skipped. responses counts the status lines of final responses seen,
+ * at the start of any line of what came (so a status line sent twice, or
+ * hidden in a body, shows as 2). status is the first final response's
+ * status, or 0 if none came; body is NUL-terminated (de-chunked if chunked),
+ * head holds the status line and headers. Free with raw_reply_free.
+ */
+typedef struct {
+    int status;
+    int responses;      /* final responses seen */
+    int closed;         /* the peer closed (or reset) the connection */
+    int timed_out;      /* timeout_ms passed without a complete response or a close */
+    int sent_all;       /* every byte of the request went out */
+    char *head;
+    char *body;
+    size_t body_len;
+    double seconds;     /* from the start of the exchange to the end of the reading */
+    double first_response;   /* from the start to the first complete final response, or 0 */
+} raw_reply;
+
+int raw_dial(int port);
+raw_reply raw_request(int port, const void *req, size_t len, int timeout_ms);
+/* The same on a connected socket fd, which the caller closes. */
+raw_reply raw_exchange(int fd, const void *req, size_t len, int timeout_ms);
+void raw_reply_free(raw_reply *r);
+/* A header's value into out (1), or 0 if absent; case-insensitive names. */
+int raw_header(const raw_reply *r, const char *name, char *out, size_t n);
+/* n bytes of s are well-formed UTF-8: no overlong forms, surrogates or values over U+10FFFF. */
+int utf8_valid(const char *s, size_t n);
+/* n bytes of s are one JSON text per RFC 8259, in valid UTF-8, with no lone surrogate escapes. */
+int json_strict_valid(const char *s, size_t n);
+/* Seconds on the monotonic clock. */
+double mono_now(void);
