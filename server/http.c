@@ -29,6 +29,7 @@
 
 #include "http.h"
 #include "internal.h"
+#include "strict.h"
 
 /* Discarding a refused body: at most this many bytes, and this long. */
 #define DRAIN_BYTES (16u << 20)
@@ -52,6 +53,12 @@ static void make_key(srv_req *r)
 }
 
 /* ---- the first call: what the headers decide ---- */
+
+/* What a connection carries from request to request. */
+typedef struct {
+    int nul;   /* the request's path or query held %00 */
+} conn_state;
+
 
 typedef struct {
     int lengths, encodings;
@@ -95,6 +102,18 @@ static enum MHD_Result scan_arg(void *cls, enum MHD_ValueKind kind, const char *
     return MHD_YES;
 }
 
+/* Names the first query argument holding a literal %00. */
+static enum MHD_Result find_nul(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+{
+    (void)kind;
+    if (!strstr(key, "%00") && !(value && strstr(value, "%00")))
+        return MHD_YES;
+    char k[32];
+    api_text_clean(k, sizeof k, key, strlen(key));
+    snprintf(cls, 64, "the query parameter %s", k);
+    return MHD_NO;
+}
+
 /* Content-Length as digits only, within uint64; -1 if absent, -2 if malformed. */
 static long long content_length(struct MHD_Connection *c)
 {
@@ -122,12 +141,17 @@ static int admit(srv_req *r, const char *method)
         srv_request_id_make(r->rid);
     long long cl = content_length(r->conn);
     /* Framing that cannot be trusted: answer and close without reading a byte of body. */
-    if (h.lengths > 1 || cl == -2 || (h.encodings && h.lengths)) {
+    const char *te = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_TRANSFER_ENCODING);
+    if (h.lengths > 1 || cl == -2 || (h.encodings && h.lengths) || h.encodings > 1 ||
+        (te && strcasecmp(te, "chunked"))) {
         r->close = r->decided = 1;
-        srv_problem(r, 400, NULL, "%s",
-                    h.lengths > 1 ? "the request has more than one Content-Length header"
-                    : cl == -2    ? "the Content-Length header is not a number of bytes"
-                                  : "the request has both Transfer-Encoding and Content-Length; it may have one");
+        int coding = te && strcasecmp(te, "chunked") && !h.lengths && h.encodings == 1;
+        srv_problem(r, coding ? 501 : 400, NULL, "%s",
+                    h.lengths > 1  ? "the request has more than one Content-Length header"
+                    : cl == -2     ? "the Content-Length header is not a number of bytes"
+                    : h.lengths    ? "the request has both Transfer-Encoding and Content-Length; it may have one"
+                    : coding       ? "the only Transfer-Encoding taken is chunked"
+                                   : "the request has more than one Transfer-Encoding header");
         return 1;
     }
     pthread_mutex_lock(&s->lock);
@@ -140,6 +164,18 @@ static int admit(srv_req *r, const char *method)
                     s->cfg.max_body);
         /* Expect: 100-continue: the client waits, and sends nothing. Too large to discard: close. */
         return (expect && !strcasecmp(expect, "100-continue")) || cl > (long long)DRAIN_BYTES;
+    }
+    const union MHD_ConnectionInfo *ci = MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    conn_state *cs = ci ? ci->socket_context : NULL;
+    if (cs && cs->nul) {
+        /* unescape() kept the %00 literal: find where, to name it. */
+        cs->nul = 0;
+        r->decided = 1;
+        char where[64] = "the path";
+        if (!strstr(r->path, "%00"))
+            MHD_get_connection_values(r->conn, MHD_GET_ARGUMENT_KIND, find_nul, where);
+        srv_problem(r, 400, NULL, "%s holds a NUL (%%00), which no part of a request may", where);
+        return 0;
     }
     if (stopping) {
         r->decided = r->close = 1;
@@ -166,8 +202,8 @@ static int admit(srv_req *r, const char *method)
         return 0;
     }
     if (qs.bad || srv_query_done(&srv_routes[r->route], &r->q, qs.msg, sizeof qs.msg)) {
-        r->decided = 1;
-        srv_problem(r, 400, NULL, "%s", qs.msg);
+        r->decided = 1;   /* a malformed query is a bad request; a well-formed value out of range is not */
+        srv_problem(r, qs.bad ? 400 : 422, NULL, "%s", qs.msg);
         return 0;
     }
     if (!srv_origin_allowed(r)) {
@@ -344,20 +380,25 @@ static int hexval(char c)
     return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
 }
 
-/* libmicrohttpd's %-decoding, except that %00 stays as it is: a NUL never hides the rest of a path or a value. */
+/* libmicrohttpd's %-decoding, except that %00 stays as it is, so that a NUL never hides the rest of a path
+ * or a value, and the request is refused (admit). */
 static size_t unescape(void *cls, struct MHD_Connection *c, char *s)
 {
     (void)cls;
-    (void)c;
     char *w = s;
     for (const char *p = s; *p;) {
-        int hi, lo;
-        if (p[0] == '%' && (hi = hexval(p[1])) >= 0 && (lo = hexval(p[2])) >= 0 && (hi | lo)) {
+        int hi = p[0] == '%' ? hexval(p[1]) : -1, lo = hi >= 0 ? hexval(p[2]) : -1;
+        if (lo >= 0 && (hi | lo)) {
             *w++ = (char)(hi << 4 | lo);
             p += 3;
-        } else {
-            *w++ = *p++;
+            continue;
         }
+        if (lo >= 0) {
+            const union MHD_ConnectionInfo *ci = MHD_get_connection_info(c, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+            if (ci && ci->socket_context)
+                ((conn_state *)ci->socket_context)->nul = 1;
+        }
+        *w++ = *p++;
     }
     *w = '\0';
     return (size_t)(w - s);
@@ -403,9 +444,14 @@ static void connection_event(void *cls, struct MHD_Connection *conn, void **sock
                              enum MHD_ConnectionNotificationCode toe)
 {
     (void)conn;
-    (void)socket_context;
     srv_server *s = cls;
     srv_metrics_connection(s->metrics, toe == MHD_CONNECTION_NOTIFY_STARTED ? 1 : -1);
+    if (toe == MHD_CONNECTION_NOTIFY_STARTED) {
+        *socket_context = calloc(1, sizeof(conn_state));   /* NULL: %00 goes unnoticed, and is still kept literal */
+    } else {
+        free(*socket_context);
+        *socket_context = NULL;
+    }
 }
 
 /* ---- start and stop ---- */

@@ -262,6 +262,11 @@ static void post_eval(srv_req *r)
         stopped(r);
         return;
     }
+    if (api_eval_check(v, derivs ? du : NULL, derivs ? dv : NULL, derivs ? dw : NULL, n, &err)) {
+        free(v);
+        srv_problem_api(r, &err);
+        return;
+    }
     t0 = srv_now();
     char *json = api_eval_json(r->id, v, derivs ? du : NULL, derivs ? dv : NULL, derivs ? dw : NULL, n);
     r->tm.output = srv_now() - t0;
