@@ -61,16 +61,34 @@ typedef struct {
 
 
 typedef struct {
-    int lengths, encodings;
+    int lengths, encodings, hosts;
     srv_req *r;
-    char msg[200];
-    int bad;
+    const char *bad;   /* what is wrong with a header, or NULL */
 } header_scan;
 
-static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+/* RFC 9110's token characters, which a header's name is made of. */
+static int token(const char *s, size_t n)
+{
+    static const char extra[] = "!#$%&'*+-.^_`|~";
+    for (size_t i = 0; i < n; i++)
+        if (!((s[i] >= 'a' && s[i] <= 'z') || (s[i] >= 'A' && s[i] <= 'Z') || (s[i] >= '0' && s[i] <= '9') ||
+              (s[i] && strchr(extra, s[i]))))
+            return 0;
+    return n > 0;
+}
+
+static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const char *key, size_t klen,
+                                   const char *value, size_t vlen)
 {
     (void)kind;
     header_scan *h = cls;
+    if (!h->bad && !token(key, klen))
+        h->bad = "a header's name is not a token (RFC 9110: letters, digits and !#$%&'*+-.^_`|~)";
+    for (size_t i = 0; value && i < vlen && !h->bad; i++)
+        if (((unsigned char)value[i] < 0x20 && value[i] != '\t') || value[i] == 0x7f)
+            h->bad = "a header's value holds a control character";
+    if (!strcasecmp(key, MHD_HTTP_HEADER_HOST))
+        h->hosts++;
     if (!strcasecmp(key, MHD_HTTP_HEADER_CONTENT_LENGTH))
         h->lengths++;
     if (!strcasecmp(key, MHD_HTTP_HEADER_TRANSFER_ENCODING))
@@ -136,7 +154,7 @@ static int admit(srv_req *r, const char *method)
 {
     srv_server *s = r->s;
     header_scan h = { .r = r };
-    MHD_get_connection_values(r->conn, MHD_HEADER_KIND, scan_header, &h);
+    MHD_get_connection_values_n(r->conn, MHD_HEADER_KIND, scan_header, &h);
     if (!r->rid[0])
         srv_request_id_make(r->rid);
     long long cl = content_length(r->conn);
@@ -152,6 +170,12 @@ static int admit(srv_req *r, const char *method)
                     : h.lengths    ? "the request has both Transfer-Encoding and Content-Length; it may have one"
                     : coding       ? "the only Transfer-Encoding taken is chunked"
                                    : "the request has more than one Transfer-Encoding header");
+        return 1;
+    }
+    /* libmicrohttpd's strict mode refuses these with an HTML page; pdesolidd refuses them with a problem. */
+    if (h.bad || (h.hosts != 1 && !strcmp(r->version, MHD_HTTP_VERSION_1_1))) {
+        r->close = r->decided = 1;
+        srv_problem(r, 400, NULL, "%s", h.bad ? h.bad : "an HTTP/1.1 request needs exactly one Host header");
         return 1;
     }
     pthread_mutex_lock(&s->lock);
@@ -215,7 +239,8 @@ static int admit(srv_req *r, const char *method)
     return 0;
 }
 
-static srv_req *begin(srv_server *s, struct MHD_Connection *conn, const char *url, const char *method)
+static srv_req *begin(srv_server *s, struct MHD_Connection *conn, const char *url, const char *method,
+                      const char *version)
 {
     srv_req *r = calloc(1, sizeof *r);
     if (!r)
@@ -226,6 +251,7 @@ static srv_req *begin(srv_server *s, struct MHD_Connection *conn, const char *ur
     r->route = srv_nroutes;
     r->phase = SRV_BODY;
     snprintf(r->method, sizeof r->method, "%s", method);
+    snprintf(r->version, sizeof r->version, "%s", version);
     snprintf(r->path, sizeof r->path, "%s", url);
     pthread_mutex_lock(&s->lock);
     s->in_flight++;
@@ -354,11 +380,10 @@ static enum MHD_Result take_body(srv_req *r, const char *upload, size_t n)
 static enum MHD_Result handler(void *cls, struct MHD_Connection *conn, const char *url, const char *method,
                                const char *version, const char *upload, size_t *upload_size, void **con_cls)
 {
-    (void)version;
     srv_server *s = cls;
     srv_req *r = *con_cls;
     if (!r) {
-        if (!(r = begin(s, conn, url, method)))
+        if (!(r = begin(s, conn, url, method, version)))
             return MHD_NO;
         *con_cls = r;
         if (admit(r, method))
@@ -513,7 +538,7 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
     s->d = MHD_start_daemon(flags, (uint16_t)c->port, NULL, NULL, handler, s, MHD_OPTION_SOCK_ADDR, ai->ai_addr,
                             MHD_OPTION_THREAD_POOL_SIZE, (unsigned)(c->http_threads > 1 ? c->http_threads : 0),
                             MHD_OPTION_CONNECTION_TIMEOUT, c->timeout, MHD_OPTION_PER_IP_CONNECTION_LIMIT, c->per_ip,
-                            MHD_OPTION_CONNECTION_LIMIT, c->max_conns, MHD_OPTION_STRICT_FOR_CLIENT, (int)1,
+                            MHD_OPTION_CONNECTION_LIMIT, c->max_conns, MHD_OPTION_STRICT_FOR_CLIENT, (int)0,
                             MHD_OPTION_UNESCAPE_CALLBACK, unescape, NULL, MHD_OPTION_NOTIFY_COMPLETED, completed, s,
                             MHD_OPTION_NOTIFY_CONNECTION, connection_event, s, MHD_OPTION_END);
     freeaddrinfo(ai);

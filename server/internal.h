@@ -60,6 +60,7 @@ typedef struct srv_req {
     enum srv_phase phase;
     double t0;                   /* the first call of the handler */
     char method[8];
+    char version[12];            /* HTTP/1.1 */
     char path[512];              /* decoded, as libmicrohttpd gives it (escaped only in the log) */
     char query[512];             /* key=value&..., decoded, for the log */
     char arg[96];                /* the path's {} segment */

@@ -403,8 +403,10 @@ int srv_query_arg(const srv_route *rt, srv_query *q, const char *key, size_t kle
         return -1;
     }
     q->seen |= params[i].bit;
-    if (!value)
-        value = "", vlen = 0;
+    if (!value || !vlen) {
+        snprintf(msg, n, "the query parameter %s needs a value", params[i].name);
+        return -1;
+    }
     if (bad_text(value, vlen) || strlen(value) != vlen) {
         snprintf(msg, n, "the query parameter %s holds a control character or a NUL", params[i].name);
         return -1;
