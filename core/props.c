@@ -23,6 +23,7 @@ static const double gl_w[GL_N] = { 0.1012285362903763, 0.2223810344533745, 0.313
                                    0.2223810344533745, 0.1012285362903763 };
 #define MAX_PANELS 64
 #define MAX_NODES (2u << 20)   /* quadrature nodes in all, to bound the time */
+#define POLISH_EVALS 400       /* evaluations of one compass search (api/cost.c counts on it) */
 
 static double det3(const double a[3], const double b[3], const double c[3])
 {
@@ -82,11 +83,18 @@ static double objective(const pde_solution *s, int what, double sign, const doub
     return sign * x[what];
 }
 
-/* Compass search for a minimum of the objective in the unit cube, from p. */
-static double polish(const pde_solution *s, int what, double sign, double p[3], double step)
+/* Compass search for a minimum of the objective in the unit cube, from p; *stopped when cancelled. */
+static double polish(const pde_solution *s, int what, double sign, double p[3], double step,
+                     const pde_cancel *cancel, int *stopped)
 {
+    if (*stopped)
+        return 0.0;
     double best = objective(s, what, sign, p);
-    for (int evals = 0; step > 1e-7 && evals < 400;) {
+    for (int evals = 0; step > 1e-7 && evals < POLISH_EVALS;) {
+        if (evals % 8 == 7 && pde_stopped(cancel)) {
+            *stopped = 1;
+            return 0.0;
+        }
         int moved = 0;
         for (int a = 0; a < 3 && !moved; a++)
             for (int d = -1; d <= 1 && !moved; d += 2) {
@@ -130,8 +138,8 @@ static void note_point(extremes *e, const double p[3], const double x[3], double
 /* Walks a grid over us x vs x ws, noting extremes; with weights, integrates det J. */
 static pde_status sweep(const pde_solution *s, const double *us, size_t nu, const double *vs,
                         size_t nv, const double *ws, size_t nw, const double *wts_u,
-                        const double *wts_v, const double *wts_w, extremes *e, double *vol,
-                        double *svol)
+                        const double *wts_v, const double *wts_w, const pde_cancel *cancel, extremes *e,
+                        double *vol, double *svol)
 {
     pde_grid *g;
     pde_status st = pde_grid_create(s, us, nu, vs, nv, &g);
@@ -141,6 +149,10 @@ static pde_status sweep(const pde_solution *s, const double *us, size_t nu, cons
     for (size_t k = 0; k < nw; k++) {
         grid_set_w(g, ws[k]);
         for (size_t j = 0; j < nv; j++) {
+            if (pde_stopped(cancel)) {
+                pde_grid_free(g);
+                return PDE_ERR_CANCELLED;
+            }
             grid_row(g, j, GRID_X | GRID_XU | GRID_XV | GRID_XW);
             for (size_t i = 0; i < nu; i++) {
                 double x[3], a[3], b[3], c[3];
@@ -170,13 +182,15 @@ static pde_status sweep(const pde_solution *s, const double *us, size_t nu, cons
 }
 
 /* Largest relative error of the boundary conditions of each component, on res x res points. */
-static double bc_residual(const pde_solution *s, int res)
+static double bc_residual(const pde_solution *s, int res, const pde_cancel *cancel, int *stopped)
 {
     double worst = 0.0;
-    for (int c = 0; c < 3; c++) {
+    for (int c = 0; c < 3 && !*stopped; c++) {
         const comp_solution *cs = &s->comp[c];
         double err = 0.0, scale = 0.0;
-        for (int i = 0; i < res; i++)
+        for (int i = 0; i < res; i++) {
+            if ((*stopped = pde_stopped(cancel)))
+                return 0.0;
             for (int j = 0; j < res; j++) {
                 double u = (double)i / (res - 1), v = (double)j / (res - 1);
                 double g[4] = { 0, 0, 0, 0 };
@@ -196,20 +210,23 @@ static double bc_residual(const pde_solution *s, int res)
                                              fmax(fabs(x[c]), fabs(xw[c]))));
                 }
             }
+        }
         worst = fmax(worst, scale > 0.0 ? err / scale : err);
     }
     return worst;
 }
 
 /* Largest |a x_uuuu + b x_vvvv + c x_wwww - p| relative to its terms, inside the cube. */
-static double pde_residual(const pde_solution *s, int res)
+static double pde_residual(const pde_solution *s, int res, const pde_cancel *cancel, int *stopped)
 {
     double worst = 0.0;
-    for (int c = 0; c < 3; c++) {
+    for (int c = 0; c < 3 && !*stopped; c++) {
         const comp_solution *cs = &s->comp[c];
         double err = 0.0, scale = 0.0;
         for (int i = 0; i < res; i++)
-            for (int j = 0; j < res; j++)
+            for (int j = 0; j < res; j++) {
+                if ((*stopped = pde_stopped(cancel)))
+                    return 0.0;
                 for (int k = 0; k < res; k++) {
                     double u = (i + 0.5) / res, v = (j + 0.5) / res, w = (k + 0.5) / res;
                     double tu = cs->a * pde_eval_partial(s, c, u, v, w, 4, 0, 0);
@@ -219,9 +236,18 @@ static double pde_residual(const pde_solution *s, int res)
                     err = fmax(err, fabs(tu + tv + tw - p));
                     scale = fmax(scale, fabs(tu) + fabs(tv) + fabs(tw) + fabs(p));
                 }
+            }
         worst = fmax(worst, scale > 0.0 ? err / scale : err);
     }
     return worst;
+}
+
+void pde_properties_nodes(const pde_solution *s, size_t nodes[3])
+{
+    int np[3];
+    panel_counts(s, np);
+    for (int a = 0; a < 3; a++)
+        nodes[a] = (size_t)np[a] * GL_N;
 }
 
 pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde_props *out)
@@ -229,6 +255,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     if (!s || !out)
         return PDE_ERR_INVALID;
     int res = opts && opts->res > 0 ? opts->res : 17;
+    const pde_cancel *cancel = opts ? opts->cancel : NULL;
     if (res < 2 || res > 1025)
         return PDE_ERR_INVALID;
     int np[3];
@@ -263,27 +290,33 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     e.jmax = -DBL_MAX;
     double vol, svol;
     pde_status st = sweep(s, node[0], nq[0], node[1], nq[1], node[2], nq[2], wt[0], wt[1], wt[2],
-                          &e, &vol, &svol);
+                          cancel, &e, &vol, &svol);
     if (st == PDE_OK)
-        st = sweep(s, uni, res, uni, res, uni, res, NULL, NULL, NULL, &e, NULL, NULL);
+        st = sweep(s, uni, res, uni, res, uni, res, NULL, NULL, NULL, cancel, &e, NULL, NULL);
     free(buf);
     if (st != PDE_OK)
         return st;
 
+    /* Into a local result, so that a cancelled call leaves *out untouched. */
+    pde_props r;
+    int stopped = 0;
     double step = 1.0 / (res - 1);
     for (int c = 0; c < 3; c++) {
-        out->bbox_min[c] = polish(s, c, 1.0, e.lo_at[c], step);
-        out->bbox_max[c] = polish(s, c, -1.0, e.hi_at[c], step);
+        r.bbox_min[c] = polish(s, c, 1.0, e.lo_at[c], step, cancel, &stopped);
+        r.bbox_max[c] = polish(s, c, -1.0, e.hi_at[c], step, cancel, &stopped);
     }
-    out->detj_min = polish(s, 3, 1.0, e.jmin_at, step);
-    out->detj_max = polish(s, 3, -1.0, e.jmax_at, step);
+    r.detj_min = polish(s, 3, 1.0, e.jmin_at, step, cancel, &stopped);
+    r.detj_max = polish(s, 3, -1.0, e.jmax_at, step, cancel, &stopped);
     for (int a = 0; a < 3; a++)
-        out->detj_min_at[a] = e.jmin_at[a];
-    double tol = 1e-9 * fmax(fabs(out->detj_min), fabs(out->detj_max));
-    out->folds = out->detj_min < -tol && out->detj_max > tol;
-    out->volume = vol;
-    out->signed_volume = svol;
-    out->bc_residual = bc_residual(s, res);
-    out->pde_residual = pde_residual(s, res < 9 ? res : 9);
+        r.detj_min_at[a] = e.jmin_at[a];
+    double tol = 1e-9 * fmax(fabs(r.detj_min), fabs(r.detj_max));
+    r.folds = r.detj_min < -tol && r.detj_max > tol;
+    r.volume = vol;
+    r.signed_volume = svol;
+    r.bc_residual = bc_residual(s, res, cancel, &stopped);
+    r.pde_residual = pde_residual(s, res < 9 ? res : 9, cancel, &stopped);
+    if (stopped)
+        return PDE_ERR_CANCELLED;
+    *out = r;
     return PDE_OK;
 }

@@ -506,7 +506,7 @@ static void answer_entry(request *r, srv_entry *e, api_format f, const unsigned 
         props = srv_entry_props(e);
     api_error err;
     double t0 = now();
-    api_output *o = api_output_open(srv_entry_solution(e), r->id, props, f, res, &err);
+    api_output *o = api_output_open(srv_entry_solution(e), r->id, props, f, res, NULL, &err);
     size_t tl = strlen(r->timing);
     if (!o) {
         srv_cache_release(s->cache, e);
@@ -519,7 +519,9 @@ static void answer_entry(request *r, srv_entry *e, api_format f, const unsigned 
     if (r->key && size >= 0 && size <= (long long)SRV_RCACHE_MAX_ITEM) {
         /* Small and of known size: render it here, and keep it for the next identical request. */
         char *bytes = malloc((size_t)size + 1);
-        long n = bytes ? api_output_read(o, bytes, (size_t)size) : -1;
+        long n = bytes ? 0 : -1;
+        for (long k = 1; n >= 0 && n < size && k > 0; n = k < 0 ? -1 : n + k)
+            k = api_output_read(o, bytes + n, (size_t)(size - n));   /* bounded work per call */
         api_output_free(o);
         srv_cache_release(s->cache, e);
         srv_metrics_output(s->metrics, now() - t0, n > 0 ? (size_t)n : 0);
