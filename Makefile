@@ -100,6 +100,9 @@ build/bench/%: bench/%.c build/libpdeapi.a build/libpdecore.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(CJSON_CFLAGS) $^ $(LIBS) $(LDLIBS) -o $@
 
+# bench_cost measures the heap's peak by wrapping malloc.
+build/bench/bench_cost: LDLIBS += -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free
+
 build/bench/mhd_minimal: bench/mhd_minimal.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $< $(MHD) -lpthread -o $@

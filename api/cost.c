@@ -35,9 +35,10 @@
 #define K_WD_DEG   1.6    /* a coefficient of wterm_deriv's complex Horner, per derivative order + 1 */
 #define K_WD_TERM  25.0   /* wterm_deriv's exp, cexp and loop */
 #define K_COEF     2.0    /* a mode of a grid row's coefficients */
+#define K_COEF_MEM 8.0    /* the same when the f_v table does not fit in cache (a miss per mode) */
 #define K_FMA      0.9    /* a multiply-add of a sampled row (strided over the u table), table in cache */
 #define K_COMBINE  0.2    /* a multiply-add of a properties row (contiguous) */
-#define K_FMA_MEM  3.0    /* a sampled row's multiply-add when the table does not fit in cache */
+#define K_FMA_MEM  8.0    /* a sampled row's multiply-add when the table does not fit in cache */
 #define CACHE_BYTES (1 << 20)
 #define K_GROUP    0.5    /* a comparison of pde_grid_create's grouping of u-factors */
 #define K_TOUCH    0.1    /* a byte of fresh memory (page faults, zeroing) */
@@ -165,13 +166,14 @@ static double plane_work(const comp_stats st[3])
 }
 
 /* A row of nu samples filling `arrays` arrays (x; or x, xu, xv, xw); props: the contiguous combine(). */
-static double row_work(const comp_stats st[3], double nu, double arrays, int props)
+static double row_work(const comp_stats st[3], double nu, double nv, double arrays, int props)
 {
     double w = 0.0;
     for (int c = 0; c < 3; c++) {
         /* emit1() has vectorised loops for up to three distinct u-factors. */
         double k = props || st[c].nd <= 3 ? K_COMBINE : 16.0 * st[c].nd * nu > CACHE_BYTES ? K_FMA_MEM : K_FMA;
-        w += K_COEF * st[c].nm + arrays * k * st[c].nd * nu;
+        double kc = !props && 16.0 * st[c].nm * nv > CACHE_BYTES ? K_COEF_MEM : K_COEF;
+        w += kc * st[c].nm + arrays * k * st[c].nd * nu;
     }
     return w;
 }
@@ -179,7 +181,7 @@ static double row_work(const comp_stats st[3], double nu, double arrays, int pro
 /* A grid of nu x nv over nw planes, all rows, `arrays` arrays per row. */
 static double sweep_work(const comp_stats st[3], double nu, double nv, double nw, double arrays, int props)
 {
-    return grid_create_work(st, nu, nv) + nw * plane_work(st) + nw * nv * row_work(st, nu, arrays, props);
+    return grid_create_work(st, nu, nv) + nw * plane_work(st) + nw * nv * row_work(st, nu, nv, arrays, props);
 }
 
 /* ---- the properties ---- */
@@ -253,13 +255,13 @@ void api_cost_output(const pde_solution *sol, api_format f, const unsigned res[3
         return;
     case API_FMT_GRID:
         /* Three passes, one per component, each sampling all three; every sample printed once. */
-        c->work = grid_create_work(st, nu, nv) + 3.0 * (nw * plane_work(st) + nw * nv * row_work(st, nu, 1.0, 0)) +
+        c->work = grid_create_work(st, nu, nv) + 3.0 * (nw * plane_work(st) + nw * nv * row_work(st, nu, nv, 1.0, 0)) +
                   K_FMT_F32 * 3.0 * n;
         c->bytes = grid_bytes(st, nu, nv) + 12.0 * chunk + 2.0 * 17.0 * chunk;
         return;
     case API_FMT_VTS:
         /* Positions, then positions and the three derivatives again for det J. */
-        c->work = grid_create_work(st, nu, nv) + nw * (2.0 * plane_work(st)) + nw * nv * row_work(st, nu, 5.0, 0) +
+        c->work = grid_create_work(st, nu, nv) + nw * (2.0 * plane_work(st)) + nw * nv * row_work(st, nu, nv, 5.0, 0) +
                   (K_PT_F32 * 4.0 + K_DET) * n;
         c->bytes = grid_bytes(st, nu, nv) + 4.0 * 12.0 * chunk + 2.0 * 12.0 * chunk;
         return;
