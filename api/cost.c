@@ -28,18 +28,21 @@
 #define K_FE_TRIG  14.0   /* sin and cos of one argument */
 #define K_FE_EXP   8.0    /* exp */
 #define K_FE_HYP   16.0   /* sinh and cosh */
-#define K_H_TERM   4.0    /* a w-term of h(w): loop and exp */
-#define K_H_TRIG   14.0   /* its cos and sin, when beta != 0 */
+#define K_H_TERM   2.0    /* a w-term of h(w): its loop */
+#define K_H_EXP    10.0   /* its exp, when alpha != 0 */
+#define K_H_TRIG   16.0   /* its cos and sin, when beta != 0 */
 #define K_H_DEG    1.0    /* a coefficient of its Horner passes (A, and B when beta != 0) */
 #define K_EV_MODE  3.0    /* a mode of pde_eval_d beyond its factors and h */
 #define K_WD_DEG   1.6    /* a coefficient of wterm_deriv's complex Horner, per derivative order + 1 */
 #define K_WD_TERM  25.0   /* wterm_deriv's exp, cexp and loop */
 #define K_COEF     2.0    /* a mode of a grid row's coefficients */
-#define K_COEF_MEM 8.0    /* the same when the f_v table does not fit in cache (a miss per mode) */
+#define K_COEF_MEM 8.0    /* the same when the f_v table's lines do not fit in L1 */
 #define K_FMA      0.9    /* a multiply-add of a sampled row (strided over the u table), table in cache */
 #define K_COMBINE  0.2    /* a multiply-add of a properties row (contiguous) */
-#define K_FMA_MEM  8.0    /* a sampled row's multiply-add when the table does not fit in cache */
+#define K_COMBINE_MEM 0.3 /* the same when the table does not fit in cache */
+#define K_FMA_MEM  8.0    /* the same when the table's lines do not fit in L1 (strided()) */
 #define CACHE_BYTES (1 << 20)
+#define STRIDED_FAST 512.0 /* table rows whose current lines fit in L1 (strided()) */
 #define K_GROUP    0.5    /* a comparison of pde_grid_create's grouping of u-factors */
 #define K_TOUCH    0.1    /* a byte of fresh memory (page faults, zeroing) */
 #define K_PT_PROPS 10.0   /* a point of a properties sweep: det J and extremes */
@@ -51,14 +54,16 @@
 #define K_STL      25.0   /* an STL triangle written */
 #define K_B64      1.0    /* a byte of base64 */
 #define K_JNODE    90.0   /* a cJSON node made and freed */
+#define K_JMODE    3000.0 /* a mode's factors and regime printed in the closed form's text */
 #define K_JNUM     300.0  /* a number printed by cJSON (it prints, reads back, may print again) */
 #define K_DESC     250.0  /* a coefficient printed by the closed form's text */
 #define K_EVNUM    250.0  /* a %.17g number of an eval answer */
-#define K_S_MODE   3000.0 /* a mode of the solve: its plan, fit and real form */
+#define K_S_MODE   400.0  /* a mode of the solve: its fit and real form, |e| <= 1 (plans shared) */
+#define K_S_PLAN   500.0  /* a mode with |e| > 1: its own plan (roots, LU, condition) */
 #define K_S_TERM   120.0  /* a term of the solve */
-#define K_S_DEG    20.0   /* a coefficient of a force's polynomial through the solve */
+#define K_S_DEG    35.0   /* a coefficient of a force's polynomial through the solve */
 #define K_S_PAIR   3.0    /* two force terms on one mode (merging searches linearly) */
-#define POLISH_EVALS 200  /* typical evaluations of one compass search (at most 400) */
+#define POLISH_EVALS 100  /* typical evaluations of one compass search (at most 400) */
 
 /* ---- what a solution holds ---- */
 
@@ -108,7 +113,8 @@ static void stats_of(const pde_solution *sol, comp_stats st[3])
             for (size_t k = 0; k < md[m].nterms; k++) {
                 const pde_wterm *t = &md[m].terms[k];
                 double d1 = t->deg + 1.0, passes = t->beta != 0.0 ? 2.0 : 1.0;
-                s->h += K_H_TERM + (t->beta != 0.0 ? K_H_TRIG : 0.0) + K_H_DEG * 2.0 * passes * d1;
+                s->h += K_H_TERM + (t->alpha != 0.0 ? K_H_EXP : 0.0) + (t->beta != 0.0 ? K_H_TRIG : 0.0) +
+                        K_H_DEG * 2.0 * passes * d1;
                 s->d4 += K_WD_TERM + K_WD_DEG * 5.0 * d1;
                 s->d0 += K_WD_TERM + K_WD_DEG * d1;
                 s->coefs += 2.0 * d1;
@@ -165,14 +171,29 @@ static double plane_work(const comp_stats st[3])
     return st[0].h + st[1].h + st[2].h;
 }
 
+/*
+ * A loop that reads one element of each of n table rows in turn, for each
+ * sample, reuses a cache line per row from one sample to the next while the
+ * n lines fit in L1 (n up to about 512); beyond about 1024 every read misses.
+ */
+static double strided(double n, double fast, double slow)
+{
+    if (n <= STRIDED_FAST)
+        return fast;
+    if (n >= 2 * STRIDED_FAST)
+        return slow;
+    return fast + (slow - fast) * (n - STRIDED_FAST) / STRIDED_FAST;
+}
+
 /* A row of nu samples filling `arrays` arrays (x; or x, xu, xv, xw); props: the contiguous combine(). */
-static double row_work(const comp_stats st[3], double nu, double nv, double arrays, int props)
+static double row_work(const comp_stats st[3], double nu, double arrays, int props)
 {
     double w = 0.0;
     for (int c = 0; c < 3; c++) {
         /* emit1() has vectorised loops for up to three distinct u-factors. */
-        double k = props || st[c].nd <= 3 ? K_COMBINE : 16.0 * st[c].nd * nu > CACHE_BYTES ? K_FMA_MEM : K_FMA;
-        double kc = !props && 16.0 * st[c].nm * nv > CACHE_BYTES ? K_COEF_MEM : K_COEF;
+        double k = props ? (16.0 * st[c].nd * nu > CACHE_BYTES ? K_COMBINE_MEM : K_COMBINE)
+                         : st[c].nd <= 3 ? K_COMBINE : strided(st[c].nd, K_FMA, K_FMA_MEM);
+        double kc = props ? K_COEF : strided(st[c].nm, K_COEF, K_COEF_MEM);
         w += kc * st[c].nm + arrays * k * st[c].nd * nu;
     }
     return w;
@@ -181,7 +202,7 @@ static double row_work(const comp_stats st[3], double nu, double nv, double arra
 /* A grid of nu x nv over nw planes, all rows, `arrays` arrays per row. */
 static double sweep_work(const comp_stats st[3], double nu, double nv, double nw, double arrays, int props)
 {
-    return grid_create_work(st, nu, nv) + nw * plane_work(st) + nw * nv * row_work(st, nu, nv, arrays, props);
+    return grid_create_work(st, nu, nv) + nw * plane_work(st) + nw * nv * row_work(st, nu, arrays, props);
 }
 
 /* ---- the properties ---- */
@@ -255,13 +276,13 @@ void api_cost_output(const pde_solution *sol, api_format f, const unsigned res[3
         return;
     case API_FMT_GRID:
         /* Three passes, one per component, each sampling all three; every sample printed once. */
-        c->work = grid_create_work(st, nu, nv) + 3.0 * (nw * plane_work(st) + nw * nv * row_work(st, nu, nv, 1.0, 0)) +
+        c->work = grid_create_work(st, nu, nv) + 3.0 * (nw * plane_work(st) + nw * nv * row_work(st, nu, 1.0, 0)) +
                   K_FMT_F32 * 3.0 * n;
         c->bytes = grid_bytes(st, nu, nv) + 12.0 * chunk + 2.0 * 17.0 * chunk;
         return;
     case API_FMT_VTS:
         /* Positions, then positions and the three derivatives again for det J. */
-        c->work = grid_create_work(st, nu, nv) + nw * (2.0 * plane_work(st)) + nw * nv * row_work(st, nu, nv, 5.0, 0) +
+        c->work = grid_create_work(st, nu, nv) + nw * (2.0 * plane_work(st)) + nw * nv * row_work(st, nu, 5.0, 0) +
                   (K_PT_F32 * 4.0 + K_DET) * n;
         c->bytes = grid_bytes(st, nu, nv) + 4.0 * 12.0 * chunk + 2.0 * 12.0 * chunk;
         return;
@@ -287,7 +308,7 @@ void api_cost_output(const pde_solution *sol, api_format f, const unsigned res[3
             nodes += 8.0 * st[i].nm + 6.0 * st[i].wterms + st[i].coefs;
             nums += st[i].nm + 3.0 * st[i].wterms + st[i].coefs;
         }
-        c->work = K_JNODE * nodes + K_JNUM * nums + K_DESC * (st[0].coefs + st[1].coefs + st[2].coefs) / 2.0 +
+        c->work = K_JMODE * (st[0].nm + st[1].nm + st[2].nm) + K_JNODE * nodes + K_JNUM * nums + K_DESC * (st[0].coefs + st[1].coefs + st[2].coefs) / 2.0 +
                   30000.0;
         /* The tree (node and key), the printed text with cJSON's doubling buffer, the text, the copy. */
         double text = 24.0 * nums + 8.0 * nodes;
@@ -319,6 +340,7 @@ static int term_key_cmp(const void *pa, const void *pb)
     return r ? r : factor_cmp(&a[1], &b[1]);
 }
 
+
 static double lambda(pde_factor f)
 {
     double w = f.kind == PDE_SIN || f.kind == PDE_COS ? f.p * M_PI : f.kind == PDE_POW ? 0.0 : f.p;
@@ -330,7 +352,7 @@ void api_cost_solve(const pde_model *m, api_cost *c)
     double w = 0.0, bytes = 0.0;
     for (int ci = 0; ci < 3; ci++) {
         const pde_component *pc = &m->comp[ci];
-        double modes = 0.0;
+        double modes = 0.0, plans = 0.0;
         size_t nt = pc->nbterms + pc->nfterms;
         /* Chains: t^n brings t^(n-4), t^(n-8), ... along. */
         for (size_t j = 0; j < nt; j++) {
@@ -339,10 +361,12 @@ void api_cost_solve(const pde_model *m, api_cost *c)
             double iu = u.kind == PDE_POW && u.p >= 0 ? floor(fmin(u.p, PDE_MAX_POW) / 4) : 0;
             double iv = v.kind == PDE_POW && v.p >= 0 ? floor(fmin(v.p, PDE_MAX_POW) / 4) : 0;
             modes += (iu + 1) * (iv + 1);
+            double e = pc->c != 0.0 ? -(pc->a * lambda(u) + pc->b * lambda(v)) / pc->c : 0.0;
+            plans += fabs(e) > 1.0;
         }
         modes = fmin(modes, 4.0 * PDE_MAX_MODES);
-        w += K_S_MODE * modes + K_S_TERM * (double)nt;
-        bytes += 400.0 * modes;
+        w += K_S_MODE * modes + K_S_PLAN * fmin(plans, modes) + K_S_TERM * (double)nt;
+        bytes += 1600.0 * modes;   /* scratch modes, plans and eps, and the solution's arena */
         /* Force terms: their polynomials through force_w, the particular solution and the real form. */
         pde_factor *keys = malloc((pc->nfterms ? pc->nfterms : 1) * 2 * sizeof *keys);
         for (size_t j = 0; j < pc->nfterms; j++) {
@@ -373,7 +397,7 @@ void api_cost_solve(const pde_model *m, api_cost *c)
         }
         free(keys);
     }
-    c->work = w + 10000.0;
+    c->work = w + 500.0;
     c->bytes = bytes + 4096.0;
 }
 
