@@ -289,6 +289,63 @@ static int teardown(void **state)
     return system(cmd) == 0 ? 0 : -1;
 }
 
+/* ---- the polling thread only copies ---- */
+
+typedef struct {
+    const daemon_t *d;
+    const char *body;
+    long long bytes;
+    int status;
+} stream_arg;
+
+static void *stream_client(void *arg)
+{
+    stream_arg *a = arg;
+    raw_reply r = ask(a->d, "POST", "/solve?format=f32&res=256,256,16", NULL, a->body, strlen(a->body), 60000);
+    a->status = r.status;
+    a->bytes = (long long)r.body_len;
+    raw_reply_free(&r);
+    return NULL;
+}
+
+/*
+ * Finding 1: grid bodies were made in libmicrohttpd's content reader, on the
+ * polling thread, so one client's stream stalled every other request. With a
+ * single polling thread (--http-threads 1) and a stream of 4 M floats of a
+ * 1536-mode solid being made and read, /livez must still answer, each time,
+ * well within a second (the bound is generous; the benchmark measures p99).
+ */
+static void livez_should_answer_while_the_only_polling_thread_sends_a_heavy_stream(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--http-threads 1 --threads 1 --max-work 1e13 --max-mem-mb 1024 --job-timeout 120");
+    char *body = heavy_model(512, 3);
+    stream_arg a = { &d, body, 0, 0 };
+    pthread_t t;
+    pthread_create(&t, NULL, stream_client, &a);
+    double worst = 0;
+    int asked = 0;
+    /* While the stream runs (the metrics count bytes of output as they go). */
+    for (double end = mono_now() + 20; mono_now() < end && metric(&d, "pdesolid_connections") >= 2; asked++) {
+        raw_reply r = ask(&d, "GET", "/livez", NULL, NULL, 0, 3000);
+        assert_int_equal(r.status, 200);
+        if (r.seconds > worst)
+            worst = r.seconds;
+        raw_reply_free(&r);
+        usleep(50000);
+    }
+    pthread_join(t, NULL);
+    free(body);
+    assert_int_equal(a.status, 200);
+    assert_int_equal(a.bytes, 256LL * 256 * 16 * 12);
+    if (asked < 5)
+        fail_msg("the stream ended before /livez was asked 5 times (%d): make it heavier", asked);
+    if (worst > 1.0)
+        fail_msg("/livez took %.2f s while a stream was sent", worst);
+    stop(&d);
+}
+
 /* ---- connections ---- */
 
 static void a_body_sent_one_byte_each_half_second_should_be_cut_off_at_the_request_timeout(void **state)
@@ -1030,6 +1087,7 @@ static void the_openapi_document_should_be_served(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test_teardown(livez_should_answer_while_the_only_polling_thread_sends_a_heavy_stream, kill_leftover),
         cmocka_unit_test_teardown(a_body_sent_one_byte_each_half_second_should_be_cut_off_at_the_request_timeout, kill_leftover),
         cmocka_unit_test_teardown(slow_bodies_at_the_per_address_limit_should_not_lock_the_address_out, kill_leftover),
         cmocka_unit_test_teardown(an_oversized_body_with_expect_100_continue_should_get_413_before_any_byte_of_it, kill_leftover),
