@@ -35,7 +35,9 @@
 
 #include "support.h"
 
+#ifndef NGINX
 #define NGINX "/usr/sbin/nginx"
+#endif
 #define SHIPPED "deploy/nginx.conf"
 /* The test copy's client_header_timeout and client_body_timeout, in seconds. */
 #define HEADER_TIMEOUT 2.0
@@ -184,6 +186,27 @@ static void write_text(const char *path, const char *text)
     assert_int_equal(fclose(f), 0);
 }
 
+/* The main file that Debian's /etc/nginx/nginx.conf stands for: every path in the test prefix. */
+static void write_main(const char *conf, const char *site, const char *log, int k)
+{
+    char text[1024];
+    snprintf(text, sizeof text,
+             "worker_processes 1;\n"
+             "error_log %s info;\n"
+             "events { worker_connections 512; }\n"
+             "http {\n"
+             "    access_log %s/access%d.log;\n"
+             "    client_body_temp_path %s/body;\n"
+             "    proxy_temp_path %s/proxy;\n"
+             "    fastcgi_temp_path %s/fastcgi;\n"
+             "    uwsgi_temp_path %s/uwsgi;\n"
+             "    scgi_temp_path %s/scgi;\n"
+             "    include %s;\n"
+             "}\n",
+             log, dir, k, dir, dir, dir, dir, dir, site);
+    write_text(conf, text);
+}
+
 static void need_nginx(void)
 {
     if (access(NGINX, X_OK) != 0) {
@@ -210,23 +233,7 @@ static void front_start(front_t *f, int upstream_port)
         char *text = test_copy(f->port, upstream_port);
         write_text(site, text);
         free(text);
-        char main_conf[1024];
-        snprintf(main_conf, sizeof main_conf,
-                 "# The main file that Debian's /etc/nginx/nginx.conf stands for, in a test prefix.\n"
-                 "worker_processes 1;\n"
-                 "error_log %s info;\n"
-                 "events { worker_connections 512; }\n"
-                 "http {\n"
-                 "    access_log %s/access%d.log;\n"
-                 "    client_body_temp_path %s/body;\n"
-                 "    proxy_temp_path %s/proxy;\n"
-                 "    fastcgi_temp_path %s/fastcgi;\n"
-                 "    uwsgi_temp_path %s/uwsgi;\n"
-                 "    scgi_temp_path %s/scgi;\n"
-                 "    include %s;\n"
-                 "}\n",
-                 f->log, dir, k, dir, dir, dir, dir, dir, site);
-        write_text(conf, main_conf);
+        write_main(conf, site, f->log, k);
         snprintf(cmd, sizeof cmd, "exec %s -p %s -c %s -e %s -g 'daemon off; pid %s/nginx%d.pid;' >/dev/null 2>%s", NGINX,
                  dir, conf, f->log, dir, k, err);
         pid_t pid = fork();
@@ -632,12 +639,10 @@ static void the_shipped_conf_should_have_every_directive_the_tests_rely_on(void 
     snprintf(conf, sizeof conf, "%s/nginx-t.conf", dir);
     write_text(site, copy);
     free(copy);
-    char main_conf[512];
-    snprintf(main_conf, sizeof main_conf, "error_log %s/t.log;\nevents {}\nhttp {\n    include %s;\n}\n", dir,
-             site);
-    write_text(conf, main_conf);
-    snprintf(cmd, sizeof cmd, "%s -q -t -p %s -c %s -e %s/t.log -g 'pid %s/t.pid;' 2>&1", NGINX, dir, conf, dir,
-             dir);
+    char log[160];
+    snprintf(log, sizeof log, "%s/t.log", dir);
+    write_main(conf, site, log, 99);
+    snprintf(cmd, sizeof cmd, "%s -q -t -p %s -c %s -e %s -g 'pid %s/t.pid;' 2>&1", NGINX, dir, conf, log, dir);
     assert_int_equal(system(cmd), 0);
 }
 
@@ -1020,20 +1025,23 @@ static void a_burst_above_limit_req_should_get_429_problems_and_health_checks_no
     CURL *c = curl_easy_init();
     int ok = 0, limited = 0;
     double t0 = now();
-    for (int i = 0; i < 100; i++) {
+    /* Until ten are refused, in at most 400 requests (bounded even on a loaded machine). */
+    for (int i = 0; i < 400 && limited < 10; i++) {
         reply r = http_on(c, f.base, "GET", "/version", NULL, NULL, NULL);
         if (r.status == 200) {
             ok++;
         } else {
             expect_problem(r.status, r.headers, r.body, 429);
+            char retry[16];
+            assert_true(header_in(r.headers, "Retry-After", retry, sizeof retry));
             limited++;
         }
         free(r.body);
     }
     double took = now() - t0;
-    /* rate=20r/s burst=40: at most 41 at once and 20 a second after. */
-    assert_true(ok >= 41 && ok <= 41 + (int)(20 * took) + 1);
-    assert_int_equal(ok + limited, 100);
+    /* rate=20r/s burst=40 nodelay: 41 at once, then 20 a second. */
+    if (limited < 10 || ok < 41 || ok > 41 + (int)(20 * took) + 1)
+        fail_msg("%d answered and %d refused in %.2f s", ok, limited, took);
     /* /livez is not limited, even now. */
     for (int i = 0; i < 60; i++) {
         reply r = http_on(c, f.base, "GET", "/livez", NULL, NULL, NULL);
@@ -1121,21 +1129,24 @@ static void an_unreachable_daemon_should_give_a_502_problem(void **state)
     front_stop(&f);
 }
 
+/* Each test, then whatever it left running if it failed. */
+#define T(test) cmocka_unit_test_teardown(test, stop_leftovers)
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(the_shipped_conf_should_have_every_directive_the_tests_rely_on, stop_leftovers),
-        cmocka_unit_test_teardown(a_solve_through_nginx_should_be_byte_identical_to_direct, stop_leftovers),
-        cmocka_unit_test_teardown(json_should_be_gzipped_when_asked_and_binary_outputs_never, stop_leftovers),
-        cmocka_unit_test_teardown(slowloris_on_the_headers_should_be_cut_within_client_header_timeout, stop_leftovers),
-        cmocka_unit_test_teardown(a_trickled_body_should_be_held_by_nginx_and_a_stalled_one_cut_within_client_body_timeout, stop_leftovers),
-        cmocka_unit_test_teardown(trickled_bodies_from_one_address_should_be_capped_by_limit_conn, stop_leftovers),
-        cmocka_unit_test_teardown(malformed_framing_should_get_one_problem_and_never_reach_the_daemon, stop_leftovers),
-        cmocka_unit_test_teardown(malformed_framing_should_leave_the_daemon_serving, stop_leftovers),
-        cmocka_unit_test_teardown(an_oversize_body_should_get_a_413_problem_that_the_client_can_read, stop_leftovers),
-        cmocka_unit_test_teardown(a_burst_above_limit_req_should_get_429_problems_and_health_checks_none, stop_leftovers),
-        cmocka_unit_test_teardown(the_daemon_should_get_a_sane_request_id_and_forwarded_headers, stop_leftovers),
-        cmocka_unit_test_teardown(an_unreachable_daemon_should_give_a_502_problem, stop_leftovers),
+        T(the_shipped_conf_should_have_every_directive_the_tests_rely_on),
+        T(a_solve_through_nginx_should_be_byte_identical_to_direct),
+        T(json_should_be_gzipped_when_asked_and_binary_outputs_never),
+        T(slowloris_on_the_headers_should_be_cut_within_client_header_timeout),
+        T(a_trickled_body_should_be_held_by_nginx_and_a_stalled_one_cut_within_client_body_timeout),
+        T(trickled_bodies_from_one_address_should_be_capped_by_limit_conn),
+        T(malformed_framing_should_get_one_problem_and_never_reach_the_daemon),
+        T(malformed_framing_should_leave_the_daemon_serving),
+        T(an_oversize_body_should_get_a_413_problem_that_the_client_can_read),
+        T(a_burst_above_limit_req_should_get_429_problems_and_health_checks_none),
+        T(the_daemon_should_get_a_sane_request_id_and_forwarded_headers),
+        T(an_unreachable_daemon_should_give_a_502_problem),
     };
     return cmocka_run_group_tests_name("nginx", tests, setup, teardown);
 }
