@@ -12,7 +12,6 @@
  */
 #define _GNU_SOURCE   /* strcasestr */
 #include <arpa/inet.h>
-#include <errno.h>
 #include <poll.h>
 #include <pthread.h>
 #include <setjmp.h>
