@@ -185,7 +185,10 @@ static void write_text(const char *path, const char *text)
     assert_int_equal(fclose(f), 0);
 }
 
-/* The main file that Debian's /etc/nginx/nginx.conf stands for: every path in the test prefix. */
+/*
+ * The main file that Debian's /etc/nginx/nginx.conf stands for, with its http
+ * settings (sendfile, mime types, gzip) and every path in the test prefix.
+ */
 static void write_main(const char *conf, const char *site, const char *log, int k)
 {
     char text[1024];
@@ -194,6 +197,11 @@ static void write_main(const char *conf, const char *site, const char *log, int 
              "error_log %s info;\n"
              "events { worker_connections 512; }\n"
              "http {\n"
+             "    sendfile on;\n"
+             "    tcp_nopush on;\n"
+             "    include /etc/nginx/mime.types;\n"
+             "    default_type application/octet-stream;\n"
+             "    gzip on;\n"
              "    access_log %s/access%d.log;\n"
              "    client_body_temp_path %s/body;\n"
              "    proxy_temp_path %s/proxy;\n"
