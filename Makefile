@@ -122,6 +122,9 @@ build/bench/mhd_minimal: bench/mhd_minimal.c
 bench: $(BENCHES) build/pdesolidd build/bench/mhd_minimal
 	@for b in $(BENCHES); do ./$$b; done
 	@bash bench/bench_server.sh
+	@bash bench/bench_livez.sh
+	@bash bench/bench_413.sh
+	@bash bench/bench_shutdown.sh
 
 clean:
 	rm -rf build

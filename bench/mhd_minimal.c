@@ -1,9 +1,11 @@
 /*
  * mhd_minimal: the baseline of the server benchmark. A minimal libmicrohttpd
- * server, configured like pdesolidd (one epoll polling thread), that answers
- * every request with the bytes of one file, from memory.
+ * server, configured like pdesolidd (epoll polling threads: THREADS of them in
+ * libmicrohttpd's thread pool, MHD_OPTION_THREAD_POOL_SIZE, as pdesolidd's
+ * --http-threads), that answers every request with the bytes of one file,
+ * from memory.
  *
- *   mhd_minimal PORT FILE
+ *   mhd_minimal PORT FILE [THREADS]      (THREADS: 1 by default)
  */
 #include <signal.h>
 #include <stdio.h>
@@ -37,8 +39,9 @@ static enum MHD_Result answer(void *cls, struct MHD_Connection *c, const char *u
 
 int main(int argc, char **argv)
 {
-    if (argc != 3) {
-        fprintf(stderr, "usage: mhd_minimal PORT FILE\n");
+    int threads = argc == 4 ? atoi(argv[3]) : 1;
+    if ((argc != 3 && argc != 4) || threads < 1 || threads > 256) {
+        fprintf(stderr, "usage: mhd_minimal PORT FILE [THREADS]\n");
         return 2;
     }
     FILE *f = fopen(argv[2], "rb");
@@ -48,7 +51,9 @@ int main(int argc, char **argv)
     body_len = fread(body, 1, 1 << 24, f);
     fclose(f);
     struct MHD_Daemon *d = MHD_start_daemon(MHD_USE_EPOLL_INTERNAL_THREAD | MHD_USE_ERROR_LOG, (uint16_t)atoi(argv[1]),
-                                            NULL, NULL, answer, NULL, MHD_OPTION_CONNECTION_TIMEOUT, 30u, MHD_OPTION_END);
+                                            NULL, NULL, answer, NULL, MHD_OPTION_CONNECTION_TIMEOUT, 30u,
+                                            MHD_OPTION_THREAD_POOL_SIZE, (unsigned)(threads > 1 ? threads : 0),
+                                            MHD_OPTION_END);
     if (!d)
         return 1;
     sigset_t set;
