@@ -481,5 +481,6 @@ int main(void)
         cmocka_unit_test(request_ids_should_accept_only_short_plain_tokens),
         cmocka_unit_test(made_request_ids_should_be_unique_sane_and_hex),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("log", tests, NULL, NULL);
 }

@@ -78,5 +78,6 @@ int main(void)
         cmocka_unit_test(fmt_should_round_trip_float32_across_the_whole_range),
         cmocka_unit_test(fmt_should_write_short_plain_forms),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("numfmt", tests, NULL, NULL);
 }

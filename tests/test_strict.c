@@ -768,5 +768,6 @@ int main(void)
         cmocka_unit_test(eval_json_should_write_null_for_what_is_not_finite),
         cmocka_unit_test(cli_eval_should_refuse_points_whose_values_are_not_finite),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("strict", tests, NULL, NULL);
 }
