@@ -134,7 +134,7 @@ build/fuzz/obj/%.o: %.c | deps
 build/fuzz/fuzz_%: build/fuzz/obj/tests/fuzz/fuzz_%.o $(call fuzzobj,$(FUZZ_LIB_SRC)) build/obj/openapi.o
 	$(FUZZ_CC) $(SAN) -fsanitize=fuzzer $^ $(LIBS) $(CMOCKA) $(MHD) $(LDLIBS) -lpthread -o $@
 
-build/san/tests/fuzz/%.o: CFLAGS += -Iserver -Itests
+build/san/tests/fuzz/%.o: CFLAGS += -Itests
 build/san/fuzz/fuzz_%: build/san/tests/fuzz/fuzz_%.o build/san/tests/fuzz/replay.o \
                        $(call san,$(FUZZ_LIB_SRC)) build/obj/openapi.o
 	@mkdir -p $(dir $@)

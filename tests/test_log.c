@@ -26,6 +26,8 @@
 
 #include "log.h"
 
+void test_filter_from_env(void);   /* support.h, whose utf8_valid would clash with the one here */
+
 /* ---- helpers ---- */
 
 /* Everything written to fd so far, NUL-terminated; *n its length. */

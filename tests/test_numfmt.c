@@ -14,6 +14,7 @@
 #include <cmocka.h>
 
 #include "numfmt.h"
+#include "support.h"
 
 static void check(float f)
 {

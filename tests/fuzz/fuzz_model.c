@@ -1,7 +1,7 @@
 /*
  * fuzz_model.c: the request body of POST /solve, end to end. Bytes go
  * through api_model_parse, api_solve and, when the solution is small, every
- * output format at a tiny resolution. Invariants: a refusal is a sane
+ * output format at a tiny resolution (2 or 3 samples per axis). Invariants: a refusal is a sane
  * api_error; an accepted model has a well-formed id; every output's bytes
  * number api_output_size(), the JSON ones are strict JSON (support.h's own
  * checker, not the api's), and the binary ones have the lengths their
@@ -119,15 +119,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         modes += k;
     }
     if (modes <= MAX_MODES) {
+        /* The last byte (JSON allows trailing white space) picks res 2 or 3, and whether the outputs
+         * get the properties or compute them at their default resolution. */
+        unsigned pick = size ? data[size - 1] : 0;
         pde_props props;
         pde_props_opts opts = { .res = 5 };
-        int have = pde_properties(sol, &opts, &props) == PDE_OK;
+        int have = !(pick & 2) && pde_properties(sol, &opts, &props) == PDE_OK;
         for (int f = 0; f < API_FMT_COUNT; f++) {
-            const api_format_info *fi = api_format_info_of((api_format)f);
-            unsigned res[3] = { 2, 3, 2 };
-            if (fi->mesh)
-                res[1] = 2;
+            unsigned res[3] = { 2, 2 + (pick & 1), 2 };
             memset(&err, 'X', sizeof err);
+            const api_format_info *fi = api_format_info_of((api_format)f);
             api_output *o = api_output_open(sol, id, have ? &props : NULL, (api_format)f, res, &err);
             if (!o) {
                 fuzz_check_error(&err);
