@@ -168,6 +168,9 @@ build/bench/bench_log: bench/bench_log.c build/obj/server/log.o
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Iserver $^ $(LDLIBS) -lpthread -o $@
 
+# bench_cost measures the heap's peak by wrapping malloc.
+build/bench/bench_cost: LDLIBS += -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free
+
 build/bench/mhd_minimal: bench/mhd_minimal.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $< $(MHD) -lpthread -o $@

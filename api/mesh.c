@@ -85,8 +85,14 @@ static double sample(size_t i, size_t n)
     return n > 1 ? (double)i / (double)(n - 1) : 0.5;
 }
 
-/* Positions of a face, na x nb, fast index first, into out (3 na nb floats). */
-static int sample_face(const pde_solution *sol, const face *f, const unsigned res[3], float *out)
+static int stopped(const pde_cancel *c)
+{
+    return c && c->stop && c->stop(c->arg);
+}
+
+/* Positions of a face, na x nb, fast index first, into out (3 na nb floats); 1 when cancelled. */
+static int sample_face(const pde_solution *sol, const face *f, const unsigned res[3], const pde_cancel *cancel,
+                       float *out)
 {
     size_t nu = res[0], nv = res[1], nw = res[2];
     double *us = malloc((nu + nv) * sizeof *us), *vs = us ? us + nu : NULL;
@@ -108,13 +114,18 @@ static int sample_face(const pde_solution *sol, const face *f, const unsigned re
     free(us);
     if (st != PDE_OK)
         return -1;
-    if (f->axis == 2)
-        pde_grid_plane(g, fixed, out);
-    else
-        for (size_t k = 0; k < nw; k++)
-            pde_grid_plane(g, sample(k, nw), out + 3 * k * f->na);
+    int rc = 0;
+    if (f->axis == 2) {
+        for (size_t j = 0; j < nv && !rc; j++)       /* a row at a time, to poll between rows */
+            if (!(rc = stopped(cancel)))
+                pde_grid_rows(g, fixed, j, j + 1, out + 3 * j * nu, NULL, NULL, NULL);
+    } else {
+        for (size_t k = 0; k < nw && !rc; k++)
+            if (!(rc = stopped(cancel)))
+                pde_grid_plane(g, sample(k, nw), out + 3 * k * f->na);
+    }
     pde_grid_free(g);
-    return 0;
+    return rc;
 }
 
 #define DEAD 0xff    /* rface mark of a dropped triangle */
@@ -179,7 +190,11 @@ void api_mesh_free(api_mesh *m)
     memset(m, 0, sizeof *m);
 }
 
-int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out, api_error *err)
+/* Polls every 8192 steps of a pass over points or triangles. */
+#define POLL(i) ((i) % 8192 == 8191 && stopped(cancel))
+
+int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_mesh *out,
+                   api_error *err)
 {
     /* e_v x e_w = +e_u, e_u x e_w = -e_v, e_u x e_v = +e_w: which faces must reverse. */
     face faces[6];
@@ -204,7 +219,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out
     uint32_t *chain = malloc(nraw * sizeof *chain);
     u64map cells = { 0 }, tris = { 0 };
     memset(out, 0, sizeof *out);
-    int rc = -1;
+    int rc = -1, cancelled = 0;
     const char *why = "out of memory building the mesh";
     if (!raw || !rtri || !rface || !wid || !wpos || !chain)
         goto done;
@@ -213,8 +228,11 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out
     size_t base = 0, nt = 0;
     for (int fi = 0; fi < 6; fi++) {
         const face *f = &faces[fi];
-        if (sample_face(sol, f, res, raw + 3 * base))
+        int r = sample_face(sol, f, res, cancel, raw + 3 * base);
+        if (r) {
+            cancelled = r > 0;
             goto done;
+        }
         for (size_t b = 0; b + 1 < f->nb; b++)
             for (size_t a = 0; a + 1 < f->na; a++) {
                 uint32_t v00 = (uint32_t)(base + b * f->na + a), v10 = v00 + 1;
@@ -247,6 +265,10 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out
         goto done;
     size_t npos = 0;
     for (size_t i = 0; i < nraw; i++) {
+        if (POLL(i)) {
+            cancelled = 1;
+            goto done;
+        }
         const float *p = raw + 3 * i;
         int64_t c[3];
         int span[3][2];     /* neighbouring cells worth a look: only within eps of a side */
@@ -286,6 +308,10 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out
 
     /* 3. Drop collapsed triangles; cancel coincident pairs of opposite orientation. */
     for (size_t t = 0; t < nt; t++) {
+        if (POLL(t)) {
+            cancelled = 1;
+            goto done;
+        }
         uint32_t *w = &rtri[3 * t];
         double n[3];
         tri_normal(raw + 3 * w[0], raw + 3 * w[1], raw + 3 * w[2], n);
@@ -316,6 +342,11 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out
         goto done;
     }
     for (size_t t = 0; t < nt; t++) {
+        if (POLL(t)) {
+            free(mask);
+            cancelled = 1;
+            goto done;
+        }
         if (rface[t] == DEAD)
             continue;
         uint8_t m = mask[rtri[3 * t]] & mask[rtri[3 * t + 1]] & mask[rtri[3 * t + 2]];
@@ -422,7 +453,9 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], api_mesh *out
 done:
     if (rc) {
         api_mesh_free(out);
-        api_fail(err, "", "%s", why);
+        api_fail(err, "", "%s", cancelled ? "cancelled" : why);
+        if (cancelled && err)
+            err->status = API_STATUS_CANCELLED;
     }
     free(raw);
     free(rtri);

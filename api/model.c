@@ -471,10 +471,21 @@ const pde_model *api_model_get(const api_model *m)
 
 int api_solve(const api_model *m, pde_solution **out, api_error *err)
 {
+    return api_solve_ex(m, NULL, out, err);
+}
+
+int api_solve_ex(const api_model *m, const pde_cancel *cancel, pde_solution **out, api_error *err)
+{
     pde_diag d;
-    pde_status st = pde_solve(&m->m, out, &d);
+    pde_solve_opts o = { .cancel = cancel };
+    pde_status st = pde_solve_ex(&m->m, &o, out, &d);
     if (st == PDE_OK)
         return 0;
+    if (st == PDE_ERR_CANCELLED) {
+        api_fail(err, "", "cancelled");
+        err->status = API_STATUS_CANCELLED;
+        return (int)st;
+    }
     char ptr[160] = "";
     if (m->from_params)
         snprintf(ptr, sizeof ptr, d.term < 0 && d.field[0] ? "/params/%s/%d" : "/params", d.field, d.component);

@@ -37,13 +37,17 @@
 /*
  * A JSON pointer (RFC 6901) to the field at fault, "" for the whole document,
  * a sentence, and the HTTP status it calls for: 400 for text that is not
- * JSON, 413 for a document over a size limit, 422 for anything else wrong.
+ * JSON, 413 for a document over a size limit, 422 for anything else wrong,
+ * and API_STATUS_CANCELLED (503) with the message "cancelled" when a call
+ * given a pde_cancel (pde.h) was asked to stop.
  */
 typedef struct {
     char pointer[160];
     char message[320];
     int status;
 } api_error;
+
+#define API_STATUS_CANCELLED 503
 
 #define API_MAX_TERMS 4096    /* terms in one component's boundary or force list */
 #define API_MAX_POINTS 1000000
@@ -70,6 +74,8 @@ const pde_model *api_model_get(const api_model *m);
 
 /* pde_solve() with the core's diagnosis turned into a JSON pointer. Returns 0 or the pde_status. */
 int api_solve(const api_model *m, pde_solution **out, api_error *err);
+/* The same, polling cancel (NULL: never) between modes; stopped: API_STATUS_CANCELLED. */
+int api_solve_ex(const api_model *m, const pde_cancel *cancel, pde_solution **out, api_error *err);
 
 /*
  * Parses [[u, v, w], ...] into a new array of 3 n doubles, stored in *out

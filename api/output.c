@@ -18,7 +18,10 @@
 #include "numfmt.h"
 #include "output.h"
 
-#define CHUNK_POINTS 65536
+/* One call of api_output_read() samples at most CHUNK_POINTS points, or rows worth about CHUNK_WORK
+ * multiply-adds (about 1 ms), whichever is fewer, but at least one row. */
+#define CHUNK_POINTS 16384
+#define CHUNK_WORK (1u << 21)
 
 static const api_format_info formats[API_FMT_COUNT] = {
     { "json", "application/json", ".json", 0 },
@@ -266,18 +269,37 @@ static cJSON *numbers(const double *v, int n)
     return a;
 }
 
-/* The caller's properties, or computed now. */
-static const pde_props *props_of(api_output *o)
+/* -1 with err set to the cancellation of api_error (model.h). */
+static int cancelled(api_error *err)
 {
-    if (!o->have_props && pde_properties(o->sol, NULL, &o->props) != PDE_OK)
-        return NULL;
+    api_fail(err, "", "cancelled");
+    err->status = API_STATUS_CANCELLED;
+    return -1;
+}
+
+static int stopped(const pde_cancel *c)
+{
+    return c && c->stop && c->stop(c->arg);
+}
+
+/* The caller's properties, or computed now; NULL with err when cancelled, NULL alone otherwise. */
+static const pde_props *props_of(api_output *o, const pde_cancel *cancel, api_error *err)
+{
+    pde_props_opts opts = { .cancel = cancel };
+    if (!o->have_props) {
+        pde_status st = pde_properties(o->sol, &opts, &o->props);
+        if (st == PDE_ERR_CANCELLED)
+            cancelled(err);
+        if (st != PDE_OK)
+            return NULL;
+    }
     o->have_props = 1;
     return &o->props;
 }
 
-static int json_document(api_output *o)
+static int json_document(api_output *o, const pde_cancel *cancel, api_error *err)
 {
-    const pde_props *props = props_of(o);
+    const pde_props *props = props_of(o, cancel, err);
     if (!props)
         return -1;
     cJSON *root = cJSON_CreateObject(), *comps = cJSON_AddObjectToObject(root, "components");
@@ -289,6 +311,10 @@ static int json_document(api_output *o)
         size_t nm;
         const pde_mode *md = pde_solution_modes(o->sol, c, &nm);
         for (size_t m = 0; modes && m < nm; m++) {
+            if (m % 64 == 63 && stopped(cancel)) {
+                cJSON_Delete(root);
+                return cancelled(err);
+            }
             cJSON *mo = cJSON_CreateObject(), *terms;
             cJSON_AddItemToArray(modes, mo);
             cJSON_AddItemToObject(mo, "u", api_factor_tree(md[m].u));
@@ -344,7 +370,18 @@ static int grid_open(api_output *o)
     free(us);
     if (st != PDE_OK)
         return -1;
-    o->chunk = CHUNK_POINTS / nu ? CHUNK_POINTS / nu : 1;
+    /* A row costs about (3 + nu) multiply-adds per mode and component (nu per distinct u-factor). */
+    double row = 0.0;
+    for (int c = 0; c < 3; c++) {
+        size_t nm;
+        pde_solution_modes(o->sol, c, &nm);
+        row += (double)nm * (3.0 + (double)nu) * (o->fmt == API_FMT_VTS ? 4.0 : 1.0);
+    }
+    o->chunk = CHUNK_POINTS / nu;
+    if (row > 0 && (double)o->chunk * row > CHUNK_WORK)
+        o->chunk = (size_t)(CHUNK_WORK / row);
+    if (o->chunk == 0)
+        o->chunk = 1;
     size_t n = 3 * nu * o->chunk;
     o->xyz = malloc(n * sizeof(float));
     if (o->fmt == API_FMT_VTS) {
@@ -481,9 +518,9 @@ static int fill_vts(api_output *o)
 
 /* ---- meshes ---- */
 
-static int mesh_open(api_output *o, api_error *err)
+static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
 {
-    if (api_mesh_build(o->sol, o->res, &o->mesh, err))
+    if (api_mesh_build(o->sol, o->res, cancel, &o->mesh, err))
         return -1;
     if (o->mesh.ntris == 0) {
         api_fail(err, "", "the solid has no skin: every face collapses to a line or a point");
@@ -502,7 +539,7 @@ static int mesh_open(api_output *o, api_error *err)
     memcpy(o->blob, o->mesh.pos, 12 * nv);
     memcpy(o->blob + 12 * nv, o->mesh.nrm, 12 * nv);
     memcpy(o->blob + 24 * nv, o->mesh.tri, 12 * nt);
-    const pde_props *props = props_of(o);
+    const pde_props *props = props_of(o, cancel, err);
     if (!props)
         return -1;
     char *pj = api_props_json(props);
@@ -667,7 +704,7 @@ static int fill_stl(api_output *o)
 /* ---- the stream ---- */
 
 api_output *api_output_open(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
-                            const unsigned res[3], api_error *err)
+                            const unsigned res[3], const pde_cancel *cancel, api_error *err)
 {
     api_error local;
     if (!err)
@@ -707,10 +744,10 @@ api_output *api_output_open(const pde_solution *sol, const char *id, const pde_p
     case API_FMT_GLTF:
     case API_FMT_GLB:
     case API_FMT_STL:
-        rc = mesh_open(o, err);
+        rc = mesh_open(o, cancel, err);
         break;
     case API_FMT_JSON:
-        rc = json_document(o);
+        rc = json_document(o, cancel, err);
         o->size = (long long)o->len;
         o->phase = 1;
         break;
@@ -748,6 +785,8 @@ long api_output_read(api_output *o, char *buf, size_t max)
     size_t done = 0;
     while (done < max) {
         if (o->pos == o->len) {
+            if (done)
+                break;      /* one piece of work per call: a caller can poll between calls */
             if (o->fmt != API_FMT_JSON)
                 o->pos = o->len = 0;
             int r = fill(o);

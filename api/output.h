@@ -14,7 +14,7 @@
  *
  * USAGE
  *
- *   api_output *o = api_output_open(sol, id, NULL, API_FMT_GLB, res, &err);
+ *   api_output *o = api_output_open(sol, id, NULL, API_FMT_GLB, res, NULL, &err);
  *   long n;
  *   while ((n = api_output_read(o, buf, sizeof buf)) > 0) fwrite(buf, 1, n, f);
  *   api_output_free(o);
@@ -59,13 +59,24 @@ typedef struct api_output api_output;
 /*
  * id: the model's id (id.h), or NULL. props: the solution's properties if the
  * caller has them (json, gltf and glb carry them), or NULL to compute them.
- * NULL and err on failure (out of memory, a mesh out of range).
+ * NULL and err on failure (out of memory, a mesh out of range). The long work
+ * happens here: the properties it computes, the mesh (gltf, glb, stl), the
+ * whole json document; cancel (NULL: never) is polled through it, and when
+ * it stops the call frees everything and err has status API_STATUS_CANCELLED.
+ * Grid formats only set up their sampling tables here (api/cost.h's bytes).
  */
 api_output *api_output_open(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
-                            const unsigned res[3], api_error *err);
+                            const unsigned res[3], const pde_cancel *cancel, api_error *err);
 /* The total size in bytes, or -1 when it is known only at the end (json, grid). */
 long long api_output_size(const api_output *o);
-/* Up to max bytes into buf; returns the count, 0 at the end, or -1 out of memory. */
+/*
+ * Up to max bytes into buf; returns the count, 0 at the end, or -1 out of
+ * memory. Each call does at most one bounded piece of work, so a server can
+ * poll a deadline between calls: up to 16384 sampled points and about 2^21
+ * multiply-adds of sampling (at least one row), 4096 STL triangles, 48 KB of
+ * base64 or 1 MB of copying. It may return fewer than max bytes before the
+ * end; read until it returns 0.
+ */
 long api_output_read(api_output *o, char *buf, size_t max);
 void api_output_free(api_output *o);
 

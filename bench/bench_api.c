@@ -105,7 +105,7 @@ int main(void)
     for (int r = 0; r < RUNS; r++) {
         double t0 = now();
         api_error err;
-        api_output *o = api_output_open(sol, NULL, NULL, API_FMT_GRID, res, &err);
+        api_output *o = api_output_open(sol, NULL, NULL, API_FMT_GRID, res, NULL, &err);
         long n;
         bytes = 0;
         while ((n = api_output_read(o, chunk, sizeof chunk)) > 0)
@@ -123,7 +123,7 @@ int main(void)
     for (int r = 0; r < RUNS; r++) {
         double t0 = now();
         api_error err;
-        api_output *o = api_output_open(sol, "bench", NULL, API_FMT_GLB, mres, &err);
+        api_output *o = api_output_open(sol, "bench", NULL, API_FMT_GLB, mres, NULL, &err);
         long n;
         bytes = 0;
         while ((n = api_output_read(o, chunk, sizeof chunk)) > 0)

@@ -41,6 +41,12 @@ struct pde_solution {
 
 extern const char *const pde_comp_name[3];   /* "x", "y", "z" */
 
+/* Non-zero when the caller asks the running call to stop (pde.h). */
+static inline int pde_stopped(const pde_cancel *c)
+{
+    return c && c->stop && c->stop(c->arg);
+}
+
 /* Fills d (if not NULL) and returns st. */
 pde_status pde_fail(pde_diag *d, pde_status st, int comp, int in_force, long term, const char *field,
                     const char *fmt, ...) __attribute__((format(printf, 7, 8)));

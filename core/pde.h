@@ -49,11 +49,27 @@ typedef enum {
     PDE_ERR_ILLPOSED,  /* the equation is not fourth order in w (c_i = 0) */
     PDE_ERR_SINGULAR,  /* the boundary problem has no unique solution */
     PDE_ERR_RANGE,     /* a value of the model or solution overflows a double */
-    PDE_ERR_LIMIT      /* the model exceeds a size limit below */
+    PDE_ERR_LIMIT,     /* the model exceeds a size limit below */
+    PDE_ERR_CANCELLED  /* the caller's pde_cancel asked the call to stop */
 } pde_status;
 
 /* A sentence describing the status; never NULL. */
 const char *pde_strerror(pde_status status);
+
+/*
+ * Cooperative cancellation. The long calls (pde_solve_ex, pde_properties,
+ * and api/'s mesh and output builders) call stop(arg) between bounded pieces
+ * of work, a mode of a solve or a row of a sweep: about 1 to 5 ms of work at
+ * most between two polls. Once stop() returns non-zero the call frees what it
+ * made and returns PDE_ERR_CANCELLED, leaving its out-parameters untouched.
+ * stop() runs on the caller's thread; a deadline check (clock_gettime) or an
+ * atomic flag is what it is for. A NULL pde_cancel *, or a NULL stop, never
+ * stops.
+ */
+typedef struct {
+    int (*stop)(void *arg);
+    void *arg;
+} pde_cancel;
 
 /* Limits that keep one solve bounded in time and memory. */
 #define PDE_MAX_POW   100    /* largest n of a t^n factor */
@@ -118,6 +134,14 @@ typedef struct pde_solution pde_solution;
  * whose factor is identically zero (sin 0, sinh 0) contributes nothing.
  */
 pde_status pde_solve(const pde_model *model, pde_solution **out, pde_diag *diag);
+
+/* A zeroed options struct (or NULL) gives pde_solve(). cancel is polled between modes. */
+typedef struct {
+    const pde_cancel *cancel;
+} pde_solve_opts;
+
+pde_status pde_solve_ex(const pde_model *model, const pde_solve_opts *opts, pde_solution **out,
+                        pde_diag *diag);
 
 void pde_solution_free(pde_solution *sol);
 
@@ -210,9 +234,13 @@ typedef struct {
 
 /* A zeroed options struct gives the defaults. */
 typedef struct {
-    int res;   /* samples per axis for bounds, det J and residuals; 0: 17 */
+    int res;                    /* samples per axis for bounds, det J and residuals; 0: 17 */
+    const pde_cancel *cancel;   /* polled between rows of the sweeps; NULL never stops */
 } pde_props_opts;
 
 pde_status pde_properties(const pde_solution *sol, const pde_props_opts *opts, pde_props *out);
+
+/* The Gauss-Legendre nodes per axis that pde_properties() integrates over (for api/cost.h). */
+void pde_properties_nodes(const pde_solution *sol, size_t nodes[3]);
 
 #endif

@@ -23,6 +23,35 @@ static const double gl_w[GL_N] = { 0.1012285362903763, 0.2223810344533745, 0.313
                                    0.2223810344533745, 0.1012285362903763 };
 #define MAX_PANELS 64
 #define MAX_NODES (2u << 20)   /* quadrature nodes in all, to bound the time */
+#define POLISH_EVALS 400       /* evaluations of one compass search, at most */
+
+/*
+ * Cancellation: the caller's stop() is polled once per POLL_WORK units of
+ * work, a unit being a mode or a coefficient of a w-term evaluated at one
+ * point (about 10 ns), so that small solids pay nothing for it and big ones
+ * are polled about every millisecond.
+ */
+#define POLL_WORK 65536
+
+typedef struct {
+    const pde_cancel *cancel;
+    size_t point;     /* units of one pde_eval_d() */
+    size_t modes;     /* modes of the three components */
+    size_t work;
+    int stopped;
+} poller;
+
+/* Counts units of work done; 1 once the caller has asked to stop. */
+static int poll_after(poller *p, size_t units)
+{
+    if (p->stopped)
+        return 1;
+    p->work += units;
+    if (p->work < POLL_WORK)
+        return 0;
+    p->work = 0;
+    return p->stopped = pde_stopped(p->cancel);
+}
 
 static double det3(const double a[3], const double b[3], const double c[3])
 {
@@ -83,10 +112,14 @@ static double objective(const pde_solution *s, int what, double sign, const doub
 }
 
 /* Compass search for a minimum of the objective in the unit cube, from p. */
-static double polish(const pde_solution *s, int what, double sign, double p[3], double step)
+static double polish(const pde_solution *s, int what, double sign, double p[3], double step, poller *pl)
 {
+    if (poll_after(pl, pl->point))
+        return 0.0;
     double best = objective(s, what, sign, p);
-    for (int evals = 0; step > 1e-7 && evals < 400;) {
+    for (int evals = 0; step > 1e-7 && evals < POLISH_EVALS;) {
+        if (poll_after(pl, pl->point))
+            return 0.0;
         int moved = 0;
         for (int a = 0; a < 3 && !moved; a++)
             for (int d = -1; d <= 1 && !moved; d += 2) {
@@ -130,8 +163,8 @@ static void note_point(extremes *e, const double p[3], const double x[3], double
 /* Walks a grid over us x vs x ws, noting extremes; with weights, integrates det J. */
 static pde_status sweep(const pde_solution *s, const double *us, size_t nu, const double *vs,
                         size_t nv, const double *ws, size_t nw, const double *wts_u,
-                        const double *wts_v, const double *wts_w, extremes *e, double *vol,
-                        double *svol)
+                        const double *wts_v, const double *wts_w, poller *pl, extremes *e,
+                        double *vol, double *svol)
 {
     pde_grid *g;
     pde_status st = pde_grid_create(s, us, nu, vs, nv, &g);
@@ -141,6 +174,11 @@ static pde_status sweep(const pde_solution *s, const double *us, size_t nu, cons
     for (size_t k = 0; k < nw; k++) {
         grid_set_w(g, ws[k]);
         for (size_t j = 0; j < nv; j++) {
+            /* A row: coefficients of every mode, four arrays of nu multiply-adds per u-factor. */
+            if (poll_after(pl, (j ? 0 : pl->point) + pl->modes * (4 + nu) / 16)) {
+                pde_grid_free(g);
+                return PDE_ERR_CANCELLED;
+            }
             grid_row(g, j, GRID_X | GRID_XU | GRID_XV | GRID_XW);
             for (size_t i = 0; i < nu; i++) {
                 double x[3], a[3], b[3], c[3];
@@ -170,14 +208,16 @@ static pde_status sweep(const pde_solution *s, const double *us, size_t nu, cons
 }
 
 /* Largest relative error of the boundary conditions of each component, on res x res points. */
-static double bc_residual(const pde_solution *s, int res)
+static double bc_residual(const pde_solution *s, int res, poller *pl)
 {
     double worst = 0.0;
     for (int c = 0; c < 3; c++) {
         const comp_solution *cs = &s->comp[c];
         double err = 0.0, scale = 0.0;
-        for (int i = 0; i < res; i++)
+        for (int i = 0; i < res; i++) {
             for (int j = 0; j < res; j++) {
+                if (poll_after(pl, 2 * pl->point + cs->nbterms))
+                    return 0.0;
                 double u = (double)i / (res - 1), v = (double)j / (res - 1);
                 double g[4] = { 0, 0, 0, 0 };
                 for (size_t t = 0; t < cs->nbterms; t++) {
@@ -196,21 +236,25 @@ static double bc_residual(const pde_solution *s, int res)
                                              fmax(fabs(x[c]), fabs(xw[c]))));
                 }
             }
+        }
         worst = fmax(worst, scale > 0.0 ? err / scale : err);
     }
     return worst;
 }
 
 /* Largest |a x_uuuu + b x_vvvv + c x_wwww - p| relative to its terms, inside the cube. */
-static double pde_residual(const pde_solution *s, int res)
+static double pde_residual(const pde_solution *s, int res, poller *pl)
 {
     double worst = 0.0;
     for (int c = 0; c < 3; c++) {
         const comp_solution *cs = &s->comp[c];
         double err = 0.0, scale = 0.0;
         for (int i = 0; i < res; i++)
-            for (int j = 0; j < res; j++)
+            for (int j = 0; j < res; j++) {
                 for (int k = 0; k < res; k++) {
+                    /* Three derivatives of one component, the fourth in w costing about five h's. */
+                    if (poll_after(pl, 3 * pl->point / 2 + cs->nfterms))
+                        return 0.0;
                     double u = (i + 0.5) / res, v = (j + 0.5) / res, w = (k + 0.5) / res;
                     double tu = cs->a * pde_eval_partial(s, c, u, v, w, 4, 0, 0);
                     double tv = cs->b * pde_eval_partial(s, c, u, v, w, 0, 4, 0);
@@ -219,9 +263,18 @@ static double pde_residual(const pde_solution *s, int res)
                     err = fmax(err, fabs(tu + tv + tw - p));
                     scale = fmax(scale, fabs(tu) + fabs(tv) + fabs(tw) + fabs(p));
                 }
+            }
         worst = fmax(worst, scale > 0.0 ? err / scale : err);
     }
     return worst;
+}
+
+void pde_properties_nodes(const pde_solution *s, size_t nodes[3])
+{
+    int np[3];
+    panel_counts(s, np);
+    for (int a = 0; a < 3; a++)
+        nodes[a] = (size_t)np[a] * GL_N;
 }
 
 pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde_props *out)
@@ -229,6 +282,15 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     if (!s || !out)
         return PDE_ERR_INVALID;
     int res = opts && opts->res > 0 ? opts->res : 17;
+    poller pl = { .cancel = opts ? opts->cancel : NULL };
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
+            const pde_mode *md = &s->comp[c].modes[m];
+            pl.modes++;
+            pl.point++;
+            for (size_t k = 0; k < md->nterms; k++)
+                pl.point += (size_t)md->terms[k].deg + 1;
+        }
     if (res < 2 || res > 1025)
         return PDE_ERR_INVALID;
     int np[3];
@@ -263,27 +325,32 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     e.jmax = -DBL_MAX;
     double vol, svol;
     pde_status st = sweep(s, node[0], nq[0], node[1], nq[1], node[2], nq[2], wt[0], wt[1], wt[2],
-                          &e, &vol, &svol);
+                          &pl, &e, &vol, &svol);
     if (st == PDE_OK)
-        st = sweep(s, uni, res, uni, res, uni, res, NULL, NULL, NULL, &e, NULL, NULL);
+        st = sweep(s, uni, res, uni, res, uni, res, NULL, NULL, NULL, &pl, &e, NULL, NULL);
     free(buf);
     if (st != PDE_OK)
         return st;
 
+    /* Into a local result, so that a cancelled call leaves *out untouched. */
+    pde_props r;
     double step = 1.0 / (res - 1);
     for (int c = 0; c < 3; c++) {
-        out->bbox_min[c] = polish(s, c, 1.0, e.lo_at[c], step);
-        out->bbox_max[c] = polish(s, c, -1.0, e.hi_at[c], step);
+        r.bbox_min[c] = polish(s, c, 1.0, e.lo_at[c], step, &pl);
+        r.bbox_max[c] = polish(s, c, -1.0, e.hi_at[c], step, &pl);
     }
-    out->detj_min = polish(s, 3, 1.0, e.jmin_at, step);
-    out->detj_max = polish(s, 3, -1.0, e.jmax_at, step);
+    r.detj_min = polish(s, 3, 1.0, e.jmin_at, step, &pl);
+    r.detj_max = polish(s, 3, -1.0, e.jmax_at, step, &pl);
     for (int a = 0; a < 3; a++)
-        out->detj_min_at[a] = e.jmin_at[a];
-    double tol = 1e-9 * fmax(fabs(out->detj_min), fabs(out->detj_max));
-    out->folds = out->detj_min < -tol && out->detj_max > tol;
-    out->volume = vol;
-    out->signed_volume = svol;
-    out->bc_residual = bc_residual(s, res);
-    out->pde_residual = pde_residual(s, res < 9 ? res : 9);
+        r.detj_min_at[a] = e.jmin_at[a];
+    double tol = 1e-9 * fmax(fabs(r.detj_min), fabs(r.detj_max));
+    r.folds = r.detj_min < -tol && r.detj_max > tol;
+    r.volume = vol;
+    r.signed_volume = svol;
+    r.bc_residual = bc_residual(s, res, &pl);
+    r.pde_residual = pde_residual(s, res < 9 ? res : 9, &pl);
+    if (pl.stopped)
+        return PDE_ERR_CANCELLED;
+    *out = r;
     return PDE_OK;
 }

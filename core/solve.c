@@ -36,6 +36,7 @@ const char *pde_strerror(pde_status status)
     case PDE_ERR_SINGULAR: return "singular boundary problem";
     case PDE_ERR_RANGE: return "value out of range";
     case PDE_ERR_LIMIT: return "model too large";
+    case PDE_ERR_CANCELLED: return "cancelled";
     }
     return "unknown status";
 }
@@ -415,7 +416,8 @@ static pde_status collect(arena *s, const pde_component *c, int ci, mode **out, 
 
 /* Solves one mode: forcing from its force terms and its chain parents, then the boundary fit. */
 static pde_status solve_mode(arena *s, plan_cache *plans, const pde_component *c, int ci, mode *modes,
-                             size_t nmodes, mode *m, const long *next_force, pde_diag *diag)
+                             size_t nmodes, mode *m, const long *next_force, const pde_cancel *cancel,
+                             pde_diag *diag)
 {
     double mu = c->a * factor_lambda(m->u) + c->b * factor_lambda(m->v);
     double e = -mu / c->c;                                   /* eq. (8) */
@@ -425,7 +427,11 @@ static pde_status solve_mode(arena *s, plan_cache *plans, const pde_component *c
                     pde_comp_name[ci]);
     ep q = { 0 };
     pde_status st;
+    unsigned polls = 0;
     for (long j = m->first_force; j >= 0; j = next_force[j]) {
+        /* ep_add merges by a linear search: many terms on one mode cost their square. */
+        if (++polls % 64 == 0 && pde_stopped(cancel))
+            return PDE_ERR_CANCELLED;
         const pde_fterm *t = &c->fterms[j];
         pde_factor ku, kv;
         double su, sv;
@@ -479,7 +485,7 @@ static pde_status solve_mode(arena *s, plan_cache *plans, const pde_component *c
 }
 
 static pde_status solve_component(arena *mem, arena *s, plan_cache *plans, const pde_model *model,
-                                  int ci, comp_solution *out, pde_diag *diag)
+                                  int ci, const pde_cancel *cancel, comp_solution *out, pde_diag *diag)
 {
     const pde_component *c = &model->comp[ci];
     pde_status st = model_check_component(c, ci, diag);
@@ -491,9 +497,14 @@ static pde_status solve_component(arena *mem, arena *s, plan_cache *plans, const
     long *next_force = NULL;
     if ((st = collect(s, c, ci, &modes, &n, &next_force, diag)) != PDE_OK)
         return st;
-    for (size_t i = 0; i < n; i++)
-        if ((st = solve_mode(s, plans, c, ci, modes, n, &modes[i], next_force, diag)) != PDE_OK)
+    if (pde_stopped(cancel))
+        return PDE_ERR_CANCELLED;
+    for (size_t i = 0; i < n; i++) {
+        if ((st = solve_mode(s, plans, c, ci, modes, n, &modes[i], next_force, cancel, diag)) != PDE_OK)
             return st;
+        if (pde_stopped(cancel))
+            return PDE_ERR_CANCELLED;
+    }
 
     out->a = c->a;
     out->b = c->b;
@@ -511,6 +522,8 @@ static pde_status solve_component(arena *mem, arena *s, plan_cache *plans, const
     out->nfterms = c->nfterms;
     size_t kept = 0;
     for (size_t i = 0; i < n; i++) {
+        if (i % 256 == 255 && pde_stopped(cancel))
+            return PDE_ERR_CANCELLED;
         pde_mode *pm = &out->modes[kept];
         pm->u = modes[i].u;
         pm->v = modes[i].v;
@@ -529,6 +542,13 @@ static pde_status solve_component(arena *mem, arena *s, plan_cache *plans, const
 
 pde_status pde_solve(const pde_model *model, pde_solution **out, pde_diag *diag)
 {
+    return pde_solve_ex(model, NULL, out, diag);
+}
+
+pde_status pde_solve_ex(const pde_model *model, const pde_solve_opts *opts, pde_solution **out,
+                        pde_diag *diag)
+{
+    const pde_cancel *cancel = opts ? opts->cancel : NULL;
     if (diag)
         memset(diag, 0, sizeof *diag), diag->component = -1, diag->term = -1;
     if (!model || !out)
@@ -538,11 +558,11 @@ pde_status pde_solve(const pde_model *model, pde_solution **out, pde_diag *diag)
     pde_solution *sol = arena_alloc(&mem, sizeof *sol);
     pde_status st = sol ? PDE_OK : PDE_ERR_NOMEM;
     for (int ci = 0; ci < 3 && st == PDE_OK; ci++)
-        st = solve_component(&mem, &scratch, &plans, model, ci, &sol->comp[ci], diag);
+        st = solve_component(&mem, &scratch, &plans, model, ci, cancel, &sol->comp[ci], diag);
     arena_free(&scratch);
     if (st != PDE_OK) {
-        if (st == PDE_ERR_NOMEM && diag && !diag->message[0])
-            snprintf(diag->message, sizeof diag->message, "out of memory");
+        if ((st == PDE_ERR_NOMEM || st == PDE_ERR_CANCELLED) && diag && !diag->message[0])
+            snprintf(diag->message, sizeof diag->message, "%s", pde_strerror(st));
         arena_free(&mem);
         return st;
     }

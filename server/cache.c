@@ -24,7 +24,7 @@ struct srv_entry {
     api_error err;                 /* FAILED: why */
     pthread_cond_t done;           /* SOLVING -> READY or FAILED */
     srv_entry *hnext, *prev, *next;
-    pthread_once_t props_once;
+    pthread_mutex_t props_lock;   /* one computes the properties; the others wait for them */
     pde_props props;
     int props_ok;
 };
@@ -64,6 +64,7 @@ static void entry_free(srv_entry *e)
 {
     pde_solution_free(e->sol);
     pthread_cond_destroy(&e->done);
+    pthread_mutex_destroy(&e->props_lock);
     free(e);
 }
 
@@ -164,6 +165,13 @@ srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void 
     e = calloc(1, sizeof *e);
     if (!e || pthread_cond_init(&e->done, NULL)) {
         free(e);
+        e = NULL;
+    } else if (pthread_mutex_init(&e->props_lock, NULL)) {
+        pthread_cond_destroy(&e->done);
+        free(e);
+        e = NULL;
+    }
+    if (!e) {
         pthread_mutex_unlock(&c->lock);
         api_fail(err, "", "out of memory");
         err->status = 500;
@@ -174,7 +182,6 @@ srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void 
     e->state = SOLVING;
     e->refs = 1;
     e->linked = 1;
-    e->props_once = (pthread_once_t)PTHREAD_ONCE_INIT;
     size_t b = bucket_of(e->id);
     e->hnext = c->bucket[b];
     c->bucket[b] = e;
@@ -239,20 +246,27 @@ const char *srv_entry_id(const srv_entry *e)
     return e->id;
 }
 
-/* pthread_once runs a function without arguments: the entry being initialised travels in a thread-local. */
-static _Thread_local srv_entry *props_target;
-
-static void compute_props(void)
+const pde_props *srv_entry_props(srv_entry *e, const pde_cancel *cancel, int *cancelled)
 {
-    srv_entry *e = props_target;
-    e->props_ok = pde_properties(e->sol, NULL, &e->props) == PDE_OK;
+    pthread_mutex_lock(&e->props_lock);
+    pde_status st = PDE_OK;
+    if (!e->props_ok) {
+        pde_props_opts o = { .cancel = cancel };
+        st = pde_properties(e->sol, &o, &e->props);
+        e->props_ok = st == PDE_OK;   /* a cancelled computation leaves them for the next request */
+    }
+    pthread_mutex_unlock(&e->props_lock);
+    *cancelled = st == PDE_ERR_CANCELLED;
+    return e->props_ok ? &e->props : NULL;
 }
 
-const pde_props *srv_entry_props(srv_entry *e)
+/* Whether the properties are there already (then they cost nothing). */
+int srv_entry_has_props(srv_entry *e)
 {
-    props_target = e;
-    pthread_once(&e->props_once, compute_props);
-    return e->props_ok ? &e->props : NULL;
+    pthread_mutex_lock(&e->props_lock);
+    int ok = e->props_ok;
+    pthread_mutex_unlock(&e->props_lock);
+    return ok;
 }
 
 void srv_cache_stats_get(srv_cache *c, srv_cache_stats *out)

@@ -40,8 +40,14 @@ void srv_cache_release(srv_cache *c, srv_entry *e);
 
 const pde_solution *srv_entry_solution(const srv_entry *e);
 const char *srv_entry_id(const srv_entry *e);
-/* The properties, computed once on first use; NULL if out of memory. */
-const pde_props *srv_entry_props(srv_entry *e);
+/*
+ * The properties, computed on first use, once: concurrent callers wait for
+ * the first. NULL if out of memory, or cancelled (then *cancelled is 1, and
+ * the next call computes them again).
+ */
+const pde_props *srv_entry_props(srv_entry *e, const pde_cancel *cancel, int *cancelled);
+/* 1 if the properties are computed already. */
+int srv_entry_has_props(srv_entry *e);
 
 void srv_cache_stats_get(srv_cache *c, srv_cache_stats *out);
 

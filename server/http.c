@@ -29,6 +29,7 @@
 
 #include "http.h"
 #include "internal.h"
+#include "strict.h"
 
 /* Discarding a refused body: at most this many bytes, and this long. */
 #define DRAIN_BYTES (16u << 20)
@@ -53,17 +54,41 @@ static void make_key(srv_req *r)
 
 /* ---- the first call: what the headers decide ---- */
 
+/* What a connection carries from request to request. */
 typedef struct {
-    int lengths, encodings;
+    int nul;   /* the request's path or query held %00 */
+} conn_state;
+
+
+typedef struct {
+    int lengths, encodings, hosts;
     srv_req *r;
-    char msg[200];
-    int bad;
+    const char *bad;   /* what is wrong with a header, or NULL */
 } header_scan;
 
-static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+/* RFC 9110's token characters, which a header's name is made of. */
+static int token(const char *s, size_t n)
+{
+    static const char extra[] = "!#$%&'*+-.^_`|~";
+    for (size_t i = 0; i < n; i++)
+        if (!((s[i] >= 'a' && s[i] <= 'z') || (s[i] >= 'A' && s[i] <= 'Z') || (s[i] >= '0' && s[i] <= '9') ||
+              (s[i] && strchr(extra, s[i]))))
+            return 0;
+    return n > 0;
+}
+
+static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const char *key, size_t klen,
+                                   const char *value, size_t vlen)
 {
     (void)kind;
     header_scan *h = cls;
+    if (!h->bad && !token(key, klen))
+        h->bad = "a header's name is not a token (RFC 9110: letters, digits and !#$%&'*+-.^_`|~)";
+    for (size_t i = 0; value && i < vlen && !h->bad; i++)
+        if (((unsigned char)value[i] < 0x20 && value[i] != '\t') || value[i] == 0x7f)
+            h->bad = "a header's value holds a control character";
+    if (!strcasecmp(key, MHD_HTTP_HEADER_HOST))
+        h->hosts++;
     if (!strcasecmp(key, MHD_HTTP_HEADER_CONTENT_LENGTH))
         h->lengths++;
     if (!strcasecmp(key, MHD_HTTP_HEADER_TRANSFER_ENCODING))
@@ -95,6 +120,18 @@ static enum MHD_Result scan_arg(void *cls, enum MHD_ValueKind kind, const char *
     return MHD_YES;
 }
 
+/* Names the first query argument holding a literal %00. */
+static enum MHD_Result find_nul(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+{
+    (void)kind;
+    if (!strstr(key, "%00") && !(value && strstr(value, "%00")))
+        return MHD_YES;
+    char k[32];
+    api_text_clean(k, sizeof k, key, strlen(key));
+    snprintf(cls, 64, "the query parameter %s", k);
+    return MHD_NO;
+}
+
 /* Content-Length as digits only, within uint64; -1 if absent, -2 if malformed. */
 static long long content_length(struct MHD_Connection *c)
 {
@@ -117,17 +154,28 @@ static int admit(srv_req *r, const char *method)
 {
     srv_server *s = r->s;
     header_scan h = { .r = r };
-    MHD_get_connection_values(r->conn, MHD_HEADER_KIND, scan_header, &h);
+    MHD_get_connection_values_n(r->conn, MHD_HEADER_KIND, scan_header, &h);
     if (!r->rid[0])
         srv_request_id_make(r->rid);
     long long cl = content_length(r->conn);
     /* Framing that cannot be trusted: answer and close without reading a byte of body. */
-    if (h.lengths > 1 || cl == -2 || (h.encodings && h.lengths)) {
+    const char *te = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_TRANSFER_ENCODING);
+    if (h.lengths > 1 || cl == -2 || (h.encodings && h.lengths) || h.encodings > 1 ||
+        (te && strcasecmp(te, "chunked"))) {
         r->close = r->decided = 1;
-        srv_problem(r, 400, NULL, "%s",
-                    h.lengths > 1 ? "the request has more than one Content-Length header"
-                    : cl == -2    ? "the Content-Length header is not a number of bytes"
-                                  : "the request has both Transfer-Encoding and Content-Length; it may have one");
+        int coding = te && strcasecmp(te, "chunked") && !h.lengths && h.encodings == 1;
+        srv_problem(r, coding ? 501 : 400, NULL, "%s",
+                    h.lengths > 1  ? "the request has more than one Content-Length header"
+                    : cl == -2     ? "the Content-Length header is not a number of bytes"
+                    : h.lengths    ? "the request has both Transfer-Encoding and Content-Length; it may have one"
+                    : coding       ? "the only Transfer-Encoding taken is chunked"
+                                   : "the request has more than one Transfer-Encoding header");
+        return 1;
+    }
+    /* libmicrohttpd's strict mode refuses these with an HTML page; pdesolidd refuses them with a problem. */
+    if (h.bad || (h.hosts != 1 && !strcmp(r->version, MHD_HTTP_VERSION_1_1))) {
+        r->close = r->decided = 1;
+        srv_problem(r, 400, NULL, "%s", h.bad ? h.bad : "an HTTP/1.1 request needs exactly one Host header");
         return 1;
     }
     pthread_mutex_lock(&s->lock);
@@ -140,6 +188,18 @@ static int admit(srv_req *r, const char *method)
                     s->cfg.max_body);
         /* Expect: 100-continue: the client waits, and sends nothing. Too large to discard: close. */
         return (expect && !strcasecmp(expect, "100-continue")) || cl > (long long)DRAIN_BYTES;
+    }
+    const union MHD_ConnectionInfo *ci = MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    conn_state *cs = ci ? ci->socket_context : NULL;
+    if (cs && cs->nul) {
+        /* unescape() kept the %00 literal: find where, to name it. */
+        cs->nul = 0;
+        r->decided = 1;
+        char where[64] = "the path";
+        if (!strstr(r->path, "%00"))
+            MHD_get_connection_values(r->conn, MHD_GET_ARGUMENT_KIND, find_nul, where);
+        srv_problem(r, 400, NULL, "%s holds a NUL (%%00), which no part of a request may", where);
+        return 0;
     }
     if (stopping) {
         r->decided = r->close = 1;
@@ -166,8 +226,8 @@ static int admit(srv_req *r, const char *method)
         return 0;
     }
     if (qs.bad || srv_query_done(&srv_routes[r->route], &r->q, qs.msg, sizeof qs.msg)) {
-        r->decided = 1;
-        srv_problem(r, 400, NULL, "%s", qs.msg);
+        r->decided = 1;   /* a malformed query is a bad request; a well-formed value out of range is not */
+        srv_problem(r, qs.bad ? 400 : 422, NULL, "%s", qs.msg);
         return 0;
     }
     if (!srv_origin_allowed(r)) {
@@ -179,7 +239,8 @@ static int admit(srv_req *r, const char *method)
     return 0;
 }
 
-static srv_req *begin(srv_server *s, struct MHD_Connection *conn, const char *url, const char *method)
+static srv_req *begin(srv_server *s, struct MHD_Connection *conn, const char *url, const char *method,
+                      const char *version)
 {
     srv_req *r = calloc(1, sizeof *r);
     if (!r)
@@ -190,6 +251,7 @@ static srv_req *begin(srv_server *s, struct MHD_Connection *conn, const char *ur
     r->route = srv_nroutes;
     r->phase = SRV_BODY;
     snprintf(r->method, sizeof r->method, "%s", method);
+    snprintf(r->version, sizeof r->version, "%s", version);
     snprintf(r->path, sizeof r->path, "%s", url);
     pthread_mutex_lock(&s->lock);
     s->in_flight++;
@@ -318,11 +380,10 @@ static enum MHD_Result take_body(srv_req *r, const char *upload, size_t n)
 static enum MHD_Result handler(void *cls, struct MHD_Connection *conn, const char *url, const char *method,
                                const char *version, const char *upload, size_t *upload_size, void **con_cls)
 {
-    (void)version;
     srv_server *s = cls;
     srv_req *r = *con_cls;
     if (!r) {
-        if (!(r = begin(s, conn, url, method)))
+        if (!(r = begin(s, conn, url, method, version)))
             return MHD_NO;
         *con_cls = r;
         if (admit(r, method))
@@ -344,20 +405,25 @@ static int hexval(char c)
     return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
 }
 
-/* libmicrohttpd's %-decoding, except that %00 stays as it is: a NUL never hides the rest of a path or a value. */
+/* libmicrohttpd's %-decoding, except that %00 stays as it is, so that a NUL never hides the rest of a path
+ * or a value, and the request is refused (admit). */
 static size_t unescape(void *cls, struct MHD_Connection *c, char *s)
 {
     (void)cls;
-    (void)c;
     char *w = s;
     for (const char *p = s; *p;) {
-        int hi, lo;
-        if (p[0] == '%' && (hi = hexval(p[1])) >= 0 && (lo = hexval(p[2])) >= 0 && (hi | lo)) {
+        int hi = p[0] == '%' ? hexval(p[1]) : -1, lo = hi >= 0 ? hexval(p[2]) : -1;
+        if (lo >= 0 && (hi | lo)) {
             *w++ = (char)(hi << 4 | lo);
             p += 3;
-        } else {
-            *w++ = *p++;
+            continue;
         }
+        if (lo >= 0) {
+            const union MHD_ConnectionInfo *ci = MHD_get_connection_info(c, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+            if (ci && ci->socket_context)
+                ((conn_state *)ci->socket_context)->nul = 1;
+        }
+        *w++ = *p++;
     }
     *w = '\0';
     return (size_t)(w - s);
@@ -403,9 +469,14 @@ static void connection_event(void *cls, struct MHD_Connection *conn, void **sock
                              enum MHD_ConnectionNotificationCode toe)
 {
     (void)conn;
-    (void)socket_context;
     srv_server *s = cls;
     srv_metrics_connection(s->metrics, toe == MHD_CONNECTION_NOTIFY_STARTED ? 1 : -1);
+    if (toe == MHD_CONNECTION_NOTIFY_STARTED) {
+        *socket_context = calloc(1, sizeof(conn_state));   /* NULL: %00 goes unnoticed, and is still kept literal */
+    } else {
+        free(*socket_context);
+        *socket_context = NULL;
+    }
 }
 
 /* ---- start and stop ---- */
@@ -467,7 +538,7 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
     s->d = MHD_start_daemon(flags, (uint16_t)c->port, NULL, NULL, handler, s, MHD_OPTION_SOCK_ADDR, ai->ai_addr,
                             MHD_OPTION_THREAD_POOL_SIZE, (unsigned)(c->http_threads > 1 ? c->http_threads : 0),
                             MHD_OPTION_CONNECTION_TIMEOUT, c->timeout, MHD_OPTION_PER_IP_CONNECTION_LIMIT, c->per_ip,
-                            MHD_OPTION_CONNECTION_LIMIT, c->max_conns, MHD_OPTION_STRICT_FOR_CLIENT, (int)1,
+                            MHD_OPTION_CONNECTION_LIMIT, c->max_conns, MHD_OPTION_STRICT_FOR_CLIENT, (int)0,
                             MHD_OPTION_UNESCAPE_CALLBACK, unescape, NULL, MHD_OPTION_NOTIFY_COMPLETED, completed, s,
                             MHD_OPTION_NOTIFY_CONNECTION, connection_event, s, MHD_OPTION_END);
     freeaddrinfo(ai);

@@ -21,6 +21,7 @@
 
 #include "cache.h"
 #include "config.h"
+#include "cost.h"
 #include "http.h"
 #include "id.h"
 #include "log.h"
@@ -60,6 +61,7 @@ typedef struct srv_req {
     enum srv_phase phase;
     double t0;                   /* the first call of the handler */
     char method[8];
+    char version[12];            /* HTTP/1.1 */
     char path[512];              /* decoded, as libmicrohttpd gives it (escaped only in the log) */
     char query[512];             /* key=value&..., decoded, for the log */
     char arg[96];                /* the path's {} segment */
@@ -85,7 +87,9 @@ typedef struct srv_req {
     long long sent;
     char *key;                   /* the response cache's key of this request, or NULL */
     size_t klen;
-    /* Timing and cancellation. */
+    /* Cost, timing and cancellation. */
+    api_cost cost;               /* the estimate so far (--max-work, --max-mem-mb) */
+    pde_cancel cancel;           /* polls srv_job_stop(r) */
     double queued_at, run_start;
     double work;                 /* seconds the solver threads spent on it before this run */
     struct {

@@ -26,7 +26,7 @@ static const struct {
     { 404, "Not Found" },            { 405, "Method Not Allowed" },
     { 408, "Request Timeout" },      { 413, "Content Too Large" },
     { 422, "Unprocessable Content" }, { 500, "Internal Server Error" },
-    { 503, "Service Unavailable" },
+    { 501, "Not Implemented" },       { 503, "Service Unavailable" },
 };
 
 static const char *title_of(int status)

@@ -57,7 +57,7 @@ int srv_route_find(const char *method, const char *path, char *arg, size_t argn,
 
 /* A request's query, checked against its row. */
 typedef struct {
-    char format[16], res[48];   /* as given, "" when absent */
+    char format[32], res[256];  /* as given, "" when absent */
     int seen;                   /* bits: 1 format, 2 res */
     api_format fmt;             /* after srv_query_done */
     unsigned res3[3];
@@ -71,7 +71,7 @@ void srv_query_init(srv_query *q);
  */
 int srv_query_arg(const srv_route *rt, srv_query *q, const char *key, size_t klen, const char *value, size_t vlen,
                   char *msg, size_t n);
-/* Parses format and res (with the format's defaults); 0, or -1 with msg. */
+/* Parses format and res (with the format's defaults); 0, or -1 with msg (a value the format does not take: 422). */
 int srv_query_done(const srv_route *rt, srv_query *q, char *msg, size_t n);
 
 #endif

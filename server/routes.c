@@ -18,6 +18,7 @@
 #include <cJSON.h>
 
 #include "catalog.h"
+#include "cost.h"
 #include "internal.h"
 #include "model.h"
 #include "strict.h"
@@ -108,13 +109,46 @@ static void stopped(srv_req *r)
                     r->s->cfg.job_timeout);
 }
 
+/* Adds part to the request's estimate; 1 (with the problem set) when the whole is over a budget. */
+static int over_budget(srv_req *r, const api_cost *part)
+{
+    const srv_config *c = &r->s->cfg;
+    api_cost_add(&r->cost, part);
+    if (r->cost.work > c->max_work) {
+        srv_problem(r, 422, NULL,
+                    "this request is estimated at %.3g units of work (about %.2g CPU-seconds), over the limit of %.3g "
+                    "(--max-work); ask for a lower res, fewer points, or a model with fewer terms",
+                    r->cost.work, r->cost.work * 1e-9, c->max_work);
+        return 1;
+    }
+    if (r->cost.bytes > (double)c->max_mem) {
+        srv_problem(r, 422, NULL,
+                    "this request would use about %.0f MiB of memory, over the limit of %zu MiB (--max-mem-mb); "
+                    "ask for a lower res or a model with fewer terms",
+                    r->cost.bytes / 1048576, c->max_mem >> 20);
+        return 1;
+    }
+    return 0;
+}
+
+/* An api/ error, or the problem of a job that was stopped. */
+static void failed(srv_req *r, const api_error *err)
+{
+    if (err->status == API_STATUS_CANCELLED)
+        stopped(r);
+    else
+        srv_problem_api(r, err);
+}
+
 typedef struct {
     api_model *model;
+    const pde_cancel *cancel;
 } solve_arg;
 
 static int solve_model(void *arg, pde_solution **out, api_error *err)
 {
-    return api_solve(((solve_arg *)arg)->model, out, err);
+    solve_arg *a = arg;
+    return api_solve_ex(a->model, a->cancel, out, err);
 }
 
 /* The response of a solved entry: 304, a whole body, or a stream. Takes over the reference. */
@@ -132,23 +166,37 @@ static void answer_entry(srv_req *r, srv_entry *e)
         srv_cache_release(s->cache, e);
         return;
     }
+    const pde_solution *sol = srv_entry_solution(e);
+    int with_props = f == API_FMT_JSON || f == API_FMT_GLTF || f == API_FMT_GLB;
+    api_cost part;
+    api_cost_output(sol, f, res, &part);
+    int over = over_budget(r, &part);
+    if (!over && with_props && !srv_entry_has_props(e)) {
+        api_cost_props(sol, &part);
+        over = over_budget(r, &part);
+    }
+    if (over) {
+        srv_cache_release(s->cache, e);
+        return;
+    }
     const pde_props *props = NULL;
     double t0 = srv_now();
-    if (f == API_FMT_JSON || f == API_FMT_GLTF || f == API_FMT_GLB)
-        props = srv_entry_props(e);
+    int cancelled = 0;
+    if (with_props)
+        props = srv_entry_props(e, &r->cancel, &cancelled);
     r->tm.props = srv_now() - t0;
-    if (srv_job_stop(r)) {
+    if (cancelled || srv_job_stop(r)) {
         srv_cache_release(s->cache, e);
         stopped(r);
         return;
     }
     api_error err;
     t0 = srv_now();
-    api_output *o = api_output_open(srv_entry_solution(e), r->id, props, f, res, &err);
+    api_output *o = api_output_open(sol, r->id, props, f, res, &r->cancel, &err);
     r->tm.output = srv_now() - t0;
     if (!o) {
         srv_cache_release(s->cache, e);
-        srv_problem(r, err.status == 422 ? 422 : 500, NULL, "%s", err.message);
+        failed(r, &err);
         return;
     }
     r->status = 200;
@@ -183,7 +231,13 @@ static void post_solve(srv_req *r)
         srv_problem_api(r, &err);
         return;
     }
-    solve_arg sa = { m };
+    api_cost part;
+    api_cost_solve(api_model_get(m), &part);
+    if (over_budget(r, &part)) {
+        api_model_free(m);
+        return;
+    }
+    solve_arg sa = { m, &r->cancel };
     int hit;
     t0 = srv_now();
     srv_entry *e = srv_cache_get(s->cache, id, solve_model, &sa, &hit, &err);
@@ -193,7 +247,7 @@ static void post_solve(srv_req *r)
         srv_metrics_solve(s->metrics, r->tm.solve);
     api_model_free(m);
     if (!e) {
-        srv_problem_api(r, &err);
+        failed(r, &err);
         return;
     }
     answer_entry(r, e);
@@ -237,6 +291,13 @@ static void post_eval(srv_req *r)
         return;
     }
     const pde_solution *sol = srv_entry_solution(e);
+    api_cost part;
+    api_cost_eval(sol, n, derivs, &part);
+    if (over_budget(r, &part)) {
+        free(pts);
+        srv_cache_release(s->cache, e);
+        return;
+    }
     double *v = malloc((n ? n : 1) * 12 * sizeof *v);
     if (!v) {
         free(pts);
@@ -262,6 +323,11 @@ static void post_eval(srv_req *r)
         stopped(r);
         return;
     }
+    if (api_eval_check(v, derivs ? du : NULL, derivs ? dv : NULL, derivs ? dw : NULL, n, &err)) {
+        free(v);
+        srv_problem_api(r, &err);
+        return;
+    }
     t0 = srv_now();
     char *json = api_eval_json(r->id, v, derivs ? du : NULL, derivs ? dv : NULL, derivs ? dw : NULL, n);
     r->tm.output = srv_now() - t0;
@@ -274,6 +340,7 @@ void srv_run_job(void *arg)
     srv_req *r = arg;
     r->run_start = srv_now();
     r->tm.queue = r->run_start - r->queued_at;
+    r->cancel = (pde_cancel){ srv_job_stop, r };
     if (atomic_load(&r->s->aborting))
         stopped(r);
     else
@@ -398,8 +465,10 @@ int srv_query_arg(const srv_route *rt, srv_query *q, const char *key, size_t kle
         return -1;
     }
     q->seen |= params[i].bit;
-    if (!value)
-        value = "", vlen = 0;
+    if (!value || !vlen) {
+        snprintf(msg, n, "the query parameter %s needs a value", params[i].name);
+        return -1;
+    }
     if (bad_text(value, vlen) || strlen(value) != vlen) {
         snprintf(msg, n, "the query parameter %s holds a control character or a NUL", params[i].name);
         return -1;

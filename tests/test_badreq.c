@@ -5,7 +5,7 @@
  * response, a 4xx problem+json whose body is strict JSON (RFC 8259, valid
  * UTF-8) with "status" equal to the HTTP status; or, for the few requests
  * libmicrohttpd refuses before pdesolidd sees them (marked MHD), one 4xx/5xx
- * response of any type or a close. No row may take more than 2 s (SLOW rows,
+ * response of any type (its HTML page, whose head 0.9.75 sends twice) or a close. No row may take more than 2 s (SLOW rows,
  * which leave the request unfinished, until the daemon's --timeout closes it).
  * After the table the daemon still answers /livez, and exits 0 on SIGTERM.
  */
@@ -201,7 +201,7 @@ static const row rows[] = {
     RAW(MHD, "version HTTP/1.1x", "GET /livez HTTP/1.1x\r\nHost: x\r\n" CLOSE "\r\n"),
     RAW(MHD, "version HTTP/9.9", "GET /livez HTTP/9.9\r\nHost: x\r\n" CLOSE "\r\n"),
     RAW(MHD, "version in lower case", "GET /livez http/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
-    RAW(MHD, "HTTP/1.1 without Host", "GET /livez HTTP/1.1\r\n" CLOSE "\r\n"),
+    RAW(400, "HTTP/1.1 without Host", "GET /livez HTTP/1.1\r\n" CLOSE "\r\n"),
     RAW(MHD, "a CR without LF ending the request line", "GET /livez HTTP/1.1\rHost: x\r\n" CLOSE "\r\n"),
     RAW(MHD, "a NUL in the request target", "GET /li\0vez HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
     RAW(MHD, "a tab between method and target", "GET\t/livez HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
@@ -221,7 +221,7 @@ static const row rows[] = {
      * before the colon; a name that is not a token and a bare CR in a value reach pdesolidd, which
      * must refuse them (a 400 problem also passes an MHD row). -- */
     RAW(MHD, "a header line without a colon", "GET /livez HTTP/1.1\r\nHost: x\r\nNoColonHere\r\n" CLOSE "\r\n"),
-    RAW(MHD, "a space before the colon", "GET /livez HTTP/1.1\r\nHost : x\r\n" CLOSE "\r\n"),
+    RAW(400, "a space before the colon", "GET /livez HTTP/1.1\r\nHost : x\r\n" CLOSE "\r\n"),
     RAW(MHD, "a non-ASCII header name", "GET /livez HTTP/1.1\r\nHost: x\r\nX-\xff: 1\r\n" CLOSE "\r\n"),
     RAW(MHD, "a CR without LF inside the headers", "GET /livez HTTP/1.1\r\nHost: x\r\nX-A: 1\rX-B: 2\r\n" CLOSE "\r\n"),
     RAW(404, "a UTF-8 header value on an unknown route",
@@ -250,7 +250,7 @@ static const row rows[] = {
         "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Transfer-Encoding: gzip, chunked\r\n\r\n12\r\n" FIG4A "\r\n0\r\n\r\n"),
     RAW(MHD, "Transfer-Encoding: chunked, gzip",
         "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Transfer-Encoding: chunked, gzip\r\n\r\n12\r\n" FIG4A "\r\n0\r\n\r\n"),
-    RAW(MHD, "a chunk size of ffffffffffffffff",
+    RAWF(MHD, SLOW, "a chunk size of ffffffffffffffff",
         "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\nffffffffffffffff\r\n" FIG4A "\r\n"),
     RAW(MHD, "a chunk size that is not hex",
         "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\nzz\r\n" FIG4A "\r\n0\r\n\r\n"),
@@ -475,7 +475,9 @@ static const char *judge(const row *w, const raw_reply *r)
         snprintf(why, sizeof why, "no answer and no close within %.0f s", limit);
         return why;
     }
-    if (r->responses > 1) {
+    /* libmicrohttpd 0.9.75 sends its own error's status line and headers twice (MHD rows only): a defect
+     * of that version, which deploy/nginx.conf keeps from clients (tests/test_nginx.c). */
+    if (r->responses > 1 && w->expect != MHD) {
         snprintf(why, sizeof why, "%d responses (status lines) to one request", r->responses);
         return why;
     }

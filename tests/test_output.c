@@ -68,7 +68,7 @@ static pde_solution *solve_preset(const char *name, char id[API_ID_LEN + 1])
 static unsigned char *render(const pde_solution *sol, const char *id, api_format f, const unsigned res[3], size_t *len)
 {
     api_error err;
-    api_output *o = api_output_open(sol, id, NULL, f, res, &err);
+    api_output *o = api_output_open(sol, id, NULL, f, res, NULL, &err);
     if (!o)
         fail_msg("%s: %s", api_format_info_of(f)->name, err.message);
     size_t cap = 1 << 16, n = 0;

@@ -106,7 +106,7 @@ static void props_should_flag_a_solid_that_folds(void **state)
     assert_true(p.detj_min_at[2] < 1e-6);
     assert_rel(p.detj_max, 3.375, 1e-9, 1);
     assert_true(p.volume > p.signed_volume);
-    pde_props_opts bad = { 1 };
+    pde_props_opts bad = { .res = 1 };
     assert_int_equal(pde_properties(sol, &bad, &p), PDE_ERR_INVALID);
     pde_solution_free(sol);
 }

@@ -190,7 +190,7 @@ static int write_output(const options *o, const pde_solution *sol, const char *i
         fprintf(stderr, "pdesolid: %s: %s\n", o->out, strerror(errno));
         return 1;
     }
-    api_output *w = api_output_open(sol, id, NULL, f, res, &err);
+    api_output *w = api_output_open(sol, id, NULL, f, res, NULL, &err);
     if (!w) {
         if (out != stdout)
             fclose(out);

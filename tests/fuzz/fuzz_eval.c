@@ -3,14 +3,15 @@
  * through api_eval_parse, then pde_eval_d at every point on a fixed small
  * solution (the paper's figure 4a), then api_eval_check and api_eval_json,
  * as the server does. Invariants: a refusal is a sane api_error; at most
- * MAX_POINTS points; a non-finite value is refused at the first point that
- * has one; otherwise the answer is strict JSON whose numbers read back to
- * the very doubles computed.
+ * MAX_POINTS points; a finite cost estimate (cost.h); a non-finite value is
+ * refused at the first point that has one; otherwise the answer is strict
+ * JSON whose numbers read back to the very doubles computed.
  */
 #include <math.h>
 
 #include <cJSON.h>
 
+#include "cost.h"
 #include "fuzz.h"
 #include "id.h"
 #include "output.h"
@@ -84,6 +85,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FUZZ_CHECK(n <= MAX_POINTS, "%zu points, over the limit of %d", n, MAX_POINTS);
     FUZZ_CHECK(derivs == 0 || derivs == 1, "derivatives %d", derivs);
     FUZZ_CHECK(pts || n == 0, "no points array");
+    api_cost cost;
+    api_cost_eval(sol, n, derivs, &cost);
+    FUZZ_CHECK(isfinite(cost.work) && cost.work >= 0 && isfinite(cost.bytes) && cost.bytes >= 0,
+               "the cost of %zu points is work %g, bytes %g", n, cost.work, cost.bytes);
     double *v = malloc((n ? n : 1) * 12 * sizeof *v);
     FUZZ_CHECK(v, "out of memory");
     double *du = v + 3 * n, *dv = v + 6 * n, *dw = v + 9 * n;

@@ -1,13 +1,19 @@
 /*
  * fuzz_model.c: the request body of POST /solve, end to end. Bytes go
  * through api_model_parse, api_solve and, when the solution is small, every
- * output format at a tiny resolution (2 or 3 samples per axis). Invariants: a refusal is a sane
- * api_error; an accepted model has a well-formed id; every output's bytes
- * number api_output_size(), the JSON ones are strict JSON (support.h's own
- * checker, not the api's), and the binary ones have the lengths their
- * headers declare.
+ * output format at a tiny resolution (2 or 3 samples per axis), all under a
+ * pde_cancel that may stop the work after a number of polls the input picks.
+ * Invariants: a refusal is a sane api_error; a cancelled call says so and
+ * leaks nothing; every cost estimate (cost.h) is finite and not negative, so
+ * that a budget check cannot be passed by a NaN; an accepted model has a
+ * well-formed id; every output's bytes number api_output_size(), the JSON
+ * ones are strict JSON (support.h's own checker, not the api's), and the
+ * binary ones have the lengths their headers declare.
  */
 #define _GNU_SOURCE   /* memmem */
+#include <math.h>
+
+#include "cost.h"
 #include "fuzz.h"
 #include "id.h"
 #include "output.h"
@@ -44,6 +50,28 @@ static char *read_all(api_output *o, size_t *len)
     }
     *len = n;
     return buf;
+}
+
+static void check_cost(const api_cost *c, const char *what)
+{
+    FUZZ_CHECK(isfinite(c->work) && c->work >= 0 && isfinite(c->bytes) && c->bytes >= 0,
+               "the cost of %s is work %g, bytes %g", what, c->work, c->bytes);
+}
+
+/* Stops the work after *arg polls, when *arg is not negative. */
+static int stop_after(void *arg)
+{
+    long *left = arg;
+    return *left >= 0 && (*left)-- == 0;
+}
+
+/* A refusal, or a cancelled call: status API_STATUS_CANCELLED and nothing made. */
+static void check_refusal(const api_error *err, int may_cancel)
+{
+    if (may_cancel && err->status == API_STATUS_CANCELLED)
+        FUZZ_CHECK(!strcmp(err->message, "cancelled"), "cancelled with \"%s\"", err->message);
+    else
+        fuzz_check_error(err);
 }
 
 static void check_output(api_format f, const unsigned res[3], const char *b, size_t n)
@@ -93,6 +121,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size > MAX_INPUT)
         return 0;
+    /* JSON allows white space at the end, so the input's tail picks how to run it: its last byte res 2
+     * or 3 (bit 0) and whether the outputs get the properties or compute them (bit 1); k >= 2 trailing
+     * white space bytes cancel the work at the 3 (k - 2)th poll. */
+    unsigned pick = size ? data[size - 1] : 0;
+    size_t ws = 0;
+    while (ws < size && strchr(" \t\r\n", data[size - 1 - ws]) && data[size - 1 - ws])
+        ws++;
+    long left = ws >= 2 ? 3 * (long)(ws - 2) : -1;
+    pde_cancel cancel = { stop_after, &left };
+
     api_error err;
     memset(&err, 'X', sizeof err);
     api_model *m = api_model_parse((const char *)data, size, &err);
@@ -100,10 +138,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         fuzz_check_error(&err);
         return 0;
     }
+    api_cost cost;
+    api_cost_solve(api_model_get(m), &cost);
+    check_cost(&cost, "the solve");
     pde_solution *sol = NULL;
     memset(&err, 'X', sizeof err);
-    if (api_solve(m, &sol, &err) != 0) {
-        fuzz_check_error(&err);
+    if (api_solve_ex(m, &cancel, &sol, &err) != 0) {
+        check_refusal(&err, 1);
+        FUZZ_CHECK(!sol, "a refused solve left a solution");
         api_model_free(m);
         return 0;
     }
@@ -119,19 +161,20 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         modes += k;
     }
     if (modes <= MAX_MODES) {
-        /* The last byte (JSON allows trailing white space) picks res 2 or 3, and whether the outputs
-         * get the properties or compute them at their default resolution. */
-        unsigned pick = size ? data[size - 1] : 0;
+        api_cost_props(sol, &cost);
+        check_cost(&cost, "the properties");
         pde_props props;
-        pde_props_opts opts = { .res = 5 };
-        int have = !(pick & 2) && pde_properties(sol, &opts, &props) == PDE_OK;
+        pde_props_opts opts = { .res = 5, .cancel = &cancel };
+        pde_status ps = pick & 2 ? PDE_ERR_CANCELLED : pde_properties(sol, &opts, &props);
         for (int f = 0; f < API_FMT_COUNT; f++) {
             unsigned res[3] = { 2, 2 + (pick & 1), 2 };
-            memset(&err, 'X', sizeof err);
             const api_format_info *fi = api_format_info_of((api_format)f);
-            api_output *o = api_output_open(sol, id, have ? &props : NULL, (api_format)f, res, &err);
+            api_cost_output(sol, (api_format)f, res, &cost);
+            check_cost(&cost, fi->name);
+            memset(&err, 'X', sizeof err);
+            api_output *o = api_output_open(sol, id, ps == PDE_OK ? &props : NULL, (api_format)f, res, &cancel, &err);
             if (!o) {
-                fuzz_check_error(&err);
+                check_refusal(&err, 1);
                 continue;
             }
             long long want = api_output_size(o);

@@ -1,0 +1,408 @@
+/*
+ * cost.c: estimates of work and memory (cost.h).
+ *
+ * DESIGN
+ * Every estimate counts the operations of the code it stands for, and prices
+ * each kind with one coefficient (the K_ constants, in ns of the reference
+ * machine, fitted by bench/bench_cost.c):
+ *   - a point of pde_eval_d() costs, per mode, the factors f_u, f_v and h(w);
+ *     h costs per w-term a Horner pass over its degree and its exp, cos, sin;
+ *   - a pde_grid costs its tables (a factor per mode and sample), a plane
+ *     costs h of every mode, a row the coefficients of every mode and one
+ *     multiply-add per distinct u-factor and sample for each array it fills;
+ *     the multiply-adds cost more once the u table leaves the cache;
+ *   - a mesh samples six faces and then welds, cleans and indexes them;
+ *   - the properties sweep two grids with derivatives, polish eight extremes
+ *     by compass search and take residuals with fourth derivatives.
+ * The memory estimates add the arrays the code allocates at its peak.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cost.h"
+
+/* ---- coefficients, ns on the reference machine (bench/bench_cost.c) ---- */
+
+#define K_FE_POW   3.0    /* factor_eval of t^n */
+#define K_FE_TRIG  14.0   /* sin and cos of one argument */
+#define K_FE_EXP   8.0    /* exp */
+#define K_FE_HYP   16.0   /* sinh and cosh */
+#define K_H_TERM   2.0    /* a w-term of h(w): its loop */
+#define K_H_EXP    10.0   /* its exp, when alpha != 0 */
+#define K_H_TRIG   16.0   /* its cos and sin, when beta != 0 */
+#define K_H_DEG    1.0    /* a coefficient of its Horner passes (A, and B when beta != 0) */
+#define K_EV_MODE  3.0    /* a mode of pde_eval_d beyond its factors and h */
+#define K_WD_DEG   1.6    /* a coefficient of wterm_deriv's complex Horner, per derivative order + 1 */
+#define K_WD_TERM  25.0   /* wterm_deriv's exp, cexp and loop */
+#define K_COEF     2.0    /* a mode of a grid row's coefficients */
+#define K_COEF_MEM 8.0    /* the same when the f_v table's lines do not fit in L1 */
+#define K_FMA      0.9    /* a multiply-add of a sampled row (strided over the u table), table in cache */
+#define K_COMBINE  0.2    /* a multiply-add of a properties row (contiguous) */
+#define K_COMBINE_MEM 0.3 /* the same when the table does not fit in cache */
+#define K_FMA_MEM  8.0    /* the same when the table's lines do not fit in L1 (strided()) */
+#define CACHE_BYTES (1 << 20)
+#define STRIDED_FAST 512.0 /* table rows whose current lines fit in L1 (strided()) */
+#define K_GROUP    0.5    /* a comparison of pde_grid_create's grouping of u-factors */
+#define K_TOUCH    0.1    /* a byte of fresh memory (page faults, zeroing) */
+#define K_PT_PROPS 10.0   /* a point of a properties sweep: det J and extremes */
+#define K_PT_F32   1.0    /* a sample written as f32 */
+#define K_FMT_F32  17.0   /* a float32 printed for grid json */
+#define K_DET      4.0    /* det J of a vts point */
+#define K_WELD     60.0   /* a face sample welded */
+#define K_TRI      40.0   /* a face triangle cleaned, cancelled or indexed, with its normals */
+#define K_STL      25.0   /* an STL triangle written */
+#define K_B64      1.0    /* a byte of base64 */
+#define K_JNODE    90.0   /* a cJSON node made and freed */
+#define K_JMODE    3000.0 /* a mode's factors and regime printed in the closed form's text */
+#define K_JNUM     300.0  /* a number printed by cJSON (it prints, reads back, may print again) */
+#define K_DESC     250.0  /* a coefficient printed by the closed form's text */
+#define K_EVNUM    250.0  /* a %.17g number of an eval answer */
+#define K_S_MODE   400.0  /* a mode of the solve: its fit and real form, |e| <= 1 (plans shared) */
+#define K_S_PLAN   500.0  /* a mode with |e| > 1: its own plan (roots, LU, condition) */
+#define K_S_TERM   120.0  /* a term of the solve */
+#define K_S_DEG    35.0   /* a coefficient of a force's polynomial through the solve */
+#define K_S_PAIR   3.0    /* two force terms on one mode (merging searches linearly) */
+#define POLISH_EVALS 100  /* typical evaluations of one compass search (at most 400) */
+
+/* ---- what a solution holds ---- */
+
+typedef struct {
+    double nm, nd;          /* modes, distinct u-factors */
+    double fu, fv;          /* sum over modes of a factor_eval of f_u, of f_v */
+    double h;               /* sum over modes of mode_h */
+    double d4, d0;          /* sum over modes of wterm_deriv with n = 4, and with n = 0 */
+    double coefs;           /* sum over modes of their w-terms' coefficients (json) */
+    double wterms;
+} comp_stats;
+
+static double fe_cost(pde_factor f)
+{
+    switch (f.kind) {
+    case PDE_POW: return K_FE_POW;
+    case PDE_SIN:
+    case PDE_COS: return K_FE_TRIG;
+    case PDE_EXP: return K_FE_EXP;
+    case PDE_SINH:
+    case PDE_COSH: return K_FE_HYP;
+    }
+    return K_FE_TRIG;
+}
+
+static int factor_cmp(const void *pa, const void *pb)
+{
+    const pde_factor *a = pa, *b = pb;
+    if (a->kind != b->kind)
+        return a->kind < b->kind ? -1 : 1;
+    return (a->p > b->p) - (a->p < b->p);
+}
+
+static void stats_of(const pde_solution *sol, comp_stats st[3])
+{
+    memset(st, 0, 3 * sizeof *st);
+    for (int c = 0; c < 3; c++) {
+        size_t nm;
+        const pde_mode *md = pde_solution_modes(sol, c, &nm);
+        comp_stats *s = &st[c];
+        s->nm = (double)nm;
+        pde_factor *us = malloc((nm ? nm : 1) * sizeof *us);
+        for (size_t m = 0; m < nm; m++) {
+            s->fu += fe_cost(md[m].u);
+            s->fv += fe_cost(md[m].v);
+            s->h += K_EV_MODE;
+            for (size_t k = 0; k < md[m].nterms; k++) {
+                const pde_wterm *t = &md[m].terms[k];
+                double d1 = t->deg + 1.0, passes = t->beta != 0.0 ? 2.0 : 1.0;
+                s->h += K_H_TERM + (t->alpha != 0.0 ? K_H_EXP : 0.0) + (t->beta != 0.0 ? K_H_TRIG : 0.0) +
+                        K_H_DEG * 2.0 * passes * d1;
+                s->d4 += K_WD_TERM + K_WD_DEG * 5.0 * d1;
+                s->d0 += K_WD_TERM + K_WD_DEG * d1;
+                s->coefs += 2.0 * d1;
+            }
+            s->wterms += (double)md[m].nterms;
+            if (us)
+                us[m] = md[m].u;
+        }
+        if (us && nm) {
+            qsort(us, nm, sizeof *us, factor_cmp);
+            size_t nd = 1;
+            for (size_t m = 1; m < nm; m++)
+                nd += factor_cmp(&us[m - 1], &us[m]) != 0;
+            s->nd = (double)nd;
+        } else {
+            s->nd = s->nm;
+        }
+        free(us);
+    }
+}
+
+/* One point of pde_eval_d(): every mode of every component. */
+static double point_cost(const comp_stats st[3])
+{
+    double w = 0.0;
+    for (int c = 0; c < 3; c++)
+        w += st[c].fu + st[c].fv + st[c].h;
+    return w;
+}
+
+/* ---- a pde_grid: its tables, its planes, its rows ---- */
+
+static double grid_bytes(const comp_stats st[3], double nu, double nv)
+{
+    double b = 96.0 * nu + 256.0;
+    for (int c = 0; c < 3; c++)
+        b += 8.0 * st[c].nm + 16.0 * st[c].nd * nu + 16.0 * st[c].nm * nv + 40.0 * st[c].nm;
+    return b;
+}
+
+static double grid_create_work(const comp_stats st[3], double nu, double nv)
+{
+    double w = K_TOUCH * grid_bytes(st, nu, nv);
+    for (int c = 0; c < 3; c++) {
+        double nm = st[c].nm > 0 ? st[c].nm : 1.0;
+        w += st[c].fu / nm * st[c].nm * nu + st[c].fv * nv;   /* f_u is evaluated per mode, not per distinct */
+        w += K_GROUP * st[c].nm * st[c].nd * 0.5;
+    }
+    return w;
+}
+
+static double plane_work(const comp_stats st[3])
+{
+    return st[0].h + st[1].h + st[2].h;
+}
+
+/*
+ * A loop that reads one element of each of n table rows in turn, for each
+ * sample, reuses a cache line per row from one sample to the next while the
+ * n lines fit in L1 (n up to about 512); beyond about 1024 every read misses.
+ */
+static double strided(double n, double fast, double slow)
+{
+    if (n <= STRIDED_FAST)
+        return fast;
+    if (n >= 2 * STRIDED_FAST)
+        return slow;
+    return fast + (slow - fast) * (n - STRIDED_FAST) / STRIDED_FAST;
+}
+
+/* A row of nu samples filling `arrays` arrays (x; or x, xu, xv, xw); props: the contiguous combine(). */
+static double row_work(const comp_stats st[3], double nu, double arrays, int props)
+{
+    double w = 0.0;
+    for (int c = 0; c < 3; c++) {
+        /* emit1() has vectorised loops for up to three distinct u-factors. */
+        double k = props ? (16.0 * st[c].nd * nu > CACHE_BYTES ? K_COMBINE_MEM : K_COMBINE)
+                         : st[c].nd <= 3 ? K_COMBINE : strided(st[c].nd, K_FMA, K_FMA_MEM);
+        double kc = props ? K_COEF : strided(st[c].nm, K_COEF, K_COEF_MEM);
+        w += kc * st[c].nm + arrays * k * st[c].nd * nu;
+    }
+    return w;
+}
+
+/* A grid of nu x nv over nw planes, all rows, `arrays` arrays per row. */
+static double sweep_work(const comp_stats st[3], double nu, double nv, double nw, double arrays, int props)
+{
+    return grid_create_work(st, nu, nv) + nw * plane_work(st) + nw * nv * row_work(st, nu, arrays, props);
+}
+
+/* ---- the properties ---- */
+
+void api_cost_props(const pde_solution *sol, api_cost *c)
+{
+    comp_stats st[3];
+    stats_of(sol, st);
+    size_t nq[3];
+    pde_properties_nodes(sol, nq);
+    const double res = 17.0, rres = 9.0;
+    double w = 0.0;
+    /* The two sweeps fill x, xu, xv and xw of every row. */
+    w += sweep_work(st, (double)nq[0], (double)nq[1], (double)nq[2], 4.0, 1) +
+         K_PT_PROPS * (double)nq[0] * (double)nq[1] * (double)nq[2];
+    w += sweep_work(st, res, res, res, 4.0, 1) + K_PT_PROPS * res * res * res;
+    /* Polish: eight compass searches of pde_eval_d points. */
+    double pt = point_cost(st);
+    w += 8.0 * POLISH_EVALS * pt;
+    /* Boundary residual: per component, res^2 points at w = 0 and 1 (each a full pde_eval_d). */
+    w += 3.0 * res * res * 2.0 * pt;
+    /* PDE residual: per component, 9^3 points of x_uuuu, x_vvvv (h itself) and x_wwww. */
+    for (int i = 0; i < 3; i++)
+        w += rres * rres * rres * (st[i].d4 + 2.0 * st[i].d0 + 3.0 * (st[i].fu + st[i].fv));
+    c->work = w;
+    c->bytes = grid_bytes(st, (double)nq[0], (double)nq[1]) + 16.0 * (double)(nq[0] + nq[1] + nq[2]);
+}
+
+/* ---- outputs ---- */
+
+/* The six faces of api_mesh_build(): their samples, planes and rows, then welding and cleaning. */
+static void mesh_cost(const comp_stats st[3], const unsigned res[3], api_cost *c)
+{
+    double nu = res[0], nv = res[1], nw = res[2];
+    double w = 0.0;
+    /* u = 0, 1: grids 1 x nv over nw planes, nv rows of one sample each. */
+    w += 2.0 * sweep_work(st, 1.0, nv, nw, 1.0, 0);
+    /* v = 0, 1: grids nu x 1 over nw planes, one row each. */
+    w += 2.0 * sweep_work(st, nu, 1.0, nw, 1.0, 0);
+    /* w = 0, 1: grids nu x nv, one plane. */
+    w += 2.0 * sweep_work(st, nu, nv, 1.0, 1.0, 0);
+    double nraw = 2.0 * (nv * nw + nu * nw + nu * nv);
+    double ntraw = 4.0 * ((nv - 1) * (nw - 1) + (nu - 1) * (nw - 1) + (nu - 1) * (nv - 1));
+    w += K_WELD * nraw + K_TRI * ntraw;
+    double cells = 16.0;
+    while (cells < 2.0 * nraw)
+        cells *= 2.0;
+    double tris = 16.0;
+    while (tris < 2.0 * ntraw / 3.0)
+        tris *= 2.0;
+    /* raw, wid, wpos, chain; rtri, rface; the two maps; then tri, pos, nrm, weld, acc, vof. */
+    double scratch = nraw * (12.0 + 4.0 + 24.0 + 4.0) + ntraw * 13.0 + 12.0 * cells + 12.0 * tris + nraw;
+    double outb = ntraw * 12.0 + nraw * (12.0 + 12.0 + 4.0 + 24.0 + 4.0);
+    double g = grid_bytes(st, nu, nv);
+    c->work = w + K_TOUCH * (scratch + outb);
+    c->bytes = scratch + outb + g;
+}
+
+void api_cost_output(const pde_solution *sol, api_format f, const unsigned res[3], api_cost *c)
+{
+    comp_stats st[3];
+    stats_of(sol, st);
+    double nu = res ? res[0] : 0, nv = res ? res[1] : 0, nw = res ? res[2] : 0, n = nu * nv * nw;
+    c->work = c->bytes = 0.0;
+    /* Rows per read: CHUNK_POINTS of output.c; the buffers hold them (4 arrays for vts). */
+    double chunk = nu > 0 ? fmax(1.0, floor(16384.0 / nu)) * nu : 0.0;
+    switch (f) {
+    case API_FMT_F32:
+        c->work = sweep_work(st, nu, nv, nw, 1.0, 0) + K_PT_F32 * n;
+        c->bytes = grid_bytes(st, nu, nv) + 2.0 * 12.0 * chunk + 12.0 * chunk;
+        return;
+    case API_FMT_GRID:
+        /* Three passes, one per component, each sampling all three; every sample printed once. */
+        c->work = grid_create_work(st, nu, nv) + 3.0 * (nw * plane_work(st) + nw * nv * row_work(st, nu, 1.0, 0)) +
+                  K_FMT_F32 * 3.0 * n;
+        c->bytes = grid_bytes(st, nu, nv) + 12.0 * chunk + 2.0 * 17.0 * chunk;
+        return;
+    case API_FMT_VTS:
+        /* Positions, then positions and the three derivatives again for det J. */
+        c->work = grid_create_work(st, nu, nv) + nw * (2.0 * plane_work(st)) + nw * nv * row_work(st, nu, 5.0, 0) +
+                  (K_PT_F32 * 4.0 + K_DET) * n;
+        c->bytes = grid_bytes(st, nu, nv) + 4.0 * 12.0 * chunk + 2.0 * 12.0 * chunk;
+        return;
+    case API_FMT_GLTF:
+    case API_FMT_GLB:
+    case API_FMT_STL: {
+        mesh_cost(st, res, c);
+        double nraw = 2.0 * (nv * nw + nu * nw + nu * nv);
+        double ntri = 4.0 * ((nv - 1) * (nw - 1) + (nu - 1) * (nw - 1) + (nu - 1) * (nv - 1));
+        double blob = 24.0 * nraw + 12.0 * ntri;
+        if (f == API_FMT_STL)
+            c->work += K_STL * ntri;
+        else
+            c->work += (f == API_FMT_GLTF ? K_B64 * blob : 0.1 * blob) + K_TOUCH * blob;
+        /* After the build the mesh, the blob and a read buffer remain; the build's peak is larger. */
+        c->bytes = fmax(c->bytes, (nraw * 28.0 + ntri * 12.0) + (f == API_FMT_STL ? 0.0 : blob) + (2 << 20));
+        return;
+    }
+    case API_FMT_JSON: {
+        /* A cJSON tree of every mode and coefficient, printed, and the closed form as text. */
+        double nodes = 0.0, nums = 0.0;
+        for (int i = 0; i < 3; i++) {
+            nodes += 8.0 * st[i].nm + 6.0 * st[i].wterms + st[i].coefs;
+            nums += st[i].nm + 3.0 * st[i].wterms + st[i].coefs;
+        }
+        c->work = K_JMODE * (st[0].nm + st[1].nm + st[2].nm) + K_JNODE * nodes + K_JNUM * nums + K_DESC * (st[0].coefs + st[1].coefs + st[2].coefs) / 2.0 +
+                  30000.0;
+        /* The tree (node and key), the printed text with cJSON's doubling buffer, the text, the copy. */
+        double text = 24.0 * nums + 8.0 * nodes;
+        c->bytes = 96.0 * nodes + 2.0 * text + 2.0 * 14.0 * (st[0].coefs + st[1].coefs + st[2].coefs) / 2.0 +
+                   2.0 * text + 65536.0;
+        return;
+    }
+    }
+}
+
+/* ---- eval ---- */
+
+void api_cost_eval(const pde_solution *sol, size_t npoints, int derivatives, api_cost *c)
+{
+    comp_stats st[3];
+    stats_of(sol, st);
+    double n = (double)npoints, arrays = derivatives ? 4.0 : 1.0;
+    c->work = n * point_cost(st) + n * arrays * 3.0 * K_EVNUM;
+    /* The points, the values (12 doubles a point), the answer's text. */
+    c->bytes = n * (24.0 + 96.0) + n * arrays * (3.0 * 24.0 + 4.0) + 4096.0;
+}
+
+/* ---- the solve ---- */
+
+static int term_key_cmp(const void *pa, const void *pb)
+{
+    const pde_factor *a = pa, *b = pb;
+    int r = factor_cmp(&a[0], &b[0]);
+    return r ? r : factor_cmp(&a[1], &b[1]);
+}
+
+
+static double lambda(pde_factor f)
+{
+    double w = f.kind == PDE_SIN || f.kind == PDE_COS ? f.p * M_PI : f.kind == PDE_POW ? 0.0 : f.p;
+    return w * w * w * w;
+}
+
+void api_cost_solve(const pde_model *m, api_cost *c)
+{
+    double w = 0.0, bytes = 0.0;
+    for (int ci = 0; ci < 3; ci++) {
+        const pde_component *pc = &m->comp[ci];
+        double modes = 0.0, plans = 0.0;
+        size_t nt = pc->nbterms + pc->nfterms;
+        /* Chains: t^n brings t^(n-4), t^(n-8), ... along. */
+        for (size_t j = 0; j < nt; j++) {
+            pde_factor u = j < pc->nbterms ? pc->bterms[j].u : pc->fterms[j - pc->nbterms].u;
+            pde_factor v = j < pc->nbterms ? pc->bterms[j].v : pc->fterms[j - pc->nbterms].v;
+            double iu = u.kind == PDE_POW && u.p >= 0 ? floor(fmin(u.p, PDE_MAX_POW) / 4) : 0;
+            double iv = v.kind == PDE_POW && v.p >= 0 ? floor(fmin(v.p, PDE_MAX_POW) / 4) : 0;
+            modes += (iu + 1) * (iv + 1);
+            double e = pc->c != 0.0 ? -(pc->a * lambda(u) + pc->b * lambda(v)) / pc->c : 0.0;
+            plans += fabs(e) > 1.0;
+        }
+        modes = fmin(modes, 4.0 * PDE_MAX_MODES);
+        w += K_S_MODE * modes + K_S_PLAN * fmin(plans, modes) + K_S_TERM * (double)nt;
+        bytes += 1600.0 * modes;   /* scratch modes, plans and eps, and the solution's arena */
+        /* Force terms: their polynomials through force_w, the particular solution and the real form. */
+        pde_factor *keys = malloc((pc->nfterms ? pc->nfterms : 1) * 2 * sizeof *keys);
+        for (size_t j = 0; j < pc->nfterms; j++) {
+            const pde_fterm *t = &pc->fterms[j];
+            double d1 = (t->w.kind == PDE_POW && t->w.p >= 0 ? fmin(t->w.p, PDE_MAX_POW) : 0.0) + 1.0;
+            double e = pc->c != 0.0 ? -(pc->a * lambda(t->u) + pc->b * lambda(t->v)) / pc->c : 0.0;
+            if (fabs(e) <= 1.0)
+                d1 += 40.0;    /* the power-series regime expands the force and sums a series */
+            w += K_S_DEG * d1;
+            bytes += 6.0 * 16.0 * d1;
+            if (keys) {
+                keys[2 * j] = t->u;
+                keys[2 * j + 1] = t->v;
+            }
+        }
+        /* Force terms that share a mode merge by linear searches: the square of their count. */
+        if (keys && pc->nfterms) {
+            qsort(keys, pc->nfterms, 2 * sizeof *keys, term_key_cmp);
+            double run = 1.0;
+            for (size_t j = 1; j <= pc->nfterms; j++) {
+                if (j < pc->nfterms && term_key_cmp(&keys[2 * (j - 1)], &keys[2 * j]) == 0) {
+                    run += 1.0;
+                    continue;
+                }
+                w += K_S_PAIR * run * run;
+                run = 1.0;
+            }
+        }
+        free(keys);
+    }
+    c->work = w + 500.0;
+    c->bytes = bytes + 4096.0;
+}
+
+void api_cost_add(api_cost *sum, const api_cost *part)
+{
+    sum->work += part->work;
+    sum->bytes = fmax(sum->bytes, part->bytes);
+}

@@ -1,0 +1,53 @@
+/*
+ * cost.h: what a request will cost, estimated before doing the work, so that
+ * a server can refuse one over its budget instead of running it.
+ *
+ * USAGE
+ *
+ *   api_cost c = { 0 }, part;
+ *   api_cost_solve(api_model_get(m), &part);        // before pde_solve()
+ *   api_cost_add(&c, &part);
+ *   ...solve...
+ *   api_cost_props(sol, &part);                     // if the properties are not cached
+ *   api_cost_add(&c, &part);
+ *   api_cost_output(sol, API_FMT_GLB, res, &part);  // or api_cost_eval(sol, n, derivs, &part)
+ *   api_cost_add(&c, &part);
+ *   if (c.work > max_work || c.bytes > 64e6) refuse(c.work, max_work);
+ *
+ * work is in units of about 1 ns of one core of the reference machine (the
+ * one docs/BENCHMARKS.md names), so 2e9 is about 2 CPU-seconds there. bytes is
+ * the peak scratch memory the call allocates beyond its inputs: sampling
+ * tables, mesh arrays, JSON trees and texts. The estimates follow what the
+ * code does (modes per component, w-terms and their degrees, distinct
+ * factors, samples, triangles, planes and rows), with coefficients measured by
+ * bench/bench_cost.c, which prints estimate against measured time; they are
+ * within about a factor of 2 of the measured CPU time over the presets and the
+ * heavy synthetic models there. Each call fills *c (it does not add) and
+ * cannot fail; every call is reentrant and reads its arguments only.
+ */
+#ifndef API_COST_H
+#define API_COST_H
+
+#include <stddef.h>
+
+#include "output.h"
+#include "pde.h"
+
+typedef struct {
+    double work;    /* units of about 1 ns of one core of the reference machine */
+    double bytes;   /* peak scratch memory, in bytes */
+} api_cost;
+
+/* pde_solve() of the model, from its terms (the model need not be valid). */
+void api_cost_solve(const pde_model *m, api_cost *c);
+/* pde_properties() with the default options. */
+void api_cost_props(const pde_solution *sol, api_cost *c);
+/* api_output_open() and reading the whole output, excluding the properties (api_cost_props). */
+void api_cost_output(const pde_solution *sol, api_format f, const unsigned res[3], api_cost *c);
+/* pde_eval_d() at npoints points and api_eval_json() of the answer (with derivatives or not). */
+void api_cost_eval(const pde_solution *sol, size_t npoints, int derivatives, api_cost *c);
+
+/* sum->work += part->work; sum->bytes = the larger of the two (steps run one after another). */
+void api_cost_add(api_cost *sum, const api_cost *part);
+
+#endif
