@@ -36,13 +36,16 @@
 #define K_WD_DEG   1.6    /* a coefficient of wterm_deriv's complex Horner, per derivative order + 1 */
 #define K_WD_TERM  25.0   /* wterm_deriv's exp, cexp and loop */
 #define K_COEF     2.0    /* a mode of a grid row's coefficients */
-#define K_COEF_MEM 8.0    /* the same when the f_v table's lines do not fit in L1 */
-#define K_FMA      0.9    /* a multiply-add of a sampled row (strided over the u table), table in cache */
+#define K_COEF_MEM 16.0   /* the same past STRIDED_FAST modes, the f_v table beyond L2 */
+#define K_FMA      1.0    /* a multiply-add of a sampled row (strided over the u table; a chain of adds) */
+#define K_FMA_L2   2.0    /* the same past STRIDED_FAST rows, the table in L2 (strided()) */
+#define K_FMA_MEM  8.0    /* the same past STRIDED_FAST rows, the table beyond L2 */
 #define K_COMBINE  0.2    /* a multiply-add of a properties row (contiguous) */
-#define K_COMBINE_MEM 0.3 /* the same when the table does not fit in cache */
-#define K_FMA_MEM  8.0    /* the same when the table's lines do not fit in L1 (strided()) */
-#define CACHE_BYTES (1 << 20)
-#define STRIDED_FAST 512.0 /* table rows whose current lines fit in L1 (strided()) */
+#define K_COMBINE_L2 0.3  /* the same, table beyond 1 MB */
+#define K_COMBINE_MEM 0.55 /* the same, table beyond 4 MB */
+#define CACHE_BYTES (1 << 20)   /* tables read at full speed (the reference machine: L1 48 KB, L2 2 MB) */
+#define L2_BYTES (2 << 20)
+#define STRIDED_FAST 1024.0 /* table rows read in turn before the loop turns memory-bound (strided()) */
 #define K_GROUP    0.5    /* a comparison of pde_grid_create's grouping of u-factors */
 #define K_TOUCH    0.1    /* a byte of fresh memory (page faults, zeroing) */
 #define K_PT_PROPS 10.0   /* a point of a properties sweep: det J and extremes */
@@ -54,7 +57,7 @@
 #define K_STL      25.0   /* an STL triangle written */
 #define K_B64      1.0    /* a byte of base64 */
 #define K_JNODE    90.0   /* a cJSON node made and freed */
-#define K_JMODE    3000.0 /* a mode's factors and regime printed in the closed form's text */
+#define K_JMODE    6000.0 /* a mode's factors and regime printed in the closed form's text */
 #define K_JNUM     300.0  /* a number printed by cJSON (it prints, reads back, may print again) */
 #define K_DESC     250.0  /* a coefficient printed by the closed form's text */
 #define K_EVNUM    250.0  /* a %.17g number of an eval answer */
@@ -173,27 +176,28 @@ static double plane_work(const comp_stats st[3])
 
 /*
  * A loop that reads one element of each of n table rows in turn, for each
- * sample, reuses a cache line per row from one sample to the next while the
- * n lines fit in L1 (n up to about 512); beyond about 1024 every read misses.
+ * sample, reuses a cache line per row from one sample to the next; up to
+ * about 1024 rows the chain of adds bounds it, beyond about 2048 rows every
+ * read waits for memory (measured: 1.0 to 1.4 ns at 513 and 1025 rows, 7 to
+ * 9 ns at 4096, whatever the row length).
  */
-static double strided(double n, double fast, double slow)
+static double strided(double n, double table_bytes, double fast, double l2, double slow)
 {
     if (n <= STRIDED_FAST)
         return fast;
-    if (n >= 2 * STRIDED_FAST)
-        return slow;
-    return fast + (slow - fast) * (n - STRIDED_FAST) / STRIDED_FAST;
+    return table_bytes <= L2_BYTES ? l2 : slow;
 }
 
 /* A row of nu samples filling `arrays` arrays (x; or x, xu, xv, xw); props: the contiguous combine(). */
-static double row_work(const comp_stats st[3], double nu, double arrays, int props)
+static double row_work(const comp_stats st[3], double nu, double nv, double arrays, int props)
 {
     double w = 0.0;
     for (int c = 0; c < 3; c++) {
         /* emit1() has vectorised loops for up to three distinct u-factors. */
-        double k = props ? (16.0 * st[c].nd * nu > CACHE_BYTES ? K_COMBINE_MEM : K_COMBINE)
-                         : st[c].nd <= 3 ? K_COMBINE : strided(st[c].nd, K_FMA, K_FMA_MEM);
-        double kc = props ? K_COEF : strided(st[c].nm, K_COEF, K_COEF_MEM);
+        double table = 16.0 * st[c].nd * nu;   /* f_u and f_u' */
+        double k = props ? (table > 4.0 * CACHE_BYTES ? K_COMBINE_MEM : table > CACHE_BYTES ? K_COMBINE_L2 : K_COMBINE)
+                         : st[c].nd <= 3 ? K_COMBINE : strided(st[c].nd, table / 2.0, K_FMA, K_FMA_L2, K_FMA_MEM);
+        double kc = props ? K_COEF : strided(st[c].nm, 16.0 * st[c].nm * nv, K_COEF, K_COEF, K_COEF_MEM);
         w += kc * st[c].nm + arrays * k * st[c].nd * nu;
     }
     return w;
@@ -202,7 +206,7 @@ static double row_work(const comp_stats st[3], double nu, double arrays, int pro
 /* A grid of nu x nv over nw planes, all rows, `arrays` arrays per row. */
 static double sweep_work(const comp_stats st[3], double nu, double nv, double nw, double arrays, int props)
 {
-    return grid_create_work(st, nu, nv) + nw * plane_work(st) + nw * nv * row_work(st, nu, arrays, props);
+    return grid_create_work(st, nu, nv) + nw * plane_work(st) + nw * nv * row_work(st, nu, nv, arrays, props);
 }
 
 /* ---- the properties ---- */
@@ -276,13 +280,13 @@ void api_cost_output(const pde_solution *sol, api_format f, const unsigned res[3
         return;
     case API_FMT_GRID:
         /* Three passes, one per component, each sampling all three; every sample printed once. */
-        c->work = grid_create_work(st, nu, nv) + 3.0 * (nw * plane_work(st) + nw * nv * row_work(st, nu, 1.0, 0)) +
+        c->work = grid_create_work(st, nu, nv) + 3.0 * (nw * plane_work(st) + nw * nv * row_work(st, nu, nv, 1.0, 0)) +
                   K_FMT_F32 * 3.0 * n;
         c->bytes = grid_bytes(st, nu, nv) + 12.0 * chunk + 2.0 * 17.0 * chunk;
         return;
     case API_FMT_VTS:
         /* Positions, then positions and the three derivatives again for det J. */
-        c->work = grid_create_work(st, nu, nv) + nw * (2.0 * plane_work(st)) + nw * nv * row_work(st, nu, 5.0, 0) +
+        c->work = grid_create_work(st, nu, nv) + nw * (2.0 * plane_work(st)) + nw * nv * row_work(st, nu, nv, 5.0, 0) +
                   (K_PT_F32 * 4.0 + K_DET) * n;
         c->bytes = grid_bytes(st, nu, nv) + 4.0 * 12.0 * chunk + 2.0 * 12.0 * chunk;
         return;
@@ -310,10 +314,11 @@ void api_cost_output(const pde_solution *sol, api_format f, const unsigned res[3
         }
         c->work = K_JMODE * (st[0].nm + st[1].nm + st[2].nm) + K_JNODE * nodes + K_JNUM * nums + K_DESC * (st[0].coefs + st[1].coefs + st[2].coefs) / 2.0 +
                   30000.0;
-        /* The tree (node and key), the printed text with cJSON's doubling buffer, the text, the copy. */
+        /* The tree and cJSON's doubling print buffer; then the text and its copy into the output's
+         * doubling buffer; the closed form's text (about 14 bytes a coefficient) beside them. */
         double text = 24.0 * nums + 8.0 * nodes;
-        c->bytes = 96.0 * nodes + 2.0 * text + 2.0 * 14.0 * (st[0].coefs + st[1].coefs + st[2].coefs) / 2.0 +
-                   2.0 * text + 65536.0;
+        c->bytes = fmax(80.0 * nodes + 2.0 * text, 3.0 * text) +
+                   14.0 * (st[0].coefs + st[1].coefs + st[2].coefs) / 2.0 + 65536.0;
         return;
     }
     }
@@ -352,7 +357,7 @@ void api_cost_solve(const pde_model *m, api_cost *c)
     double w = 0.0, bytes = 0.0;
     for (int ci = 0; ci < 3; ci++) {
         const pde_component *pc = &m->comp[ci];
-        double modes = 0.0, plans = 0.0;
+        double modes = 0.0, plans = 0.0, chain = 0.0;
         size_t nt = pc->nbterms + pc->nfterms;
         /* Chains: t^n brings t^(n-4), t^(n-8), ... along. */
         for (size_t j = 0; j < nt; j++) {
@@ -361,12 +366,14 @@ void api_cost_solve(const pde_model *m, api_cost *c)
             double iu = u.kind == PDE_POW && u.p >= 0 ? floor(fmin(u.p, PDE_MAX_POW) / 4) : 0;
             double iv = v.kind == PDE_POW && v.p >= 0 ? floor(fmin(v.p, PDE_MAX_POW) / 4) : 0;
             modes += (iu + 1) * (iv + 1);
+            /* A chain's modes are forced by their parents: degree 4 (i + j) + 3 at step (i, j). */
+            chain += (iu + 1) * (iv + 1) * (4 + 2 * (iu + iv));
             double e = pc->c != 0.0 ? -(pc->a * lambda(u) + pc->b * lambda(v)) / pc->c : 0.0;
             plans += fabs(e) > 1.0;
         }
         modes = fmin(modes, 4.0 * PDE_MAX_MODES);
-        w += K_S_MODE * modes + K_S_PLAN * fmin(plans, modes) + K_S_TERM * (double)nt;
-        bytes += 1600.0 * modes;   /* scratch modes, plans and eps, and the solution's arena */
+        w += K_S_MODE * modes + K_S_PLAN * fmin(plans, modes) + K_S_TERM * (double)nt + K_S_DEG * chain;
+        bytes += 1600.0 * modes + 6.0 * 16.0 * chain;   /* modes, plans, eps, the solution's arena */
         /* Force terms: their polynomials through force_w, the particular solution and the real form. */
         pde_factor *keys = malloc((pc->nfterms ? pc->nfterms : 1) * 2 * sizeof *keys);
         for (size_t j = 0; j < pc->nfterms; j++) {

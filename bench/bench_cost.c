@@ -11,6 +11,7 @@
  *
  *   bench_cost            the table for docs/BENCHMARKS.md
  *   bench_cost --quick    one run per case, presets fig1a and fig4a only
+ *   bench_cost --heavy    the synthetic models only
  */
 #include <malloc.h>
 #include <stdio.h>
@@ -331,14 +332,14 @@ static void cases(const char *name, const pde_model *m, const unsigned *res_grid
 
 int main(int argc, char **argv)
 {
-    int quick = argc > 1 && !strcmp(argv[1], "--quick");
+    int quick = argc > 1 && !strcmp(argv[1], "--quick"), heavy_only = argc > 1 && !strcmp(argv[1], "--heavy");
     if (quick)
         runs = 1;
     printf("| case | estimate ms | measured ms | ratio | est. MB | heap peak MB |\n");
     printf("|---|---:|---:|---:|---:|---:|\n");
     static const unsigned g33[3] = { 33, 33, 33 }, m64[3] = { 64, 64, 64 };
     static const size_t pts[3] = { 1000, 10000, 100000 };
-    for (size_t i = 0; i < api_preset_count(); i++) {
+    for (size_t i = 0; i < api_preset_count() && !heavy_only; i++) {
         const char *name = api_preset_at(i)->name;
         if (quick && strcmp(name, "fig1a") && strcmp(name, "fig4a"))
             continue;

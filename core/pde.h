@@ -59,8 +59,8 @@ const char *pde_strerror(pde_status status);
 /*
  * Cooperative cancellation. The long calls (pde_solve_ex, pde_properties,
  * and api/'s mesh and output builders) call stop(arg) between bounded pieces
- * of work, a mode of a solve or a row of a sweep: about 1 to 5 ms of work at
- * most between two polls. Once stop() returns non-zero the call frees what it
+ * of work, a mode of a solve, a row of a mesh face, about a millisecond of the
+ * properties: about 1 to 5 ms of work at most between two polls. Once stop() returns non-zero the call frees what it
  * made and returns PDE_ERR_CANCELLED, leaving its out-parameters untouched.
  * stop() runs on the caller's thread; a deadline check (clock_gettime) or an
  * atomic flag is what it is for. A NULL pde_cancel *, or a NULL stop, never
@@ -235,7 +235,7 @@ typedef struct {
 /* A zeroed options struct gives the defaults. */
 typedef struct {
     int res;                    /* samples per axis for bounds, det J and residuals; 0: 17 */
-    const pde_cancel *cancel;   /* polled between rows of the sweeps; NULL never stops */
+    const pde_cancel *cancel;   /* polled about once per ms of work (small solids: never); NULL never stops */
 } pde_props_opts;
 
 pde_status pde_properties(const pde_solution *sol, const pde_props_opts *opts, pde_props *out);

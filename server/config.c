@@ -56,7 +56,7 @@ static const flag flags[] = {
     { "--max-body", "SIZE", K_BYTES, AT(max_body), 1024, 0, "1MiB", NULL,
       "largest request body, e.g. 1MiB, 512KiB, 65536" },
     { "--max-points", "N", K_COUNT, AT(max_points), 1, 10000000, "100000", NULL, "points in one eval request" },
-    { "--max-work", "N", K_REAL, AT(max_work), 0, 1e18, "2e9", NULL,
+    { "--max-work", "N", K_REAL, AT(max_work), 0, 1e18, "1e9", NULL,
       "refuse with a 422 a request whose estimated cost\n"
       "is over N units (about 1 ns of one core each);\n"
       "2e9 or 2000000000" },

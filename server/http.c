@@ -25,6 +25,7 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "http.h"
@@ -558,6 +559,23 @@ uint16_t srv_port(const srv_server *s)
     return s->port;
 }
 
+/* Waits up to seconds for every request to complete; 1 if they did. */
+static int await_idle(srv_server *s, double seconds)
+{
+    struct timespec until;
+    clock_gettime(CLOCK_REALTIME, &until);
+    double end = until.tv_sec + until.tv_nsec * 1e-9 + seconds;
+    until.tv_sec = (time_t)end;
+    until.tv_nsec = (long)((end - (double)until.tv_sec) * 1e9);
+    pthread_mutex_lock(&s->lock);
+    while (s->in_flight > 0)
+        if (pthread_cond_timedwait(&s->idle, &s->lock, &until))
+            break;
+    int idle = s->in_flight == 0;
+    pthread_mutex_unlock(&s->lock);
+    return idle;
+}
+
 void srv_stop(srv_server *s)
 {
     pthread_mutex_lock(&s->lock);
@@ -567,17 +585,14 @@ void srv_stop(srv_server *s)
     if (fd >= 0)
         close(fd);
     /* Requests in flight may finish within the grace period. */
-    struct timespec until;
-    clock_gettime(CLOCK_REALTIME, &until);
-    until.tv_sec += s->cfg.grace;
-    pthread_mutex_lock(&s->lock);
-    while (s->in_flight > 0)
-        if (pthread_cond_timedwait(&s->idle, &s->lock, &until))
-            break;
-    pthread_mutex_unlock(&s->lock);
-    /* Then the rest ends: running jobs stop at their next poll, queued ones answer 503, streams end.
-     * Every queued job resumes its connection before the pool stops, so none stays suspended. */
-    atomic_store(&s->aborting, 1);
+    if (!await_idle(s, s->cfg.grace)) {
+        /* Then the rest ends: running jobs stop at their next poll, queued ones answer 503, streams end.
+         * Every queued job resumes its connection before the pool stops, so none stays suspended, and
+         * the polling threads get a moment to send those answers before the daemon closes everything. */
+        atomic_store(&s->aborting, 1);
+        srv_pool_stop(s->pool);
+        await_idle(s, 0.5);
+    }
     srv_pool_stop(s->pool);
     MHD_stop_daemon(s->d);
     free_server(s);

@@ -94,7 +94,7 @@ static void defaults_should_be_those_the_usage_gives(void **state)
     assert_int_equal(c.quiet, 0);
     assert_true(c.request_timeout == 30.0);
     assert_true(c.job_timeout == 2.0);
-    assert_true(c.max_work == 2e9);
+    assert_true(c.max_work == 1e9);
     assert_int_equal(c.max_mem, 64u << 20);
     assert_int_equal(c.log_format, SRV_LOG_TEXT);
 }
