@@ -1,5 +1,6 @@
 # pdesolid: `make` builds build/pdesolid; `make test` builds and runs every test
-# (under AddressSanitizer and UndefinedBehaviorSanitizer); `make bench` runs the
+# (under AddressSanitizer and UndefinedBehaviorSanitizer); `make check T=test_x
+# F=pattern` runs one; `make fuzz` runs the fuzzers; `make bench` runs the
 # benchmarks. Dependencies point one way: clients -> api -> core.
 
 CC      ?= cc
@@ -34,7 +35,16 @@ CURL     := $(shell pkg-config --libs libcurl 2>/dev/null || echo -lcurl)
 TESTS := $(patsubst tests/%.c,build/san/tests/%,$(TEST_SRC))
 BENCHES := $(patsubst bench/%.c,build/bench/%,$(BENCH_SRC))
 
-.PHONY: all test bench clean deps run tsan
+# The fuzzing harnesses (tests/fuzz/, `make fuzz`) and their clang objects.
+FUZZ_SECONDS ?= 60
+FUZZ_CC ?= clang
+FUZZ_SRC := $(wildcard tests/fuzz/fuzz_*.c)
+FUZZ_NAMES := $(patsubst tests/fuzz/%.c,%,$(FUZZ_SRC))
+FUZZ_REPLAYS := $(patsubst %,build/san/fuzz/%,$(FUZZ_NAMES))
+FUZZ_LIB_SRC := $(filter-out server/main.c,$(SRV_SRC)) $(API_SRC) $(CORE_SRC) tests/support.c
+fuzzobj = $(patsubst %.c,build/fuzz/obj/%.o,$(1))
+
+.PHONY: all test check fuzz bench clean deps run tsan
 all: build/pdesolid build/pdesolidd
 
 # Installs missing Debian and npm packages (a no-op when all are there).
@@ -87,9 +97,55 @@ build/san/tests/%: build/san/tests/%.o build/san/tests/support.o $(call san,$(fi
                    $(API_SRC) $(CORE_SRC)) build/obj/openapi.o
 	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(CURL) $(MHD) $(LDLIBS) -lpthread -o $@
 
-test: build/pdesolid build/pdesolidd build/san/pdesolid build/san/pdesolidd $(TESTS)
-	@set -e; for t in $(TESTS); do echo "== $$t"; PDESOLID=build/pdesolid PDESOLID_SAN=build/san/pdesolid \
-	    PDESOLIDD_SAN=build/san/pdesolidd ./$$t; done
+# Test binaries that start pdesolidd, or run the CLI, need them built first (order-only: a new
+# daemon does not relink the test). Found by what the tests read, so a new test needs no entry here.
+DAEMON_TESTS := $(patsubst tests/%.c,build/san/tests/%,$(shell grep -l 'daemon_start\|PDESOLIDD_SAN' $(TEST_SRC)))
+CLI_TESTS := $(patsubst tests/%.c,build/san/tests/%,$(shell grep -l 'PDESOLID_SAN\|getenv("PDESOLID")' $(TEST_SRC)))
+$(DAEMON_TESTS): | build/san/pdesolidd
+$(CLI_TESTS): | build/pdesolid build/san/pdesolid
+TEST_ENV := PDESOLID=build/pdesolid PDESOLID_SAN=build/san/pdesolid PDESOLIDD_SAN=build/san/pdesolidd
+
+# Keep every intermediate (test objects above all), so that a second `make test` rebuilds nothing.
+.SECONDARY:
+
+test: build/pdesolid build/pdesolidd build/san/pdesolid build/san/pdesolidd $(TESTS) $(FUZZ_REPLAYS)
+	@set -e; for t in $(TESTS); do echo "== $$t"; $(TEST_ENV) ./$$t; done
+	@set -e; for f in $(FUZZ_NAMES); do echo "== build/san/fuzz/$$f (seed corpus replay)"; \
+	    ./build/san/fuzz/$$f tests/fuzz/corpus/$$f; done
+
+# One test program, and optionally only its cases matching a cmocka pattern:
+# `make check T=test_solve`, `make check T=test_solve F='*resonan*'`.
+check: $(if $(T),build/san/tests/$(T))
+	@test -n "$(T)" || { echo "make check T=test_name [F='pattern']" >&2; exit 2; }
+	$(TEST_ENV) CMOCKA_FILTER='$(F)' ./build/san/tests/$(T)
+
+# ---- fuzzing: libFuzzer harnesses (tests/fuzz/fuzz_*.c, seed corpora in tests/fuzz/corpus/<name>/) ----
+# `make fuzz` builds them with clang into build/fuzz/ and runs each for FUZZ_SECONDS over its corpus;
+# new inputs go to build/fuzz/corpus-<name>/, a crash fails the target and leaves its input in
+# build/fuzz/<name>-crash-*. `make test` replays the seed corpora through the same harnesses built
+# with $(CC) and tests/fuzz/replay.c instead of libFuzzer (build/san/fuzz/<name>).
+
+# clang has no -fcx-fortran-rules: its core objects divide complex numbers the C99 way, more slowly.
+build/fuzz/obj/%.o: %.c | deps
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(STD) $(OPT) $(WARN) -Icore -Iapi -Iserver -Itests $(CJSON_CFLAGS) $(SAN) \
+	    -fsanitize=fuzzer-no-link -MMD -MP -c $< -o $@
+
+build/fuzz/fuzz_%: build/fuzz/obj/tests/fuzz/fuzz_%.o $(call fuzzobj,$(FUZZ_LIB_SRC)) build/obj/openapi.o
+	$(FUZZ_CC) $(SAN) -fsanitize=fuzzer $^ $(LIBS) $(CMOCKA) $(MHD) $(LDLIBS) -lpthread -o $@
+
+build/san/tests/fuzz/%.o: CFLAGS += -Itests
+build/san/fuzz/fuzz_%: build/san/tests/fuzz/fuzz_%.o build/san/tests/fuzz/replay.o \
+                       $(call san,$(FUZZ_LIB_SRC)) build/obj/openapi.o
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(MHD) $(LDLIBS) -lpthread -o $@
+
+fuzz: $(patsubst %,build/fuzz/%,$(FUZZ_NAMES))
+	@set -e; for f in $(FUZZ_NAMES); do mkdir -p build/fuzz/corpus-$$f; \
+	    echo "== build/fuzz/$$f for $(FUZZ_SECONDS) s"; \
+	    ./build/fuzz/$$f -max_total_time=$(FUZZ_SECONDS) -timeout=10 -max_len=4096 -print_final_stats=1 \
+	        -dict=tests/fuzz/$$f.dict -artifact_prefix=build/fuzz/$$f- build/fuzz/corpus-$$f tests/fuzz/corpus/$$f; \
+	done
 
 # The server's integration tests against a ThreadSanitizer build of pdesolidd; a race
 # leaves a report in build/tsan/ and fails the target.

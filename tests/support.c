@@ -988,3 +988,12 @@ int json_strict_valid(const char *s, size_t n)
     j_ws(&j);
     return j.p == j.e;
 }
+
+/* ---- running one case ---- */
+
+void test_filter_from_env(void)
+{
+    const char *f = getenv("CMOCKA_FILTER");
+    if (f && *f)
+        cmocka_set_test_filter(f);
+}

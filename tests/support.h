@@ -126,3 +126,9 @@ int utf8_valid(const char *s, size_t n);
 int json_strict_valid(const char *s, size_t n);
 /* Seconds on the monotonic clock. */
 double mono_now(void);
+
+/* ---- running one case (make check T=test_x F='pattern') ---- */
+
+/* Runs only the cases whose names match $CMOCKA_FILTER (cmocka's * and ? wildcards), when it is set and
+ * not empty; call it in main() before cmocka_run_group_tests. `make check F=...` sets it. */
+void test_filter_from_env(void);

@@ -657,5 +657,6 @@ int main(void)
         cmocka_unit_test(the_raw_reader_should_count_responses_as_a_client_sees_them),
         cmocka_unit_test(every_malformed_request_should_get_one_4xx_problem_or_a_documented_close),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -247,5 +247,6 @@ int main(void)
         cmocka_unit_test(solve_should_print_the_closed_form_and_properties),
         cmocka_unit_test(bad_input_should_exit_2_and_name_the_field),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);
 }

@@ -361,5 +361,6 @@ int main(void)
         cmocka_unit_test(print_should_read_back_as_the_same_config),
         cmocka_unit_test(openapi_version_should_be_the_one_version),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("config", tests, NULL, NULL);
 }

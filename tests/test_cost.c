@@ -450,5 +450,6 @@ int main(void)
         cmocka_unit_test(heavy_requests_of_the_issue_should_exceed_the_budget),
         cmocka_unit_test(every_preset_in_every_format_should_stay_well_under_the_budget),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -208,5 +208,6 @@ int main(void)
         cmocka_unit_test(eval_partial_should_agree_with_differences_and_first_derivatives),
         cmocka_unit_test(force_should_be_the_models_force),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("eval", tests, NULL, NULL);
 }

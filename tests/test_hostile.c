@@ -1134,5 +1134,6 @@ int main(void)
         cmocka_unit_test_teardown(a_post_from_a_disallowed_origin_should_get_403_and_solve_nothing, kill_leftover),
         cmocka_unit_test_teardown(the_openapi_document_should_be_served, kill_leftover),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests(tests, setup, teardown);
 }

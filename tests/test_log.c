@@ -26,6 +26,8 @@
 
 #include "log.h"
 
+void test_filter_from_env(void);   /* support.h, whose utf8_valid would clash with the one here */
+
 /* ---- helpers ---- */
 
 /* Everything written to fd so far, NUL-terminated; *n its length. */
@@ -481,5 +483,6 @@ int main(void)
         cmocka_unit_test(request_ids_should_accept_only_short_plain_tokens),
         cmocka_unit_test(made_request_ids_should_be_unique_sane_and_hex),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("log", tests, NULL, NULL);
 }

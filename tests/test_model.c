@@ -90,5 +90,6 @@ int main(void)
         cmocka_unit_test(canonical_should_not_depend_on_how_the_model_is_written),
         cmocka_unit_test(canonical_should_validate_like_solve),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("model", tests, NULL, NULL);
 }

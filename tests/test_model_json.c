@@ -323,5 +323,6 @@ int main(void)
         cmocka_unit_test(points_should_parse_and_name_bad_entries),
         cmocka_unit_test(eval_requests_should_parse_and_name_bad_entries),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("model_json", tests, NULL, NULL);
 }

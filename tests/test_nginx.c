@@ -1155,5 +1155,6 @@ int main(void)
         T(the_daemon_should_get_a_sane_request_id_and_forwarded_headers),
         T(an_unreachable_daemon_should_give_a_502_problem),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("nginx", tests, setup, teardown);
 }

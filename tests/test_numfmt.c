@@ -14,6 +14,7 @@
 #include <cmocka.h>
 
 #include "numfmt.h"
+#include "support.h"
 
 static void check(float f)
 {
@@ -78,5 +79,6 @@ int main(void)
         cmocka_unit_test(fmt_should_round_trip_float32_across_the_whole_range),
         cmocka_unit_test(fmt_should_write_short_plain_forms),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("numfmt", tests, NULL, NULL);
 }

@@ -495,5 +495,6 @@ int main(void)
         cmocka_unit_test(id_should_not_depend_on_how_the_model_is_spelled),
         cmocka_unit_test(bad_formats_and_resolutions_should_name_the_limit),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("output", tests, setup, teardown);
 }

@@ -251,5 +251,6 @@ int main(void)
         cmocka_unit_test(every_paper_figure_should_meet_its_boundary_conditions_and_the_pde),
         cmocka_unit_test(stiff_models_should_meet_their_boundary_conditions_and_the_pde),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
 }

@@ -842,5 +842,6 @@ int main(void)
         cmocka_unit_test(sigterm_should_let_a_request_in_flight_complete),
         cmocka_unit_test(presets_version_health_metrics_and_cors_should_answer),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("server", tests, setup, teardown);
 }

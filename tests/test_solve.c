@@ -581,5 +581,6 @@ int main(void)
         cmocka_unit_test(solve_should_add_up_terms_with_equal_factors),
         cmocka_unit_test(solve_should_give_an_empty_solution_for_an_empty_model),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("solve", tests, NULL, NULL);
 }

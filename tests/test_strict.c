@@ -28,7 +28,7 @@
 #include "support.h"
 
 /* UTF-8 decoded to code points, a way apart from strict.c's table of byte ranges. */
-static int utf8_valid(const char *text, size_t n)
+static int utf8_valid_by_decoding(const char *text, size_t n)
 {
     const unsigned char *s = (const unsigned char *)text;
     for (size_t i = 0; i < n;) {
@@ -83,7 +83,7 @@ static int iconv_valid(const char *text, size_t n)
 static void assert_clean_text(const char *what, const char *s)
 {
     size_t n = strlen(s);
-    if (!utf8_valid(s, n) || !iconv_valid(s, n))
+    if (!utf8_valid_by_decoding(s, n) || !iconv_valid(s, n))
         fail_msg("%s is not valid UTF-8", what);
     for (size_t i = 0; i < n; i++)
         if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
@@ -98,11 +98,11 @@ static void the_test_validators_should_refuse_what_utf8_forbids(void **state)
     static const char *const good[] = { "", "a", "\xc3\xa9", "\xe2\x82\xac", "\xf0\x9f\x98\x80", "\xf4\x8f\xbf\xbf",
                                         "\xed\x9f\xbf", "\xee\x80\x80" };
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
-        assert_false(utf8_valid(bad[i], strlen(bad[i])));
+        assert_false(utf8_valid_by_decoding(bad[i], strlen(bad[i])));
         assert_false(iconv_valid(bad[i], strlen(bad[i])));
     }
     for (size_t i = 0; i < sizeof good / sizeof *good; i++) {
-        assert_true(utf8_valid(good[i], strlen(good[i])));
+        assert_true(utf8_valid_by_decoding(good[i], strlen(good[i])));
         assert_true(iconv_valid(good[i], strlen(good[i])));
     }
 }
@@ -768,5 +768,6 @@ int main(void)
         cmocka_unit_test(eval_json_should_write_null_for_what_is_not_finite),
         cmocka_unit_test(cli_eval_should_refuse_points_whose_values_are_not_finite),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("strict", tests, NULL, NULL);
 }

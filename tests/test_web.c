@@ -47,5 +47,6 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(the_front_end_should_work_in_a_real_browser),
     };
+    test_filter_from_env();
     return cmocka_run_group_tests_name("web", tests, NULL, NULL);
 }
