@@ -38,6 +38,8 @@ typedef struct {
     double bytes;   /* peak scratch memory, in bytes */
 } api_cost;
 
+/* Parsing a JSON document of len bytes (api_model_parse, api_eval_parse), before it is read. */
+void api_cost_parse(size_t len, api_cost *c);
 /* pde_solve() of the model, from its terms (the model need not be valid). */
 void api_cost_solve(const pde_model *m, api_cost *c);
 /* pde_properties() with the default options. */

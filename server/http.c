@@ -20,6 +20,7 @@
  */
 #include <arpa/inet.h>
 #include <netdb.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,9 +49,18 @@ static void make_key(srv_req *r)
     size_t cap = tl + sizeof r->q.format + sizeof r->q.res + 16;
     if (!(r->key = malloc(cap)))
         return;
-    int n = snprintf(r->key, cap, "%d\n%s\n%s\n", r->route, r->q.format, r->q.res);
-    memcpy(r->key + n, tail, tl);
-    r->klen = (size_t)n + tl;
+    char *k = r->key;
+    *k++ = (char)('A' + r->route);   /* a letter per row of the table */
+    *k++ = '\n';
+    size_t fl = strlen(r->q.format), rl = strlen(r->q.res);
+    memcpy(k, r->q.format, fl);
+    k += fl;
+    *k++ = '\n';
+    memcpy(k, r->q.res, rl);
+    k += rl;
+    *k++ = '\n';
+    memcpy(k, tail, tl);
+    r->klen = (size_t)(k - r->key) + tl;
 }
 
 /* ---- the first call: what the headers decide ---- */
@@ -179,9 +189,7 @@ static int admit(srv_req *r, const char *method)
         srv_problem(r, 400, NULL, "%s", h.bad ? h.bad : "an HTTP/1.1 request needs exactly one Host header");
         return 1;
     }
-    pthread_mutex_lock(&s->lock);
-    int stopping = s->stopping;
-    pthread_mutex_unlock(&s->lock);
+    int stopping = atomic_load(&s->stopping);
     if (cl > (long long)s->cfg.max_body) {
         const char *expect = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_EXPECT);
         r->decided = r->close = 1;
@@ -240,23 +248,32 @@ static int admit(srv_req *r, const char *method)
     return 0;
 }
 
+/* strlcpy: src cut to fit n bytes, NUL-terminated. */
+static void copy(char *dst, size_t n, const char *src)
+{
+    size_t k = strnlen(src, n - 1);
+    memcpy(dst, src, k);
+    dst[k] = '\0';
+}
+
 static srv_req *begin(srv_server *s, struct MHD_Connection *conn, const char *url, const char *method,
                       const char *version)
 {
-    srv_req *r = calloc(1, sizeof *r);
+    /* Zeroed up to its text buffers, which are NUL-terminated as they are filled. */
+    srv_req *r = malloc(sizeof *r);
     if (!r)
         return NULL;
+    memset(r, 0, offsetof(srv_req, path));
     r->s = s;
     r->conn = conn;
     r->t0 = srv_now();
     r->route = srv_nroutes;
     r->phase = SRV_BODY;
-    snprintf(r->method, sizeof r->method, "%s", method);
-    snprintf(r->version, sizeof r->version, "%s", version);
-    snprintf(r->path, sizeof r->path, "%s", url);
-    pthread_mutex_lock(&s->lock);
-    s->in_flight++;
-    pthread_mutex_unlock(&s->lock);
+    copy(r->method, sizeof r->method, method);
+    copy(r->version, sizeof r->version, version);
+    copy(r->path, sizeof r->path, url);
+    r->query[0] = '\0';
+    atomic_fetch_add(&s->in_flight, 1);
     return r;
 }
 
@@ -286,8 +303,8 @@ static enum MHD_Result dispatch_job(srv_req *r)
         srv_rhit h;
         if (r->key && srv_rcache_get(s->rcache, r->key, r->klen, &h)) {
             /* A request answered before: its kept bytes, with this request's own headers. */
-            snprintf(r->id, sizeof r->id, "%.32s", h.id);
-            snprintf(r->etag, sizeof r->etag, "%s", h.etag);
+            copy(r->id, sizeof r->id, h.id);
+            copy(r->etag, sizeof r->etag, h.etag);
             r->ctype = h.ctype;
             const char *inm = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
             if (inm && (strstr(inm, h.etag) || !strcmp(inm, "*"))) {
@@ -307,10 +324,7 @@ static enum MHD_Result dispatch_job(srv_req *r)
     }
     if (srv_pool_reserve(s->pool)) {
         r->retry_after = 1;
-        pthread_mutex_lock(&s->lock);
-        int stopping = s->stopping;
-        pthread_mutex_unlock(&s->lock);
-        if (stopping)
+        if (atomic_load(&s->stopping))
             srv_problem(r, 503, NULL, "the server is shutting down");
         else
             srv_problem(r, 503, NULL, "all %d solver threads are busy and %zu jobs are waiting (--queue); try again",
@@ -460,10 +474,11 @@ static void completed(void *cls, struct MHD_Connection *conn, void **con_cls, en
     free(r->text);
     free(r->key);
     free(r);
-    pthread_mutex_lock(&s->lock);
-    if (--s->in_flight == 0)
+    if (atomic_fetch_sub(&s->in_flight, 1) == 1 && atomic_load(&s->stopping)) {
+        pthread_mutex_lock(&s->lock);   /* srv_stop waits for this */
         pthread_cond_broadcast(&s->idle);
-    pthread_mutex_unlock(&s->lock);
+        pthread_mutex_unlock(&s->lock);
+    }
 }
 
 static void connection_event(void *cls, struct MHD_Connection *conn, void **socket_context,
@@ -568,19 +583,17 @@ static int await_idle(srv_server *s, double seconds)
     until.tv_sec = (time_t)end;
     until.tv_nsec = (long)((end - (double)until.tv_sec) * 1e9);
     pthread_mutex_lock(&s->lock);
-    while (s->in_flight > 0)
+    while (atomic_load(&s->in_flight) > 0)
         if (pthread_cond_timedwait(&s->idle, &s->lock, &until))
             break;
-    int idle = s->in_flight == 0;
+    int idle = atomic_load(&s->in_flight) == 0;
     pthread_mutex_unlock(&s->lock);
     return idle;
 }
 
 void srv_stop(srv_server *s)
 {
-    pthread_mutex_lock(&s->lock);
-    s->stopping = 1;
-    pthread_mutex_unlock(&s->lock);
+    atomic_store(&s->stopping, 1);
     int fd = MHD_quiesce_daemon(s->d);   /* no new connections */
     if (fd >= 0)
         close(fd);

@@ -44,10 +44,10 @@ struct srv_server {
     srv_static *web;
     srv_log *log;                /* the access log, or NULL (--quiet) */
     pthread_mutex_t json_lock;   /* cJSON_Parse writes a global */
-    pthread_mutex_t lock;        /* in_flight, stopping */
+    pthread_mutex_t lock;        /* with idle: srv_stop waits for in_flight to reach 0 */
     pthread_cond_t idle;
-    size_t in_flight;
-    int stopping;                /* no new work: quiescing */
+    atomic_size_t in_flight;     /* requests begun and not completed */
+    atomic_int stopping;         /* no new work: quiescing */
     atomic_int aborting;         /* grace is over: jobs end at once, queued ones answer 503 */
     uint16_t port;
 };
@@ -62,11 +62,8 @@ typedef struct srv_req {
     double t0;                   /* the first call of the handler */
     char method[8];
     char version[12];            /* HTTP/1.1 */
-    char path[512];              /* decoded, as libmicrohttpd gives it (escaped only in the log) */
-    char query[512];             /* key=value&..., decoded, for the log */
     char arg[96];                /* the path's {} segment */
     char rid[65];                /* the request id */
-    srv_query q;
     char *body;
     size_t len, cap;
     int decided;                 /* the answer was set before the body was read: the body is discarded */
@@ -96,6 +93,10 @@ typedef struct srv_req {
         double queue, parse, solve, props, output;
         int cached;
     } tm;
+    /* Not zeroed by begin(): NUL-terminated when filled; q set by srv_query_init in admit(). */
+    srv_query q;
+    char path[512];              /* decoded, as libmicrohttpd gives it (escaped only in the log) */
+    char query[512];             /* key=value&..., decoded, for the log */
 } srv_req;
 
 double srv_now(void);
@@ -123,8 +124,9 @@ void srv_static_get(srv_req *r);
 
 /* stream.c: a body produced by the solver threads into a bounded ring (takes o and e). */
 #define SRV_STREAM_RING (256u << 10)
-/* Fills the first ring on this (solver) thread. Returns the stream, or NULL with r's problem set.
- * *whole: the output ended within the ring; then its bytes are in r->text and no stream is made. */
+/* Fills the first ring on this (solver) thread; a body of known size that the response cache may
+ * keep (r->key, at most SRV_RCACHE_MAX_ITEM) is made whole. Returns the stream, or NULL with r's
+ * problem set, or NULL with *whole set: the output ended, its bytes are in r->text. */
 srv_stream *srv_stream_start(srv_req *r, api_output *o, srv_entry *e, int *whole);
 enum MHD_Result srv_stream_respond(srv_req *r);
 /* When the request completes: drops its hold on its stream, if any. */

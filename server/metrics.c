@@ -2,6 +2,7 @@
  * metrics.c: request, latency, solve and output counters (metrics.h).
  */
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,22 +10,23 @@
 #include "metrics.h"
 #include "sbuf.h"
 
-static const int statuses[] = { 200, 204, 304, 400, 403, 404, 405, 408, 413, 422, 500, 503 };
+static const int statuses[] = { 200, 204, 304, 400, 403, 404, 405, 413, 422, 500, 501, 503 };
 #define NSTATUS (int)(sizeof statuses / sizeof *statuses)
 static const double buckets[] = { 0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1, 2.5, 5, 10 };
 #define NBUCKET (int)(sizeof buckets / sizeof *buckets)
 
+/* What every request counts is atomic, so that the polling threads never wait for one another here;
+ * the rest is under the lock. */
 struct srv_metrics {
     pthread_mutex_t lock;
     const char *const *routes;
     int nroutes;
-    unsigned long long *requests;           /* nroutes x (NSTATUS + 1 for others) */
-    unsigned long long hist[NBUCKET + 1];
-    double latency_sum;
-    unsigned long long latency_count;
+    atomic_ullong *requests;                /* nroutes x (NSTATUS + 1 for others) */
+    atomic_ullong hist[NBUCKET + 1];
+    atomic_ullong latency_ns, latency_count;
     double solve_sum, output_sum;
     unsigned long long solve_count, output_count, output_bytes;
-    long long connections;
+    atomic_llong connections;
 };
 
 srv_metrics *srv_metrics_create(const char *const *routes, int nroutes)
@@ -60,13 +62,11 @@ void srv_metrics_request(srv_metrics *m, int route, int status, double seconds)
     int b = 0;
     while (b < NBUCKET && seconds > buckets[b])
         b++;
-    pthread_mutex_lock(&m->lock);
     if (route >= 0 && route < m->nroutes)
-        m->requests[route * (NSTATUS + 1) + s]++;
-    m->hist[b]++;
-    m->latency_sum += seconds;
-    m->latency_count++;
-    pthread_mutex_unlock(&m->lock);
+        atomic_fetch_add_explicit(&m->requests[route * (NSTATUS + 1) + s], 1, memory_order_relaxed);
+    atomic_fetch_add_explicit(&m->hist[b], 1, memory_order_relaxed);
+    atomic_fetch_add_explicit(&m->latency_ns, (unsigned long long)(seconds * 1e9), memory_order_relaxed);
+    atomic_fetch_add_explicit(&m->latency_count, 1, memory_order_relaxed);
 }
 
 void srv_metrics_solve(srv_metrics *m, double seconds)
@@ -88,9 +88,7 @@ void srv_metrics_output(srv_metrics *m, double seconds, size_t bytes)
 
 void srv_metrics_connection(srv_metrics *m, int delta)
 {
-    pthread_mutex_lock(&m->lock);
-    m->connections += delta;
-    pthread_mutex_unlock(&m->lock);
+    atomic_fetch_add_explicit(&m->connections, delta, memory_order_relaxed);
 }
 
 char *srv_metrics_render(srv_metrics *m, const srv_cache_stats *c, size_t queue_depth, size_t in_flight,
@@ -102,7 +100,7 @@ char *srv_metrics_render(srv_metrics *m, const srv_cache_stats *c, size_t queue_
             "# TYPE pdesolid_requests_total counter\n");
     for (int r = 0; r < m->nroutes; r++)
         for (int s = 0; s <= NSTATUS; s++) {
-            unsigned long long n = m->requests[r * (NSTATUS + 1) + s];
+            unsigned long long n = atomic_load(&m->requests[r * (NSTATUS + 1) + s]);
             if (n) {
                 if (s < NSTATUS)
                     srv_sbuf_printf(&b, "pdesolid_requests_total{route=\"%s\",status=\"%d\"} %llu\n", m->routes[r], statuses[s], n);
@@ -114,13 +112,13 @@ char *srv_metrics_render(srv_metrics *m, const srv_cache_stats *c, size_t queue_
             "# TYPE pdesolid_request_duration_seconds histogram\n");
     unsigned long long cum = 0;
     for (int i = 0; i < NBUCKET; i++) {
-        cum += m->hist[i];
+        cum += atomic_load(&m->hist[i]);
         srv_sbuf_printf(&b, "pdesolid_request_duration_seconds_bucket{le=\"%g\"} %llu\n", buckets[i], cum);
     }
-    cum += m->hist[NBUCKET];
+    cum += atomic_load(&m->hist[NBUCKET]);
     srv_sbuf_printf(&b, "pdesolid_request_duration_seconds_bucket{le=\"+Inf\"} %llu\n", cum);
     srv_sbuf_printf(&b, "pdesolid_request_duration_seconds_sum %.9g\npdesolid_request_duration_seconds_count %llu\n",
-        m->latency_sum, m->latency_count);
+        (double)atomic_load(&m->latency_ns) * 1e-9, atomic_load(&m->latency_count));
     srv_sbuf_printf(&b, "# HELP pdesolid_solve_seconds Time spent solving models (cache misses).\n"
             "# TYPE pdesolid_solve_seconds summary\n"
             "pdesolid_solve_seconds_sum %.9g\npdesolid_solve_seconds_count %llu\n",
@@ -132,7 +130,7 @@ char *srv_metrics_render(srv_metrics *m, const srv_cache_stats *c, size_t queue_
     srv_sbuf_printf(&b, "# HELP pdesolid_output_bytes_total Bytes of outputs written.\n"
             "# TYPE pdesolid_output_bytes_total counter\npdesolid_output_bytes_total %llu\n", m->output_bytes);
     srv_sbuf_printf(&b, "# HELP pdesolid_connections Open HTTP connections.\n# TYPE pdesolid_connections gauge\n"
-            "pdesolid_connections %lld\n", m->connections);
+            "pdesolid_connections %lld\n", (long long)atomic_load(&m->connections));
     pthread_mutex_unlock(&m->lock);
     srv_sbuf_printf(&b, "# HELP pdesolid_cache_hits_total Requests whose solution was cached (or being solved).\n"
             "# TYPE pdesolid_cache_hits_total counter\npdesolid_cache_hits_total %llu\n", c->hits);

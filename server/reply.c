@@ -59,6 +59,7 @@ void srv_problem(srv_req *r, int status, const char *pointer, const char *fmt, .
     r->text_len = r->text ? strlen(r->text) : 0;
     r->status = status;
     r->ctype = "application/problem+json";
+    r->etag[0] = '\0';   /* a problem is not the representation the ETag would name */
 }
 
 /* detail reads as a sentence on its own: the pointer, then what is wrong there. */

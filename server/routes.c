@@ -9,6 +9,7 @@
  * Every job checks its cost before the work (--max-work, --max-mem-mb) and
  * polls srv_job_stop() in its long loops (--job-timeout, shutdown).
  */
+#include <malloc.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -41,10 +42,7 @@ static void get_livez(srv_req *r)
 static void get_readyz(srv_req *r)
 {
     srv_server *s = r->s;
-    pthread_mutex_lock(&s->lock);
-    int stopping = s->stopping;
-    pthread_mutex_unlock(&s->lock);
-    if (stopping) {
+    if (atomic_load(&s->stopping)) {
         r->retry_after = 1;
         srv_problem(r, 503, NULL, "shutting down");
     } else {
@@ -69,9 +67,7 @@ static void get_metrics(srv_req *r)
     srv_server *s = r->s;
     srv_cache_stats cs;
     srv_cache_stats_get(s->cache, &cs);
-    pthread_mutex_lock(&s->lock);
-    size_t in_flight = s->in_flight;
-    pthread_mutex_unlock(&s->lock);
+    size_t in_flight = atomic_load(&s->in_flight);
     srv_set_text(r, 200, "text/plain; version=0.0.4; charset=utf-8",
                  srv_metrics_render(s->metrics, &cs, srv_pool_depth(s->pool), in_flight, srv_rcache_hits(s->rcache)));
 }
@@ -211,6 +207,10 @@ static void post_solve(srv_req *r)
 {
     srv_server *s = r->s;
     api_error err;
+    api_cost part;
+    api_cost_parse(r->len, &part);
+    if (over_budget(r, &part))
+        return;
     double t0 = srv_now();
     pthread_mutex_lock(&s->json_lock);
     api_model *m = api_model_parse(r->body ? r->body : "", r->len, &err);
@@ -231,7 +231,6 @@ static void post_solve(srv_req *r)
         srv_problem_api(r, &err);
         return;
     }
-    api_cost part;
     api_cost_solve(api_model_get(m), &part);
     if (over_budget(r, &part)) {
         api_model_free(m);
@@ -277,6 +276,12 @@ static void post_eval(srv_req *r)
     if (!e)
         return;
     api_error err;
+    api_cost part;
+    api_cost_parse(r->len, &part);
+    if (over_budget(r, &part)) {
+        srv_cache_release(s->cache, e);
+        return;
+    }
     double *pts = NULL;
     size_t n = 0;
     int derivs = 0;
@@ -291,7 +296,6 @@ static void post_eval(srv_req *r)
         return;
     }
     const pde_solution *sol = srv_entry_solution(e);
-    api_cost part;
     api_cost_eval(sol, n, derivs, &part);
     if (over_budget(r, &part)) {
         free(pts);
@@ -346,6 +350,9 @@ void srv_run_job(void *arg)
     else
         srv_routes[r->route].handler(r);
     r->work += srv_now() - r->run_start;
+    /* A job that took much memory gives it back to the system, rather than keeping the peak. */
+    if (r->cost.bytes > 16e6)
+        malloc_trim(0);
     r->phase = SRV_DONE;
     MHD_resume_connection(r->conn);   /* the last act: the polling thread may free r from here on */
 }

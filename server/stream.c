@@ -30,7 +30,8 @@ struct srv_stream {
     srv_entry *entry;
     pthread_mutex_t lock;
     char *ring;
-    size_t head, len;       /* the bytes [head, head + len) mod SRV_STREAM_RING are ready */
+    size_t cap;             /* SRV_STREAM_RING, or a whole body's size + 1 */
+    size_t head, len;       /* the bytes [head, head + len) mod cap are ready */
     int filling;            /* a fill job is queued or running */
     int waiting;            /* the reader suspended the connection for want of bytes */
     int done, failed, closed;
@@ -61,11 +62,11 @@ static void fill(srv_stream *st)
 {
     double t0 = srv_now();
     pthread_mutex_lock(&st->lock);
-    while (!st->done && !st->failed && !st->closed && st->len < SRV_STREAM_RING) {
-        size_t tail = (st->head + st->len) % SRV_STREAM_RING;
-        size_t room = SRV_STREAM_RING - st->len;
-        if (room > SRV_STREAM_RING - tail)
-            room = SRV_STREAM_RING - tail;
+    while (!st->done && !st->failed && !st->closed && st->len < st->cap) {
+        size_t tail = (st->head + st->len) % st->cap;
+        size_t room = st->cap - st->len;
+        if (room > st->cap - tail)
+            room = st->cap - tail;
         pthread_mutex_unlock(&st->lock);
         /* The reader copies only [head, head + len): this part of the ring is ours. */
         long n = api_output_read(st->out, st->ring + tail, room);
@@ -99,8 +100,11 @@ static void fill_job(void *arg)
 
 srv_stream *srv_stream_start(srv_req *r, api_output *o, srv_entry *e, int *whole)
 {
+    /* A body the response cache may keep is made whole here; any other streams through the ring. */
+    long long size = api_output_size(o);
+    size_t cap = r->key && size >= 0 && size <= (long long)SRV_RCACHE_MAX_ITEM ? (size_t)size + 1 : SRV_STREAM_RING;
     srv_stream *st = calloc(1, sizeof *st);
-    if (!st || !(st->ring = malloc(SRV_STREAM_RING)) || pthread_mutex_init(&st->lock, NULL)) {
+    if (!st || !(st->ring = malloc(cap)) || pthread_mutex_init(&st->lock, NULL)) {
         if (st)
             free(st->ring);
         free(st);
@@ -110,6 +114,7 @@ srv_stream *srv_stream_start(srv_req *r, api_output *o, srv_entry *e, int *whole
         return NULL;
     }
     st->s = r->s;
+    st->cap = cap;
     st->conn = r->conn;
     st->out = o;
     st->entry = e;
@@ -131,7 +136,7 @@ srv_stream *srv_stream_start(srv_req *r, api_output *o, srv_entry *e, int *whole
     }
     *whole = st->done;
     if (st->done) {
-        /* The whole body fits in one ring: hand it over as text (it may be cached). */
+        /* The whole body is here: hand it over as text (the response cache may keep it). */
         char *text = malloc(st->len + 1);
         if (text) {
             memcpy(text, st->ring, st->len);
@@ -156,17 +161,17 @@ static ssize_t reader(void *cls, uint64_t pos, char *buf, size_t max)
     pthread_mutex_lock(&st->lock);
     if (st->len) {
         n = (ssize_t)(st->len < max ? st->len : max);
-        size_t first = SRV_STREAM_RING - st->head;
+        size_t first = st->cap - st->head;
         if (first > (size_t)n)
             first = (size_t)n;
         memcpy(buf, st->ring + st->head, first);
         memcpy(buf + first, st->ring, (size_t)n - first);
-        st->head = (st->head + (size_t)n) % SRV_STREAM_RING;
+        st->head = (st->head + (size_t)n) % st->cap;
         st->len -= (size_t)n;
         st->bytes += n;
         if (st->r)
             st->r->sent = st->bytes;
-        if (!st->filling && !st->done && !st->failed && st->len < SRV_STREAM_RING / 2)
+        if (!st->filling && !st->done && !st->failed && st->len < st->cap / 2)
             submit = st->filling = 1;
     } else if (st->failed || atomic_load(&st->s->aborting)) {
         n = MHD_CONTENT_READER_END_WITH_ERROR;
