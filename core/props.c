@@ -209,13 +209,21 @@ static pde_status sweep(const pde_solution *s, const double *us, size_t nu, cons
 
 /*
  * The boundary residual: the largest error of x and x_w on res x res points of w = 0 and w = 1,
- * relative to the scale of what the boundary fit had to meet there: the model's boundary terms
- * and the particular solution's own boundary values (the force's drive), each as a sum of
- * absolute values of its terms. Not relative to the solution: near a clamped eigenvalue the
- * solution grows like 1/delta and its digits go with it, and that loss must show. A component
- * with neither (nothing to fit) is measured against its own values.
+ * relative to the size of the problem, which must not be the solution's size alone:
+ *
+ * - near a clamped eigenvalue the boundary fit amplifies: the solution grows like 1/delta and
+ *   keeps about 4e-16/delta of its digits; measured against the data, the error shows that loss;
+ * - a force (or a chain parent) drives the fit through the particular solution's boundary values;
+ *   without boundary terms these are the only scale (the solution is ~0 on w = 0, 1);
+ * - but a particular solution much larger than the solution (a w^12 force with e near 1) cancels
+ *   against the fit and loses digits in proportion: so the drive counts only up to the solution's
+ *   own size, own[c] = max |x_c| over the solid.
+ *
+ * So scale = max(data, min(drive, own)), data and drive as sums of the absolute values of their
+ * terms at each point; own alone for a component with neither.
  */
-static pde_status bc_residual(const pde_solution *s, int res, poller *pl, double *out)
+static pde_status bc_residual(const pde_solution *s, int res, const double own_size[3], poller *pl,
+                              double *out)
 {
     const size_t n = (size_t)res;
     const size_t nb = s->comp[0].nbterms + s->comp[1].nbterms + s->comp[2].nbterms;
@@ -238,7 +246,7 @@ static pde_status bc_residual(const pde_solution *s, int res, poller *pl, double
         free(uni);
         return st;
     }
-    double err[3] = { 0, 0, 0 }, scale[3] = { 0, 0, 0 }, own[3] = { 0, 0, 0 };
+    double err[3] = { 0, 0, 0 }, scale[3] = { 0, 0, 0 };
     for (size_t j = 0; j < n && st == PDE_OK; j++) {
         for (int side = 0; side < 2; side++) {
             grid_set_w(g, side);
@@ -272,10 +280,11 @@ static pde_status bc_residual(const pde_solution *s, int res, poller *pl, double
                     for (int k = 0; k < 4; k++)
                         drive[k] += fabs(cs->drive[m][k] * f);
                 }
+                for (int k = 0; k < 4; k++)
+                    drive[k] = fmin(drive[k], own_size[c]);
                 for (int side = 0; side < 2; side++) {
                     double x = row[(6 * side + c) * n + i], xw = row[(6 * side + 3 + c) * n + i];
                     err[c] = fmax(err[c], fmax(fabs(x - d[2 * side]), fabs(xw - d[2 * side + 1])));
-                    own[c] = fmax(own[c], fmax(fabs(x), fabs(xw)));
                 }
                 for (int k = 0; k < 4; k++)
                     sc = fmax(sc, drive[k]);
@@ -289,7 +298,7 @@ static pde_status bc_residual(const pde_solution *s, int res, poller *pl, double
         return st;
     double worst = 0.0;
     for (int c = 0; c < 3; c++) {
-        double sc = scale[c] > 0.0 ? scale[c] : own[c];
+        double sc = scale[c] > 0.0 ? scale[c] : own_size[c];
         worst = fmax(worst, sc > 0.0 ? err[c] / sc : err[c]);
     }
     *out = worst;
@@ -446,7 +455,10 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     r.signed_volume = svol;
     if (pl.stopped)
         return PDE_ERR_CANCELLED;
-    if ((st = bc_residual(s, res, &pl, &r.bc_residual)) != PDE_OK ||
+    double own[3];
+    for (int c = 0; c < 3; c++)
+        own[c] = fmax(fabs(r.bbox_min[c]), fabs(r.bbox_max[c]));
+    if ((st = bc_residual(s, res, own, &pl, &r.bc_residual)) != PDE_OK ||
         (st = pde_residual(s, res < 9 ? res : 9, &pl, &r.pde_residual)) != PDE_OK)
         return st;
     *out = r;
