@@ -6,7 +6,9 @@
  * The volume is composite Gauss-Legendre quadrature of |det J|, with panels
  * sized to the fastest oscillation along each axis. The accuracy certificate
  * measures what the solve promises: the boundary conditions against the
- * model's own boundary terms, and the PDE with analytic fourth derivatives.
+ * model's own boundary terms, relative to the problem's size and not the
+ * solution's (which an ill-conditioned fit inflates), and the PDE with the
+ * closed form's exact fourth derivatives (docs/MATH.md).
  */
 #include <float.h>
 #include <math.h>
@@ -215,7 +217,7 @@ static pde_status sweep(const pde_solution *s, const double *us, size_t nu, cons
  *   keeps about 4e-16/delta of its digits; measured against the data, the error shows that loss;
  * - a force (or a chain parent) drives the fit through the particular solution's boundary values;
  *   without boundary terms these are the only scale (the solution is ~0 on w = 0, 1);
- * - but a particular solution much larger than the solution (a w^12 force with e near 1) cancels
+ * - but a particular solution much larger than the solution (a w^12 force with e = 6) cancels
  *   against the fit and loses digits in proportion: so the drive counts only up to the solution's
  *   own size, own[c] = max |x_c| over the solid.
  *
@@ -264,14 +266,14 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
                 break;
             }
             for (size_t i = 0; i < n; i++) {
-                double d[4] = { 0, 0, 0, 0 }, sc = 0.0;
+                double d[4] = { 0, 0, 0, 0 }, dabs[4] = { 0, 0, 0, 0 }, sc = 0.0;
                 for (size_t t = 0; t < cs->nbterms; t++) {
                     const pde_bterm *b = &cs->bterms[t];
                     double f = fu[(t0 + t) * n + i] * fv[(t0 + t) * n + j];
                     const double bv[4] = { b->w0, b->dw0, b->w1, b->dw1 };
                     for (int k = 0; k < 4; k++) {
                         d[k] += bv[k] * f;
-                        sc = fmax(sc, fabs(bv[k] * f));
+                        dabs[k] += fabs(bv[k] * f);
                     }
                 }
                 double drive[4] = { 0, 0, 0, 0 };
@@ -287,7 +289,7 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
                     err[c] = fmax(err[c], fmax(fabs(x - d[2 * side]), fabs(xw - d[2 * side + 1])));
                 }
                 for (int k = 0; k < 4; k++)
-                    sc = fmax(sc, drive[k]);
+                    sc = fmax(sc, fmax(dabs[k], drive[k]));
                 scale[c] = fmax(scale[c], sc);
             }
         }
