@@ -512,12 +512,13 @@ static pde_status solve_component(arena *mem, arena *s, plan_cache *plans, const
     out->a = c->a;
     out->b = c->b;
     out->c = c->c;
-    out->modes = arena_alloc(mem, (n ? n : 1) * sizeof *out->modes);
+    /* The modes, then their drives, in one allocation. */
+    out->modes = arena_alloc(mem, (n ? n : 1) * (sizeof *out->modes + sizeof *out->drive));
     out->bterms = arena_alloc(mem, (c->nbterms ? c->nbterms : 1) * sizeof *out->bterms);
     out->fterms = arena_alloc(mem, (c->nfterms ? c->nfterms : 1) * sizeof *out->fterms);
-    out->drive = arena_alloc(mem, (n ? n : 1) * sizeof *out->drive);
-    if (!out->modes || !out->bterms || !out->fterms || !out->drive)
+    if (!out->modes || !out->bterms || !out->fterms)
         return PDE_ERR_NOMEM;
+    out->drive = (double (*)[4])(out->modes + (n ? n : 1));
     if (c->nbterms)
         memcpy(out->bterms, c->bterms, c->nbterms * sizeof *out->bterms);
     if (c->nfterms)
