@@ -68,8 +68,9 @@ double factor_deriv(pde_factor f, double t, int n)
         return ipow(f.p, n) * exp(f.p * t);
     case PDE_SINH:
     case PDE_COSH: {
-        int odd = (n & 1) ^ (f.kind == PDE_COSH);
-        return ipow(f.p, n) * (odd ? sinh(f.p * t) : cosh(f.p * t));
+        /* sinh' = cosh and cosh' = sinh: sinh at even orders of sinh and odd orders of cosh. */
+        int is_sinh = ((n & 1) == 0) == (f.kind == PDE_SINH);
+        return ipow(f.p, n) * (is_sinh ? sinh(f.p * t) : cosh(f.p * t));
     }
     }
     return 0.0;

@@ -32,6 +32,9 @@ typedef struct {
     size_t nbterms, nfterms;    /* the model's terms, kept for residuals and the force */
     pde_bterm *bterms;
     pde_fterm *fterms;
+    /* Per mode, the particular solution's h(0), h'(0), h(1), h'(1): what the force (or a chain
+     * parent) asks of the boundary fit besides the data, the scale of the boundary residual. */
+    double (*drive)[4];
 } comp_solution;
 
 struct pde_solution {

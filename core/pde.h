@@ -228,8 +228,8 @@ typedef struct {
     double detj_min, detj_max;
     double detj_min_at[3];   /* (u, v, w) of the minimum */
     int folds;               /* det J takes both signs: the solid overlaps itself */
-    double bc_residual;      /* largest boundary-condition error, relative */
-    double pde_residual;     /* largest PDE residual at sample points, relative */
+    double bc_residual;      /* largest error of x, x_w on w = 0, 1, relative to the data and force (MATH.md) */
+    double pde_residual;     /* largest a x_uuuu + b x_vvvv + c x_wwww - p, relative to its largest term */
 } pde_props;
 
 /* A zeroed options struct gives the defaults. */

@@ -47,6 +47,7 @@ typedef struct {
     int src_force;        /* the term that first asked for this mode */
     long src_term;
     double bc[4];         /* w0, dw0, w1, dw1 */
+    double drive[4];      /* the particular solution's boundary values (comp_solution) */
     long first_force;     /* head of this mode's list of force terms, -1 if none */
     ep h;                 /* the solved h(w), complex */
 } mode;
@@ -462,8 +463,10 @@ static pde_status solve_mode(arena *s, plan_cache *plans, const pde_component *c
         return st;
     cplx bp[4], rhs[4], coef[4];
     ep_boundary(&hp, bp);
-    for (int i = 0; i < 4; i++)
+    for (int i = 0; i < 4; i++) {
         rhs[i] = (m->bc[i] - bp[i]) * (i & 1 ? plan->dscale : 1.0);
+        m->drive[i] = creal(bp[i]);
+    }
     double cond = plan->cond;
     if (!(cond <= COND_LIMIT)) {
         char where[64];
@@ -509,11 +512,13 @@ static pde_status solve_component(arena *mem, arena *s, plan_cache *plans, const
     out->a = c->a;
     out->b = c->b;
     out->c = c->c;
-    out->modes = arena_alloc(mem, (n ? n : 1) * sizeof *out->modes);
+    /* The modes, then their drives, in one allocation. */
+    out->modes = arena_alloc(mem, (n ? n : 1) * (sizeof *out->modes + sizeof *out->drive));
     out->bterms = arena_alloc(mem, (c->nbterms ? c->nbterms : 1) * sizeof *out->bterms);
     out->fterms = arena_alloc(mem, (c->nfterms ? c->nfterms : 1) * sizeof *out->fterms);
     if (!out->modes || !out->bterms || !out->fterms)
         return PDE_ERR_NOMEM;
+    out->drive = (double (*)[4])(out->modes + (n ? n : 1));
     if (c->nbterms)
         memcpy(out->bterms, c->bterms, c->nbterms * sizeof *out->bterms);
     if (c->nfterms)
@@ -530,6 +535,7 @@ static pde_status solve_component(arena *mem, arena *s, plan_cache *plans, const
         pm->e = -(c->a * factor_lambda(pm->u) + c->b * factor_lambda(pm->v)) / c->c;
         if ((st = to_real(mem, &modes[i].h, pm)) != PDE_OK)
             return st;
+        memcpy(out->drive[kept], modes[i].drive, sizeof out->drive[kept]);
         if (!wterms_finite(pm))
             return pde_fail(diag, PDE_ERR_RANGE, ci, modes[i].src_force, modes[i].src_term, "",
                         "component %s: the solution's coefficients overflow a double", pde_comp_name[ci]);

@@ -12,7 +12,10 @@
 
 #include <cmocka.h>
 
+#include "internal.h"   /* to perturb a solution's closed form, which the public API keeps immutable */
+#include "model.h"
 #include "support.h"
+#include "template.h"
 
 static double hermite(const double d[4], double w, int der)
 {
@@ -242,6 +245,238 @@ static void stiff_models_should_meet_their_boundary_conditions_and_the_pde(void 
     }
 }
 
+static void force_and_partials_should_not_swap_sinh_and_cosh(void **state)
+{
+    (void)state;
+    /* The certificate's false alarms on sinh and cosh came from these: checked against tfactor(). */
+    pde_bterm bx = { F_sinh(1.5), F_cosh(0.7), 1, 0.5, 2, -1 };
+    pde_bterm by = { F_pow(0), F_pow(1), 1, 0, 1, 0 }, bz = { F_pow(0), F_pow(0), 0, 1, 1, 1 };
+    pde_fterm fz = { 3, F_cosh(2), F_sinh(-1), F_cosh(1.2) };
+    pde_model m = { { { 1, 1, -1, &bx, 1, NULL, 0 }, { 1, 1, -1, &by, 1, NULL, 0 }, { 1, 1, -1, &bz, 1, &fz, 1 } } };
+    pde_solution *sol = NULL;
+    assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
+    const double u = 0.3, v = 0.8, w = 0.6;
+    assert_rel(pde_force(sol, 2, u, v, w), 3 * cosh(2 * u) * sinh(-v) * cosh(1.2 * w), 1e-14, 0);
+    /* x = h(w) sinh(1.5 u) cosh(0.7 v): its u- and v-derivatives are those of the factors. */
+    double x = pde_eval_partial(sol, 0, u, v, w, 0, 0, 0);
+    for (int n = 1; n <= 4; n++) {
+        assert_rel(pde_eval_partial(sol, 0, u, v, w, n, 0, 0), x * tfactor(bx.u, u, n) / tfactor(bx.u, u, 0), 1e-13, 0);
+        assert_rel(pde_eval_partial(sol, 0, u, v, w, 0, n, 0), x * tfactor(bx.v, v, n) / tfactor(bx.v, v, 0), 1e-13, 0);
+    }
+    pde_solution_free(sol);
+}
+
+/* The certificate: the larger of the two residuals. */
+static double certificate(const pde_solution *sol)
+{
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    return fmax(p.bc_residual, p.pde_residual);
+}
+
+static void certificate_should_be_near_rounding_on_every_preset(void **state)
+{
+    (void)state;
+    for (size_t i = 0; i < api_preset_count(); i++) {
+        const api_preset *ps = api_preset_at(i);
+        api_params par;
+        api_error err;
+        api_preset_params(ps, &par);
+        api_model *am = api_template_expand(api_preset_template(ps), &par, &err);
+        assert_non_null(am);
+        pde_solution *sol = NULL;
+        assert_int_equal(pde_solve(api_model_get(am), &sol, NULL), PDE_OK);
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        if (!(p.bc_residual < 1e-11 && p.pde_residual < 1e-11))
+            fail_msg("%s: certificate bc %.3g pde %.3g", ps->name, p.bc_residual, p.pde_residual);
+        pde_solution_free(sol);
+        api_model_free(am);
+    }
+}
+
+/* One factor of every kind, with parameters away from the clamped eigenvalues (e < 500 or between). */
+static const pde_factor every_kind[] = {
+    { PDE_POW, 6 }, { PDE_SIN, 1.2 }, { PDE_COS, 2 }, { PDE_EXP, -1.3 }, { PDE_SINH, 2 }, { PDE_COSH, 1.7 },
+};
+#define NKINDS (sizeof every_kind / sizeof every_kind[0])
+
+/*
+ * x = u, y = v and z a cubic in w, plus one term with the factor f: place 0, 1 a boundary term of x
+ * with f in u or v; 2, 3, 4 a force on x with f in u, v or w; 5 a force with f in w on z, which then
+ * has no boundary term at all. Solved with c = -1 (e > 0) or c = +1 (e < 0).
+ */
+static pde_solution *kind_model(pde_factor f, int place, double c)
+{
+    static pde_bterm bx[2], by, bz;
+    static pde_fterm fx, fz;
+    bx[0] = (pde_bterm){ F_pow(1), F_pow(0), 1, 0, 1.5, 0.5 };
+    bx[1] = (pde_bterm){ place == 0 ? f : F_cos(1), place == 1 ? f : F_pow(2), 0.3, -0.2, 0.7, 0.4 };
+    by = (pde_bterm){ F_pow(0), F_pow(1), 1, 0.2, 1, -0.1 };
+    bz = (pde_bterm){ F_pow(0), F_pow(0), 0, 1, 1, 1 };
+    fx = (pde_fterm){ 2.5, place == 2 ? f : F_pow(1), place == 3 ? f : F_sin(1), place == 4 ? f : F_cos(0.5) };
+    fz = (pde_fterm){ -4, F_sin(1), F_pow(1), f };
+    pde_model m = { { { 1, 0.5, c, bx, place < 2 ? 2 : 1, &fx, place >= 2 && place <= 4 },
+                      { 1, 1, c, &by, 1, NULL, 0 },
+                      { 0.7, 1, c, place == 5 ? NULL : &bz, place == 5 ? 0 : 1, &fz, place == 5 } } };
+    pde_solution *sol = NULL;
+    pde_diag d;
+    if (pde_solve(&m, &sol, &d) != PDE_OK)
+        fail_msg("%s(%g), place %d, c %g: %s", factor_name(f.kind), f.p, place, c, d.message);
+    return sol;
+}
+
+static void certificate_should_be_near_rounding_for_every_factor_kind_in_u_v_and_w(void **state)
+{
+    (void)state;
+    static const char *const where[] = { "boundary u", "boundary v", "force u", "force v", "force w",
+                                         "forced-only w" };
+    for (size_t k = 0; k < NKINDS; k++)
+        for (int place = 0; place < 6; place++)
+            for (int c = -1; c <= 1; c += 2) {
+                pde_solution *sol = kind_model(every_kind[k], place, c);
+                pde_props p;
+                assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+                if (!(p.bc_residual < 1e-11 && p.pde_residual < 1e-11))
+                    fail_msg("%s(%g) in %s, c = %d: certificate bc %.3g pde %.3g", factor_name(every_kind[k].kind),
+                             every_kind[k].p, where[place], c, p.bc_residual, p.pde_residual);
+                pde_solution_free(sol);
+            }
+}
+
+/* Multiplies the largest coefficient of component c's closed form by 1 + rel; returns it, to restore. */
+static double *perturb_largest(pde_solution *sol, int c, double rel, double *old)
+{
+    double *at = NULL;
+    comp_solution *cs = &sol->comp[c];
+    for (size_t m = 0; m < cs->nmodes; m++)
+        for (size_t k = 0; k < cs->modes[m].nterms; k++) {
+            const pde_wterm *t = &cs->modes[m].terms[k];
+            for (int j = 0; j <= t->deg; j++) {
+                const double *q[2] = { &t->A[j], &t->B[j] };
+                for (int i = 0; i < 2; i++)
+                    if (!at || fabs(*q[i]) > fabs(*at))
+                        at = (double *)q[i];
+            }
+        }
+    assert_non_null(at);
+    *old = *at;
+    *at *= 1.0 + rel;
+    return at;
+}
+
+static void certificate_should_catch_a_closed_form_coefficient_perturbed_by_1e_6(void **state)
+{
+    (void)state;
+    /* fig. 4a, then every factor kind, in each of the places above, on each component that has terms. */
+    pde_model fm;
+    pde_solution *sols[1 + NKINDS * 6];
+    size_t n = 0;
+    sols[n++] = figure(11, &fm);
+    assert_string_equal(paper_figure_name(11), "fig4a");
+    for (size_t k = 0; k < NKINDS; k++)
+        for (int place = 0; place < 6; place++)
+            sols[n++] = kind_model(every_kind[k], place, -1);
+    double least = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        assert_true(certificate(sols[i]) < 1e-11);
+        for (int c = 0; c < 3; c++) {
+            if (sols[i]->comp[c].nmodes == 0)
+                continue;
+            double old, *at = perturb_largest(sols[i], c, 1e-6, &old);
+            double cert = certificate(sols[i]);
+            if (!(cert > 1e-8))
+                fail_msg("model %zu, component %d: certificate %.3g after a 1e-6 perturbation", i, c, cert);
+            least = fmin(least, cert);
+            *at = old;
+        }
+        pde_solution_free(sols[i]);
+    }
+    print_message("least certificate after a perturbation: %.3g\n", least);
+}
+
+/* The first root of cos t cosh t = 1, by Newton from 4.73. */
+static double first_clamped_root(void)
+{
+    double t = 4.73;
+    for (int i = 0; i < 8; i++)
+        t -= (cos(t) * cosh(t) - 1) / (cos(t) * sinh(t) - sin(t) * cosh(t));
+    return t;
+}
+
+static void certificate_should_grow_like_one_over_the_distance_to_a_clamped_eigenvalue(void **state)
+{
+    (void)state;
+    /* x = h(w) sin(pi u) with e = a pi^4 = t1^4 (1 + delta): the boundary fit's condition grows like 1/delta,
+     * and double precision keeps about 4e-16/delta of h's digits. Driven by boundary data, then by a force
+     * alone (x then has no boundary term, and h grows like 1/delta all the same). */
+    double t1 = first_clamped_root(), e1 = t1 * t1 * t1 * t1;
+    assert_rel(e1, 500.5639017, 1e-9, 0);
+    const double deltas[] = { 1e-6, 1e-7, 1e-8, 1e-9 };
+    for (int forced = 0; forced < 2; forced++) {
+        double cert[4];
+        for (int i = 0; i < 4; i++) {
+            double a = e1 * (1 + deltas[i]) / pow(M_PI, 4);
+            pde_bterm bx = { F_sin(1), F_pow(0), 1, 0.5, -0.25, 2 }, by = { F_pow(0), F_pow(1), 1, 0, 1, 0 };
+            pde_bterm bz = { F_pow(0), F_pow(0), 0, 1, 1, 1 };
+            pde_fterm fx = { 30, F_sin(1), F_pow(0), F_pow(0) };
+            pde_model m = { { { a, 0, -1, forced ? NULL : &bx, !forced, forced ? &fx : NULL, forced },
+                              { 1, 1, -1, &by, 1, NULL, 0 }, { 1, 1, -1, &bz, 1, NULL, 0 } } };
+            pde_solution *sol = NULL;
+            assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
+            cert[i] = certificate(sol);
+            pde_solution_free(sol);
+            /* The loss shows: at least a fortieth of it, and no more than a hundred times it. */
+            if (!(cert[i] > 1e-17 / deltas[i] && cert[i] < 4e-14 / deltas[i]))
+                fail_msg("%s, delta %g: certificate %.3g, expected about %.3g", forced ? "forced" : "data",
+                         deltas[i], cert[i], 4e-16 / deltas[i]);
+        }
+        /* 1000 times closer: the certificate grows by about 1000. */
+        if (!(cert[3] > 100 * cert[0]))
+            fail_msg("%s: certificate %.3g at delta 1e-6, %.3g at 1e-9", forced ? "forced" : "data", cert[0], cert[3]);
+    }
+}
+
+/* q(w) = w^n, for the independent solver. */
+static void q_power(double w, double *out, void *ctx)
+{
+    out[0] = pow(w, *(const int *)ctx);
+}
+
+static void certificate_should_show_the_digits_lost_when_a_large_particular_solution_cancels(void **state)
+{
+    (void)state;
+    /* x = h(w) sin(pi u / 2) forced by w^n alone, e = (pi/2)^4: the particular solution grows like
+     * n!/e^(n/4) while h stays small, and the fit cancels the difference. Against the independent
+     * solver, the certificate is within a factor 1000 of the real error, above and below. */
+    const int ns[] = { 4, 8, 12, 16 };
+    for (int i = 0; i < 4; i++) {
+        pde_fterm fx = { 1, F_sin(0.5), F_pow(0), F_pow(ns[i]) };
+        pde_bterm by = { F_pow(0), F_pow(1), 1, 0, 1, 0 }, bz = { F_pow(0), F_pow(0), 0, 1, 1, 1 };
+        pde_model m = { { { 1, 1, -1, NULL, 0, &fx, 1 }, { 1, 1, -1, &by, 1, NULL, 0 },
+                          { 1, 1, -1, &bz, 1, NULL, 0 } } };
+        pde_solution *sol = NULL;
+        assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
+        double mu = pow(0.5 * M_PI, 4), bc[4] = { 0, 0, 0, 0 };
+        indep_problem p = { 1, -1, &mu, NULL, bc, q_power, (void *)&ns[i], 2 };
+        indep_solution *ind = indep_solve(&p);
+        assert_non_null(ind);
+        double err = 0, size = 0;
+        for (int k = 0; k <= 50; k++) {
+            double w = k / 50.0, x[3], h = indep_eval(ind, 0, 0, w);
+            pde_eval(sol, 1, 0.5, w, x);   /* sin(pi / 2) = 1 */
+            err = fmax(err, fabs(x[0] - h));
+            size = fmax(size, fabs(h));
+        }
+        indep_free(ind);
+        double real = err / size, cert = certificate(sol);
+        print_message("w^%d: real error %.3g, certificate %.3g\n", ns[i], real, cert);
+        if (!(cert > real / 1000 && cert < 1000 * fmax(real, 1e-13)))
+            fail_msg("w^%d: certificate %.3g for a real error of %.3g", ns[i], cert, real);
+        pde_solution_free(sol);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -250,6 +485,12 @@ int main(void)
         cmocka_unit_test(props_should_flag_a_solid_that_folds),
         cmocka_unit_test(every_paper_figure_should_meet_its_boundary_conditions_and_the_pde),
         cmocka_unit_test(stiff_models_should_meet_their_boundary_conditions_and_the_pde),
+        cmocka_unit_test(force_and_partials_should_not_swap_sinh_and_cosh),
+        cmocka_unit_test(certificate_should_be_near_rounding_on_every_preset),
+        cmocka_unit_test(certificate_should_be_near_rounding_for_every_factor_kind_in_u_v_and_w),
+        cmocka_unit_test(certificate_should_catch_a_closed_form_coefficient_perturbed_by_1e_6),
+        cmocka_unit_test(certificate_should_grow_like_one_over_the_distance_to_a_clamped_eigenvalue),
+        cmocka_unit_test(certificate_should_show_the_digits_lost_when_a_large_particular_solution_cancels),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
