@@ -203,6 +203,14 @@ static void answer_entry(srv_req *r, srv_entry *e)
         srv_rcache_put(s->rcache, r->key, r->klen, r->text, r->text_len, r->ctype, r->id, r->etag);
 }
 
+/* A large body's parse tree (some 40 bytes a byte) is freed by now; give it back to the system
+ * before the next step allocates its own, so that the two peaks do not add up (--max-mem-mb). */
+static void trim_after_parse(const srv_req *r)
+{
+    if (r->len > (256u << 10))
+        malloc_trim(0);
+}
+
 static void post_solve(srv_req *r)
 {
     srv_server *s = r->s;
@@ -215,6 +223,7 @@ static void post_solve(srv_req *r)
     pthread_mutex_lock(&s->json_lock);
     api_model *m = api_model_parse(r->body ? r->body : "", r->len, &err);
     pthread_mutex_unlock(&s->json_lock);
+    trim_after_parse(r);
     r->tm.parse = srv_now() - t0;
     if (!m) {
         srv_problem_api(r, &err);
@@ -289,6 +298,7 @@ static void post_eval(srv_req *r)
     pthread_mutex_lock(&s->json_lock);
     int rc = api_eval_parse(r->body ? r->body : "", r->len, s->cfg.max_points, &pts, &n, &derivs, &err);
     pthread_mutex_unlock(&s->json_lock);
+    trim_after_parse(r);
     r->tm.parse = srv_now() - t0;
     if (rc) {
         srv_cache_release(s->cache, e);
