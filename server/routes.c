@@ -386,8 +386,10 @@ const int srv_nroutes = (int)(sizeof srv_routes / sizeof *srv_routes);
 /* 1 if path matches pattern, with the {} segment in arg; -1 if that segment is longer than argn. */
 static int match(const char *pattern, const char *path, char *arg, size_t argn)
 {
-    if (!strcmp(pattern, "*"))
+    if (pattern[0] == '*')
         return srv_static_find(path) >= 0;
+    if (pattern[1] != path[1])   /* every pattern and path starts with '/': most rows differ next */
+        return 0;
     const char *brace = strstr(pattern, "{}");
     if (!brace)
         return !strcmp(pattern, path);
@@ -408,10 +410,12 @@ static int match(const char *pattern, const char *path, char *arg, size_t argn)
 int srv_route_find(const char *method, const char *path, char *arg, size_t argn, char *allow, size_t allown,
                    int *status)
 {
-    int found = -1, any = 0;
+    int any = 0;
     size_t used = 0;
     allow[0] = '\0';
     for (int i = 0; i < srv_nroutes; i++) {
+        if (any && srv_routes[i].path[0] == '*')
+            break;   /* no static file shares a path with the API */
         int m = match(srv_routes[i].path, path, arg, argn);
         if (m < 0) {
             *status = 400;
@@ -421,19 +425,23 @@ int srv_route_find(const char *method, const char *path, char *arg, size_t argn,
             continue;
         any = 1;
         const char *rm = srv_routes[i].method;
-        if (!strcmp(method, rm) || !strcmp(method, "OPTIONS") || (!strcmp(rm, "GET") && !strcmp(method, "HEAD"))) {
-            if (found < 0)
-                found = i;
-        }
-        used += (size_t)snprintf(allow + used, used < allown ? allown - used : 0, "%s%s", used ? ", " : "", rm);
+        if (!strcmp(method, rm) || !strcmp(method, "OPTIONS") || (!strcmp(rm, "GET") && !strcmp(method, "HEAD")))
+            return i;
+    }
+    *status = any ? 405 : 404;
+    if (!any)
+        return -1;
+    /* 405: the methods the path takes. */
+    for (int i = 0; i < srv_nroutes && !(used && srv_routes[i].path[0] == '*'); i++) {
+        char tmp[96];
+        if (match(srv_routes[i].path, path, tmp, sizeof tmp) != 1)
+            continue;
+        used += (size_t)snprintf(allow + used, used < allown ? allown - used : 0, "%s%s", used ? ", " : "",
+                                 srv_routes[i].method);
         if (used >= allown)
             used = allown - 1;
     }
-    if (found >= 0)
-        return found;
-    if (any)
-        snprintf(allow + used, used < allown ? allown - used : 0, "%sOPTIONS", used ? ", " : "");
-    *status = any ? 405 : 404;
+    snprintf(allow + used, used < allown ? allown - used : 0, "%sOPTIONS", used ? ", " : "");
     return -1;
 }
 
