@@ -154,10 +154,12 @@ build/tsan/pdesolidd: $(SRV_SRC) $(API_SRC) $(CORE_SRC) build/obj/openapi.o
 	$(CC) $(STD) -O1 -g $(WARN) -Icore -Iapi $(CJSON_CFLAGS) -fcx-fortran-rules -fsanitize=thread $^ \
 	    $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@
 
-tsan: build/tsan/pdesolidd build/san/tests/test_server build/pdesolid build/san/pdesolid
+TSAN_TESTS := test_server test_hostile
+
+tsan: build/tsan/pdesolidd $(TSAN_TESTS:%=build/san/tests/%) build/pdesolid build/san/pdesolid
 	@rm -f build/tsan/report.*
-	PDESOLIDD_SAN=build/tsan/pdesolidd PDESOLID=build/pdesolid PDESOLID_SAN=build/san/pdesolid \
-	    TSAN_OPTIONS="log_path=$(CURDIR)/build/tsan/report" ./build/san/tests/test_server
+	@set -e; for t in $(TSAN_TESTS); do PDESOLIDD_SAN=build/tsan/pdesolidd PDESOLID=build/pdesolid \
+	    PDESOLID_SAN=build/san/pdesolid TSAN_OPTIONS="log_path=$(CURDIR)/build/tsan/report" ./build/san/tests/$$t; done
 	@if ls build/tsan/report.* >/dev/null 2>&1; then cat build/tsan/report.*; exit 1; fi
 
 build/bench/%: bench/%.c build/libpdeapi.a build/libpdecore.a
