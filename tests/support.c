@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cJSON.h>
 #include <cmocka.h>
 #include <curl/curl.h>
 
@@ -563,6 +564,18 @@ void threads_join(pthread_t *t, int n)
 {
     for (int i = 0; i < n; i++)
         pthread_join(t[i], NULL);
+}
+
+void expect_problem_pointer(const cJSON *problem, const char *pointer, const char *body)
+{
+    const cJSON *ptr = cJSON_GetObjectItem(problem, "pointer");
+    if (pointer) {
+        if (!cJSON_IsString(ptr))
+            fail_msg("no pointer in %s", body);
+        assert_string_equal(ptr->valuestring, pointer);
+    } else if (ptr) {
+        fail_msg("a pointer where no field is at fault: %s", body);
+    }
 }
 
 /* Case-insensitive search for a header in a head block; its value's start and length. */

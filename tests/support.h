@@ -13,6 +13,9 @@
 
 #include "pde.h"
 
+struct api_model;
+struct cJSON;
+
 /*
  * M coupled modes: c h_m'''' + mu_m h_m + sum_k K[m][k] h_k = q_m(w) on [0,1],
  * with h_m(0), h_m'(0), h_m(1), h_m'(1) = bc[4m .. 4m+3].
@@ -89,8 +92,6 @@ typedef struct {
 void daemon_start(daemon_t *d, const char *dir, const char *args);
 void daemon_stop(daemon_t *d);
 
-#endif
-
 /* ---- raw HTTP over loopback sockets, and a strict JSON check (test_hostile, test_badreq) ---- */
 
 /*
@@ -137,6 +138,9 @@ int json_strict_valid(const char *s, size_t n);
  * waits for them all. */
 void threads_start(pthread_t *t, int n, void *(*fn)(void *), void *args, size_t size);
 void threads_join(pthread_t *t, int n);
+/* A problem's "pointer" member: equal to pointer, or absent when pointer is NULL (docs/API.md: a pointer
+ * names the field at fault); body is shown on failure. */
+void expect_problem_pointer(const struct cJSON *problem, const char *pointer, const char *body);
 /* Seconds on the monotonic clock. */
 double mono_now(void);
 
@@ -175,3 +179,5 @@ int tmpdir_remove(const char *dir);
 /* Runs only the cases whose names match $CMOCKA_FILTER (cmocka's * and ? wildcards), when it is set and
  * not empty; call it in main() before cmocka_run_group_tests. `make check F=...` sets it. */
 void test_filter_from_env(void);
+
+#endif

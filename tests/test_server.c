@@ -73,15 +73,7 @@ static void expect_problem(const reply *r, long status, const char *pointer, con
     assert_int_equal(cJSON_GetObjectItem(p, "status")->valueint, status);
     if (!strstr(cJSON_GetObjectItem(p, "detail")->valuestring, words))
         fail_msg("detail \"%s\" lacks \"%s\"", cJSON_GetObjectItem(p, "detail")->valuestring, words);
-    /* A pointer names the field at fault; with none at fault there is no pointer (docs/API.md). */
-    cJSON *ptr = cJSON_GetObjectItem(p, "pointer");
-    if (pointer) {
-        if (!cJSON_IsString(ptr))
-            fail_msg("no pointer in %s", r->body);
-        assert_string_equal(ptr->valuestring, pointer);
-    } else if (ptr) {
-        fail_msg("a pointer where no field is at fault: %s", r->body);
-    }
+    expect_problem_pointer(p, pointer, r->body);
     cJSON_Delete(p);
 }
 
