@@ -132,13 +132,13 @@ build/fuzz/obj/%.o: %.c | deps
 	    -fsanitize=fuzzer-no-link -MMD -MP -c $< -o $@
 
 build/fuzz/fuzz_%: build/fuzz/obj/tests/fuzz/fuzz_%.o $(call fuzzobj,$(FUZZ_LIB_SRC)) build/obj/openapi.o
-	$(FUZZ_CC) $(SAN) -fsanitize=fuzzer $^ $(LIBS) $(CMOCKA) $(MHD) $(LDLIBS) -lpthread -o $@
+	$(FUZZ_CC) $(SAN) -fsanitize=fuzzer $^ $(LIBS) $(CMOCKA) $(CURL) $(MHD) $(LDLIBS) -lpthread -o $@
 
 build/san/tests/fuzz/%.o: CFLAGS += -Itests
 build/san/fuzz/fuzz_%: build/san/tests/fuzz/fuzz_%.o build/san/tests/fuzz/replay.o \
                        $(call san,$(FUZZ_LIB_SRC)) build/obj/openapi.o
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(MHD) $(LDLIBS) -lpthread -o $@
+	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(CURL) $(MHD) $(LDLIBS) -lpthread -o $@
 
 fuzz: $(patsubst %,build/fuzz/%,$(FUZZ_NAMES))
 	@set -e; for f in $(FUZZ_NAMES); do mkdir -p build/fuzz/corpus-$$f; \

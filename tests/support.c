@@ -13,9 +13,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cJSON.h>
 #include <cmocka.h>
+#include <curl/curl.h>
 
 #include "support.h"
+#include "template.h"
 
 /* ---- banded Gaussian elimination with partial pivoting ---- */
 
@@ -520,6 +523,61 @@ int raw_dial(int port)
     return fd;
 }
 
+void raw_send_all(int fd, const void *s, size_t n)
+{
+    const char *p = s;
+    while (n > 0) {
+        ssize_t k = send(fd, p, n, MSG_NOSIGNAL);
+        if (k <= 0)
+            return;
+        p += k, n -= (size_t)k;
+    }
+}
+
+long raw_read_to_close(int fd, char *buf, size_t cap, double seconds)
+{
+    size_t n = 0;
+    double end = mono_now() + seconds;
+    buf[0] = '\0';
+    for (;;) {
+        double left = end - mono_now();
+        struct pollfd p = { fd, POLLIN, 0 };
+        if (left <= 0 || poll(&p, 1, (int)(left * 1000) + 1) <= 0)
+            return -1;
+        ssize_t k = recv(fd, buf + n, cap - n - 1, 0);
+        if (k <= 0) {
+            buf[n] = '\0';
+            return (long)n;
+        }
+        n += (size_t)k;
+        buf[n] = '\0';
+    }
+}
+
+void threads_start(pthread_t *t, int n, void *(*fn)(void *), void *args, size_t size)
+{
+    for (int i = 0; i < n; i++)
+        assert_int_equal(pthread_create(&t[i], NULL, fn, (char *)args + (size_t)i * size), 0);
+}
+
+void threads_join(pthread_t *t, int n)
+{
+    for (int i = 0; i < n; i++)
+        pthread_join(t[i], NULL);
+}
+
+void expect_problem_pointer(const cJSON *problem, const char *pointer, const char *body)
+{
+    const cJSON *ptr = cJSON_GetObjectItem(problem, "pointer");
+    if (pointer) {
+        if (!cJSON_IsString(ptr))
+            fail_msg("no pointer in %s", body);
+        assert_string_equal(ptr->valuestring, pointer);
+    } else if (ptr) {
+        fail_msg("a pointer where no field is at fault: %s", body);
+    }
+}
+
 /* Case-insensitive search for a header in a head block; its value's start and length. */
 static const char *head_find(const char *head, size_t hlen, const char *name, size_t *vlen)
 {
@@ -778,12 +836,7 @@ void raw_reply_free(raw_reply *r)
 
 int raw_header(const raw_reply *r, const char *name, char *out, size_t n)
 {
-    size_t vlen;
-    const char *v = head_find(r->head, strlen(r->head), name, &vlen);
-    if (!v)
-        return 0;
-    snprintf(out, n, "%.*s", (int)(vlen < n ? vlen : n - 1), v);
-    return 1;
+    return http_header(r->head, name, out, n);
 }
 
 int utf8_valid(const char *s, size_t n)
@@ -987,6 +1040,112 @@ int json_strict_valid(const char *s, size_t n)
         return 0;
     j_ws(&j);
     return j.p == j.e;
+}
+
+/* ---- presets ---- */
+
+api_model *preset_model(const char *name)
+{
+    const api_preset *ps = api_preset_find(name);
+    if (!ps)
+        fail_msg("no preset %s", name);
+    api_params p;
+    api_error err;
+    api_preset_params(ps, &p);
+    api_model *m = api_template_expand(api_preset_template(ps), &p, &err);
+    assert_non_null(m);
+    return m;
+}
+
+/* ---- HTTP through libcurl ---- */
+
+static size_t on_body(char *p, size_t size, size_t n, void *cls)
+{
+    http_reply *r = cls;
+    r->body = realloc(r->body, r->len + size * n + 1);
+    memcpy(r->body + r->len, p, size * n);
+    r->len += size * n;
+    r->body[r->len] = '\0';
+    return size * n;
+}
+
+static size_t on_header(char *p, size_t size, size_t n, void *cls)
+{
+    http_reply *r = cls;
+    size_t have = strlen(r->headers);
+    if (have + size * n < sizeof r->headers) {
+        memcpy(r->headers + have, p, size * n);
+        r->headers[have + size * n] = '\0';
+    }
+    return size * n;
+}
+
+http_reply http_request(void *handle, const char *base, const char *method, const char *path, const void *body,
+                        size_t blen, const char *headers, const char *encoding)
+{
+    http_reply r = { 0 };
+    CURL *c = handle ? handle : curl_easy_init();
+    char url[512];
+    snprintf(url, sizeof url, "%s%s", base, path);
+    curl_easy_reset(c);
+    curl_easy_setopt(c, CURLOPT_URL, url);
+    curl_easy_setopt(c, CURLOPT_CUSTOMREQUEST, method);
+    if (body) {
+        curl_easy_setopt(c, CURLOPT_POSTFIELDS, body);
+        curl_easy_setopt(c, CURLOPT_POSTFIELDSIZE_LARGE, (curl_off_t)blen);
+    }
+    struct curl_slist *h = curl_slist_append(NULL, "Expect:");
+    for (const char *p = headers; p && *p;) {
+        size_t k = strcspn(p, "\n");
+        char line[512];
+        snprintf(line, sizeof line, "%.*s", (int)(k < sizeof line ? k : sizeof line - 1), p);
+        h = curl_slist_append(h, line);
+        p += k + (p[k] == '\n');
+    }
+    curl_easy_setopt(c, CURLOPT_HTTPHEADER, h);
+    if (encoding)
+        curl_easy_setopt(c, CURLOPT_ACCEPT_ENCODING, encoding);
+    curl_easy_setopt(c, CURLOPT_WRITEFUNCTION, on_body);
+    curl_easy_setopt(c, CURLOPT_WRITEDATA, &r);
+    curl_easy_setopt(c, CURLOPT_HEADERFUNCTION, on_header);
+    curl_easy_setopt(c, CURLOPT_HEADERDATA, &r);
+    curl_easy_setopt(c, CURLOPT_TIMEOUT, 120L);
+    CURLcode rc = curl_easy_perform(c);
+    if (rc != CURLE_OK)
+        r.status = -(long)rc;
+    else
+        curl_easy_getinfo(c, CURLINFO_RESPONSE_CODE, &r.status);
+    curl_slist_free_all(h);
+    if (!handle)
+        curl_easy_cleanup(c);
+    if (!r.body)
+        r.body = calloc(1, 1);
+    return r;
+}
+
+int http_header(const char *headers, const char *name, char *out, size_t n)
+{
+    const char *end = strstr(headers, "\r\n\r\n");
+    size_t vlen;
+    const char *v = head_find(headers, end ? (size_t)(end - headers) + 2 : strlen(headers), name, &vlen);
+    if (!v)
+        return 0;
+    snprintf(out, n, "%.*s", (int)(vlen < n ? vlen : n - 1), v);
+    return 1;
+}
+
+/* ---- temporary directories ---- */
+
+int tmpdir_make(char *tmpl)
+{
+    return mkdtemp(tmpl) ? 0 : -1;
+}
+
+int tmpdir_remove(const char *dir)
+{
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    return system(cmd) == 0 ? 0 : -1;
 }
 
 /* ---- running one case ---- */

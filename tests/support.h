@@ -8,9 +8,13 @@
 #ifndef TEST_SUPPORT_H
 #define TEST_SUPPORT_H
 
+#include <pthread.h>
 #include <stddef.h>
 
 #include "pde.h"
+
+struct api_model;
+struct cJSON;
 
 /*
  * M coupled modes: c h_m'''' + mu_m h_m + sum_k K[m][k] h_k = q_m(w) on [0,1],
@@ -66,6 +70,9 @@ size_t paper_figure_count(void);
 const char *paper_figure_name(size_t i);
 void paper_figure_model(size_t i, pde_model *m);
 
+/* A preset's model with its default parameters (api_model_free it); fails the test if there is none. */
+struct api_model *preset_model(const char *name);
+
 /* Reads a whole file into a NUL-terminated buffer; NULL on failure. */
 char *read_file(const char *path, size_t *len);
 
@@ -84,8 +91,6 @@ typedef struct {
 
 void daemon_start(daemon_t *d, const char *dir, const char *args);
 void daemon_stop(daemon_t *d);
-
-#endif
 
 /* ---- raw HTTP over loopback sockets, and a strict JSON check (test_hostile, test_badreq) ---- */
 
@@ -118,17 +123,61 @@ raw_reply raw_request(int port, const void *req, size_t len, int timeout_ms);
 /* The same on a connected socket fd, which the caller closes. */
 raw_reply raw_exchange(int fd, const void *req, size_t len, int timeout_ms);
 void raw_reply_free(raw_reply *r);
+/* Sends what it can of n bytes: stops when the peer closes or resets. */
+void raw_send_all(int fd, const void *s, size_t n);
+/* Reads into buf (NUL-terminated) until the peer closes or resets, or `seconds` pass in all: the bytes
+ * read, or -1 on the timeout. */
+long raw_read_to_close(int fd, char *buf, size_t cap, double seconds);
 /* A header's value into out (1), or 0 if absent; case-insensitive names. */
 int raw_header(const raw_reply *r, const char *name, char *out, size_t n);
 /* n bytes of s are well-formed UTF-8: no overlong forms, surrogates or values over U+10FFFF. */
 int utf8_valid(const char *s, size_t n);
 /* n bytes of s are one JSON text per RFC 8259, in valid UTF-8, with no lone surrogate escapes. */
 int json_strict_valid(const char *s, size_t n);
+/* n threads, the i-th running fn(args + i * size) (fails the test if one cannot start); threads_join
+ * waits for them all. */
+void threads_start(pthread_t *t, int n, void *(*fn)(void *), void *args, size_t size);
+void threads_join(pthread_t *t, int n);
+/* A problem's "pointer" member: equal to pointer, or absent when pointer is NULL (docs/API.md: a pointer
+ * names the field at fault); body is shown on failure. */
+void expect_problem_pointer(const struct cJSON *problem, const char *pointer, const char *body);
 /* Seconds on the monotonic clock. */
 double mono_now(void);
+
+/* ---- HTTP through libcurl (test_server, test_nginx) ---- */
+
+/* A response as libcurl received it. */
+typedef struct {
+    long status;          /* the HTTP status, or -CURLcode when the exchange failed */
+    char *body;           /* NUL-terminated (never NULL), len bytes; the caller frees it */
+    size_t len;
+    char headers[4096];   /* the status line and header lines as received, cut at 4095 bytes */
+} http_reply;
+
+/*
+ * One request to base (http://127.0.0.1:port) and path (with its query):
+ * method, body of blen bytes or NULL, extra header lines separated by '\n'
+ * or NULL, and Accept-Encoding (curl then decodes the body) or NULL. Sends
+ * no Expect header; times out after 120 s. With a handle c the connection
+ * may be kept alive across calls (c is reset first); with c NULL a handle
+ * is made and cleaned up. Needs curl_global_init.
+ */
+http_reply http_request(void *c, const char *base, const char *method, const char *path, const void *body,
+                        size_t blen, const char *headers, const char *encoding);
+/* A header's value among raw header lines (up to the first blank line) into out (1), or 0 if absent. */
+int http_header(const char *headers, const char *name, char *out, size_t n);
+
+/* ---- temporary directories ---- */
+
+/* mkdtemp(tmpl): 0, or -1 (a cmocka setup's convention). */
+int tmpdir_make(char *tmpl);
+/* rm -rf dir: 0, or -1. */
+int tmpdir_remove(const char *dir);
 
 /* ---- running one case (make check T=test_x F='pattern') ---- */
 
 /* Runs only the cases whose names match $CMOCKA_FILTER (cmocka's * and ? wildcards), when it is set and
  * not empty; call it in main() before cmocka_run_group_tests. `make check F=...` sets it. */
 void test_filter_from_env(void);
+
+#endif

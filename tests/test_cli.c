@@ -33,15 +33,13 @@ static int setup(void **state)
             fprintf(stderr, "test_cli: no %s; run `make test`\n", names[i] ? names[i] : dflt[i]);
             return -1;
         }
-    return mkdtemp(dir) ? 0 : -1;
+    return tmpdir_make(dir);
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return tmpdir_remove(dir);
 }
 
 static void write_text(const char *name, const char *text)

@@ -36,18 +36,6 @@ static int count_stop(void *arg)
 
 /* ---- models ---- */
 
-static api_model *preset_model(const char *name)
-{
-    const api_preset *ps = api_preset_find(name);
-    assert_non_null(ps);
-    api_params p;
-    api_error err;
-    api_preset_params(ps, &p);
-    api_model *m = api_template_expand(api_preset_template(ps), &p, &err);
-    assert_non_null(m);
-    return m;
-}
-
 static pde_solution *solve_preset(const char *name)
 {
     api_model *m = preset_model(name);

@@ -27,28 +27,13 @@ static char dir[] = "/tmp/pdesolid-out-XXXXXX";
 static int setup(void **state)
 {
     (void)state;
-    return mkdtemp(dir) ? 0 : -1;
+    return tmpdir_make(dir);
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    char cmd[96];
-    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-    return system(cmd) == 0 ? 0 : -1;
-}
-
-static api_model *preset_model(const char *name)
-{
-    const api_preset *ps = api_preset_find(name);
-    if (!ps)
-        fail_msg("no preset %s", name);
-    api_params p;
-    api_error err;
-    api_preset_params(ps, &p);
-    api_model *m = api_template_expand(api_preset_template(ps), &p, &err);
-    assert_non_null(m);
-    return m;
+    return tmpdir_remove(dir);
 }
 
 static pde_solution *solve_preset(const char *name, char id[API_ID_LEN + 1])

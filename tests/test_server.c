@@ -4,7 +4,6 @@
  * and stops it with SIGTERM, which must end in exit status 0 (so a leak the
  * sanitiser finds at exit fails the test too).
  */
-#define _GNU_SOURCE   /* strcasestr */
 #include <arpa/inet.h>
 #include <math.h>
 #include <poll.h>
@@ -42,67 +41,13 @@ static void stop(daemon_t *d)
     daemon_stop(d);
 }
 
-typedef struct {
-    long status;
-    char *body;
-    size_t len;
-    char headers[4096];
-} reply;
-
-static size_t on_body(char *p, size_t size, size_t n, void *cls)
-{
-    reply *r = cls;
-    r->body = realloc(r->body, r->len + size * n + 1);
-    memcpy(r->body + r->len, p, size * n);
-    r->len += size * n;
-    r->body[r->len] = '\0';
-    return size * n;
-}
-
-static size_t on_header(char *p, size_t size, size_t n, void *cls)
-{
-    reply *r = cls;
-    size_t have = strlen(r->headers);
-    if (have + size * n < sizeof r->headers) {
-        memcpy(r->headers + have, p, size * n);
-        r->headers[have + size * n] = '\0';
-    }
-    return size * n;
-}
+typedef http_reply reply;
 
 /* method, path (with query), body or NULL, one extra header or NULL. */
 static reply http(const daemon_t *d, const char *method, const char *path, const char *body, size_t blen,
                   const char *header)
 {
-    reply r = { 0 };
-    CURL *c = curl_easy_init();
-    char url[512];
-    snprintf(url, sizeof url, "%s%s", d->base, path);
-    curl_easy_setopt(c, CURLOPT_URL, url);
-    curl_easy_setopt(c, CURLOPT_CUSTOMREQUEST, method);
-    if (body) {
-        curl_easy_setopt(c, CURLOPT_POSTFIELDS, body);
-        curl_easy_setopt(c, CURLOPT_POSTFIELDSIZE_LARGE, (curl_off_t)blen);
-    }
-    struct curl_slist *h = curl_slist_append(NULL, "Expect:");
-    if (header)
-        h = curl_slist_append(h, header);
-    curl_easy_setopt(c, CURLOPT_HTTPHEADER, h);
-    curl_easy_setopt(c, CURLOPT_WRITEFUNCTION, on_body);
-    curl_easy_setopt(c, CURLOPT_WRITEDATA, &r);
-    curl_easy_setopt(c, CURLOPT_HEADERFUNCTION, on_header);
-    curl_easy_setopt(c, CURLOPT_HEADERDATA, &r);
-    curl_easy_setopt(c, CURLOPT_TIMEOUT, 120L);
-    CURLcode rc = curl_easy_perform(c);
-    if (rc != CURLE_OK)
-        r.status = -(long)rc;
-    else
-        curl_easy_getinfo(c, CURLINFO_RESPONSE_CODE, &r.status);
-    curl_slist_free_all(h);
-    curl_easy_cleanup(c);
-    if (!r.body)
-        r.body = calloc(1, 1);
-    return r;
+    return http_request(NULL, d->base, method, path, body, blen, header, NULL);
 }
 
 static reply post(const daemon_t *d, const char *path, const char *body)
@@ -113,17 +58,7 @@ static reply post(const daemon_t *d, const char *path, const char *body)
 /* The value of a response header, into out. */
 static int header_value(const reply *r, const char *name, char *out, size_t n)
 {
-    size_t len = strlen(name);
-    for (const char *p = r->headers; (p = strcasestr(p, name)); p += len)
-        if ((p == r->headers || p[-1] == '\n') && p[len] == ':') {
-            p += len + 1;
-            while (*p == ' ')
-                p++;
-            size_t k = strcspn(p, "\r\n");
-            snprintf(out, n, "%.*s", (int)(k < n ? k : n - 1), p);
-            return 1;
-        }
-    return 0;
+    return http_header(r->headers, name, out, n);
 }
 
 static void expect_problem(const reply *r, long status, const char *pointer, const char *words)
@@ -138,25 +73,14 @@ static void expect_problem(const reply *r, long status, const char *pointer, con
     assert_int_equal(cJSON_GetObjectItem(p, "status")->valueint, status);
     if (!strstr(cJSON_GetObjectItem(p, "detail")->valuestring, words))
         fail_msg("detail \"%s\" lacks \"%s\"", cJSON_GetObjectItem(p, "detail")->valuestring, words);
-    /* A pointer names the field at fault; with none at fault there is no pointer (docs/API.md). */
-    cJSON *ptr = cJSON_GetObjectItem(p, "pointer");
-    if (pointer) {
-        if (!cJSON_IsString(ptr))
-            fail_msg("no pointer in %s", r->body);
-        assert_string_equal(ptr->valuestring, pointer);
-    } else if (ptr) {
-        fail_msg("a pointer where no field is at fault: %s", r->body);
-    }
+    expect_problem_pointer(p, pointer, r->body);
     cJSON_Delete(p);
 }
 
 static pde_solution *local_solve(const char *preset, char *id)
 {
-    const api_preset *ps = api_preset_find(preset);
-    api_params p;
+    api_model *m = preset_model(preset);
     api_error err;
-    api_preset_params(ps, &p);
-    api_model *m = api_template_expand(api_preset_template(ps), &p, &err);
     pde_solution *s;
     assert_int_equal(api_solve(m, &s, &err), 0);
     if (id)
@@ -182,16 +106,14 @@ static int setup(void **state)
     (void)state;
     curl_global_init(CURL_GLOBAL_ALL);
     signal(SIGPIPE, SIG_IGN);
-    return mkdtemp(dir) ? 0 : -1;
+    return tmpdir_make(dir);
 }
 
 static int teardown(void **state)
 {
     (void)state;
     curl_global_cleanup();
-    char cmd[96];
-    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return tmpdir_remove(dir);
 }
 
 /* ---- every format, against the core ---- */
@@ -389,14 +311,12 @@ static void concurrent_identical_requests_should_solve_once(void **state)
     enum { N = 16 };
     pthread_t t[N];
     same_arg a[N];
-    for (int i = 0; i < N; i++) {
+    for (int i = 0; i < N; i++)
         a[i] = (same_arg){ &d, 0 };
-        pthread_create(&t[i], NULL, same_request, &a[i]);
-    }
-    for (int i = 0; i < N; i++) {
-        pthread_join(t[i], NULL);
+    threads_start(t, N, same_request, a, sizeof *a);
+    threads_join(t, N);
+    for (int i = 0; i < N; i++)
         assert_int_equal(a[i].status, 200);
-    }
     /* One solve; every other request found the solution, or the whole response, already made. */
     assert_int_equal(metric(&d, "pdesolid_cache_misses_total"), 1);
     assert_int_equal(metric(&d, "pdesolid_cache_hits_total") + metric(&d, "pdesolid_response_cache_hits_total"), N - 1);
@@ -473,15 +393,13 @@ static void sixty_four_concurrent_clients_should_all_get_correct_answers(void **
     enum { N = 64 };
     pthread_t t[N];
     client_arg a[N];
-    for (int i = 0; i < N; i++) {
+    for (int i = 0; i < N; i++)
         a[i] = (client_arg){ &d, i, 0 };
-        pthread_create(&t[i], NULL, client, &a[i]);
-    }
-    for (int i = 0; i < N; i++) {
-        pthread_join(t[i], NULL);
+    threads_start(t, N, client, a, sizeof *a);
+    threads_join(t, N);
+    for (int i = 0; i < N; i++)
         if (!a[i].ok)
             fail_msg("client %d got a wrong answer", i);
-    }
     stop(&d);
 }
 
@@ -515,13 +433,12 @@ static void a_full_queue_should_give_503_with_retry_after(void **state)
     enum { N = 8 };
     pthread_t t[N];
     heavy_arg a[N];
-    for (int i = 0; i < N; i++) {
+    for (int i = 0; i < N; i++)
         a[i] = (heavy_arg){ &d, i, 0, "" };
-        pthread_create(&t[i], NULL, heavy, &a[i]);
-    }
+    threads_start(t, N, heavy, a, sizeof *a);
+    threads_join(t, N);
     int busy = 0, ok = 0;
     for (int i = 0; i < N; i++) {
-        pthread_join(t[i], NULL);
         if (a[i].status == 503) {
             busy++;
             assert_string_equal(a[i].retry, "1");
@@ -608,28 +525,9 @@ static void bad_requests_should_get_problems_and_the_daemon_should_keep_serving(
 
 static int dial(int port)
 {
-    int fd = socket(AF_INET, SOCK_STREAM, 0);
-    struct sockaddr_in a = { .sin_family = AF_INET, .sin_port = htons((uint16_t)port) };
-    inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
-    assert_int_equal(connect(fd, (struct sockaddr *)&a, sizeof a), 0);
+    int fd = raw_dial(port);
+    assert_true(fd >= 0);
     return fd;
-}
-
-/* Reads until the peer closes or 10 s pass; returns the bytes, or -1 on a timeout. */
-static long read_to_close(int fd, char *buf, size_t cap)
-{
-    size_t n = 0;
-    for (;;) {
-        struct pollfd p = { fd, POLLIN, 0 };
-        if (poll(&p, 1, 10000) <= 0)
-            return -1;
-        ssize_t k = recv(fd, buf + n, cap - n - 1, 0);
-        if (k <= 0) {
-            buf[n] = '\0';
-            return (long)n;
-        }
-        n += (size_t)k;
-    }
 }
 
 static void two_content_lengths_and_stalled_clients_should_be_refused(void **state)
@@ -642,7 +540,7 @@ static void two_content_lengths_and_stalled_clients_should_be_refused(void **sta
     const char *req = "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: 18\r\nContent-Length: 5\r\n\r\n"
                       "{\"preset\":\"fig4a\"}";
     send(fd, req, strlen(req), 0);
-    long n = read_to_close(fd, buf, sizeof buf);
+    long n = raw_read_to_close(fd, buf, sizeof buf, 10);
     close(fd);
     assert_true(n > 0);
     assert_true(strstr(buf, " 400 ") != NULL);
@@ -652,7 +550,7 @@ static void two_content_lengths_and_stalled_clients_should_be_refused(void **sta
     send(fd, half, strlen(half), 0);
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    n = read_to_close(fd, buf, sizeof buf);
+    n = raw_read_to_close(fd, buf, sizeof buf, 10);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     close(fd);
     assert_int_equal(n, 0);

@@ -725,7 +725,7 @@ static void cli_eval_should_refuse_points_whose_values_are_not_finite(void **sta
         skip();
     }
     char dir[] = "/tmp/pdesolid-strict-XXXXXX";
-    assert_non_null(mkdtemp(dir));
+    assert_int_equal(tmpdir_make(dir), 0);
     char path[256], args[512], *out, *err;
     snprintf(path, sizeof path, "%s/pts.json", dir);
     FILE *f = fopen(path, "w");
@@ -749,8 +749,7 @@ static void cli_eval_should_refuse_points_whose_values_are_not_finite(void **sta
     assert_string_equal(out, "");
     free(out);
     free(err);
-    snprintf(args, sizeof args, "rm -rf %s", dir);
-    assert_int_equal(system(args), 0);
+    assert_int_equal(tmpdir_remove(dir), 0);
 }
 
 int main(void)

@@ -24,7 +24,7 @@ static char dir[] = "/tmp/pdesolid-web-XXXXXX";
 static void the_front_end_should_work_in_a_real_browser(void **state)
 {
     (void)state;
-    assert_non_null(mkdtemp(dir));
+    assert_int_equal(tmpdir_make(dir), 0);
     daemon_t d;
     daemon_start(&d, dir, "--web clients/web --quiet");
     char cmd[512];
@@ -38,8 +38,7 @@ static void the_front_end_should_work_in_a_real_browser(void **state)
     if (st != 0)
         fail_msg("the browser checks failed (screenshots in build/artifacts/web)");
     free(report);
-    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
-    assert_int_equal(system(cmd), 0);
+    assert_int_equal(tmpdir_remove(dir), 0);
 }
 
 int main(void)
