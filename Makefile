@@ -166,9 +166,9 @@ build/bench/%: bench/%.c build/libpdeapi.a build/libpdecore.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(CJSON_CFLAGS) $^ $(LIBS) $(LDLIBS) -o $@
 
-build/bench/bench_log: bench/bench_log.c build/obj/server/log.o
+build/bench/bench_log: bench/bench_log.c build/obj/server/log.o build/libpdeapi.a build/libpdecore.a
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -Iserver $^ $(LDLIBS) -lpthread -o $@
+	$(CC) $(CFLAGS) -Iserver $^ $(LIBS) $(LDLIBS) -lpthread -o $@
 
 # bench_cost measures the heap's peak by wrapping malloc.
 build/bench/bench_cost: LDLIBS += -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free

@@ -16,13 +16,8 @@
 
 #define REPLACEMENT "\xEF\xBF\xBD"   /* U+FFFD in UTF-8 */
 
-/*
- * The length of the UTF-8 character at s (n > 0 bytes), or 0 if none starts
- * there; then *part gets the length of the longest valid start of one (at
- * least 1), the bytes that one U+FFFD replaces. The ranges are Table 3-7 of
- * Unicode 15: they exclude overlongs, surrogates and code points past U+10FFFF.
- */
-static size_t utf8_char(const unsigned char *s, size_t n, size_t *part)
+/* The ranges are Table 3-7 of Unicode 15: they exclude overlongs, surrogates and code points past U+10FFFF. */
+size_t api_utf8_char(const unsigned char *s, size_t n, size_t *part)
 {
     unsigned char c = s[0], lo = 0x80, hi = 0xBF;
     size_t need;
@@ -64,7 +59,7 @@ size_t api_text_clean(char *out, size_t outn, const char *s, size_t n)
     const unsigned char *u = (const unsigned char *)s;
     size_t w = 0, i = 0;
     while (i < n) {
-        size_t part, k = utf8_char(u + i, n - i, &part);
+        size_t part, k = api_utf8_char(u + i, n - i, &part);
         const char *src = s + i;
         size_t m = k;
         if (k == 0 || (k == 1 && (u[i] < 0x20 || u[i] == 0x7f))) {
@@ -331,7 +326,7 @@ static int string(checker *c, int levels)
         if (b < 0x20)
             return fail(c, at, levels, "the control character 0x%02X in a string; write it escaped (\\n, "
                         "\\t, \\u00XX)", b);
-        size_t part, k = utf8_char(c->s + at, c->len - at, &part);
+        size_t part, k = api_utf8_char(c->s + at, c->len - at, &part);
         if (k == 0)
             return fail(c, at, levels, "invalid UTF-8 in a string: the byte 0x%02X %s", b,
                         utf8_fault(c->s + at, c->len - at, part));

@@ -38,6 +38,11 @@
  * the value. Nesting deeper than API_MAX_DEPTH is status 413 (a size limit, as docs/API.md says). */
 int api_json_check(const char *text, size_t len, api_error *err);
 
+/* The length of the UTF-8 character at s (n > 0 bytes), or 0 if no valid one starts there; then
+ * *part gets the length of the longest valid start of one (at least 1), the bytes that one U+FFFD
+ * replaces. Cannot fail. */
+size_t api_utf8_char(const unsigned char *s, size_t n, size_t *part);
+
 /* Copies s (n bytes) into out (outn > 0, always NUL-terminated, truncated at a character boundary),
  * replacing each invalid UTF-8 sequence by U+FFFD and each control character (< 0x20, 0x7f) by U+FFFD;
  * returns the bytes written. For putting untrusted text into messages.

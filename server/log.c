@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 #include "log.h"
+#include "strict.h"
 
 #define CAP (64u << 10)
 #define PERIOD_NS 200000000L
@@ -44,22 +45,11 @@ struct srv_log {
 
 /* The length of the valid UTF-8 sequence at s (1 to 4), or 0 if s does not start one:
  * overlong forms, surrogates and code points over U+10FFFF are invalid (RFC 3629). */
+/* The length of the valid UTF-8 character at s, NUL-terminated, or 0. */
 static size_t utf8_seq(const unsigned char *s)
 {
-    unsigned c = s[0];
-    if (c < 0x80)
-        return 1;
-    if (c >= 0xc2 && c <= 0xdf)
-        return (s[1] & 0xc0) == 0x80 ? 2 : 0;
-    if (c >= 0xe0 && c <= 0xef) {
-        unsigned lo = c == 0xe0 ? 0xa0 : 0x80, hi = c == 0xed ? 0x9f : 0xbf;
-        return s[1] >= lo && s[1] <= hi && (s[2] & 0xc0) == 0x80 ? 3 : 0;
-    }
-    if (c >= 0xf0 && c <= 0xf4) {
-        unsigned lo = c == 0xf0 ? 0x90 : 0x80, hi = c == 0xf4 ? 0x8f : 0xbf;
-        return s[1] >= lo && s[1] <= hi && (s[2] & 0xc0) == 0x80 && (s[3] & 0xc0) == 0x80 ? 4 : 0;
-    }
-    return 0;
+    size_t part;
+    return api_utf8_char(s, strnlen((const char *)s, 4), &part);
 }
 
 static const char hexd[] = "0123456789abcdef";
