@@ -220,14 +220,31 @@ void pde_grid_rows(pde_grid *grid, double w, size_t j0, size_t j1, float *xyz, f
 /* Samples i/(n-1) on each axis (0.5 when n = 1) into out, 3 nu nv nw floats. */
 pde_status pde_sample(const pde_solution *sol, size_t nu, size_t nv, size_t nw, float *out);
 
-/* Properties of the solid, computed from the closed form. */
+/*
+ * Properties of the solid, computed from the closed form (docs/MATH.md, "Properties").
+ *
+ * Every integral is over the parameter cube, weighted by |det J|: where the
+ * solid folds (det J changes sign), a point of space is counted as often as
+ * the parametrisation covers it, and folds is set. Mass properties are at
+ * unit density. The bounds are certified: every point of the solid lies in
+ * [bbox_min, bbox_max], every value of det J in [detj_min, detj_max], and
+ * the solid comes within bbox_gap (det J within detj_gap) of each bound.
+ */
 typedef struct {
     double bbox_min[3], bbox_max[3];
+    double bbox_gap;         /* largest distance from a face of the box to the solid */
     double volume;           /* integral of |det J| over the unit cube */
     double signed_volume;    /* integral of det J */
     double detj_min, detj_max;
-    double detj_min_at[3];   /* (u, v, w) of the minimum */
+    double detj_min_at[3];   /* (u, v, w) where det J is within detj_gap of detj_min */
+    double detj_max_at[3];   /* and of detj_max */
+    double detj_gap;
     int folds;               /* det J takes both signs: the solid overlaps itself */
+    double centroid[3];
+    double inertia[3][3];    /* about the centroid: integral of (|r|^2 I - r r^T) */
+    double principal_moments[3];   /* eigenvalues of inertia, ascending */
+    double principal_axes[3][3];   /* principal_axes[k]: the unit axis of moment k; a right-handed frame */
+    double surface_area;     /* of the closed skin: collapsed faces add nothing, inner seams are left out */
     double bc_residual;      /* largest error of x, x_w on w = 0, 1, relative to the data and force (MATH.md) */
     double pde_residual;     /* largest a x_uuuu + b x_vvvv + c x_wwww - p, relative to its largest term */
 } pde_props;
