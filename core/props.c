@@ -441,7 +441,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         return st;
 
     /* Into a local result, so that a cancelled call leaves *out untouched. */
-    pde_props r;
+    pde_props r = { 0 };
     double step = 1.0 / (res - 1);
     for (int c = 0; c < 3; c++) {
         r.bbox_min[c] = polish(s, c, 1.0, e.lo_at[c], step, &pl);
