@@ -170,3 +170,144 @@ double wterm_deriv(const pde_wterm *t, double w, int n)
     double E = exp(t->alpha * (w - t->shift));
     return E * creal(sum * cexp(I * t->beta * w));
 }
+
+void factor_derivs(pde_factor f, double t, int n, double *d)
+{
+    double w, s, c, e;
+    switch (f.kind) {
+    case PDE_POW: {
+        int p = (int)f.p;
+        for (int k = 0; k <= n; k++)
+            d[k] = k > p ? 0.0 : falling(p, k) * ipow(t, p - k);
+        return;
+    }
+    case PDE_SIN:
+    case PDE_COS: {
+        w = f.p * M_PI;
+        s = sin(w * t), c = cos(w * t);
+        /* sin: s, wc, -w^2 s, -w^3 c, ...; cos: c, -ws, -w^2 c, w^3 s, ... */
+        const double cyc[4] = { s, c, -s, -c };
+        double wk = 1.0;
+        for (int k = 0; k <= n; k++, wk *= w)
+            d[k] = wk * cyc[(k + (f.kind == PDE_COS)) & 3];
+        return;
+    }
+    case PDE_EXP:
+        e = exp(f.p * t);
+        for (int k = 0; k <= n; k++, e *= f.p)
+            d[k] = e;
+        return;
+    case PDE_SINH:
+    case PDE_COSH: {
+        s = sinh(f.p * t), c = cosh(f.p * t);
+        double wk = 1.0;
+        for (int k = 0; k <= n; k++, wk *= f.p)
+            d[k] = wk * (((k & 1) == (f.kind == PDE_SINH)) ? c : s);
+        return;
+    }
+    }
+    for (int k = 0; k <= n; k++)
+        d[k] = 0.0;
+}
+
+void mode_h_derivs(const pde_mode *m, double w, int n, double *d)
+{
+    for (int k = 0; k <= n; k++)
+        d[k] = 0.0;
+    for (size_t i = 0; i < m->nterms; i++) {
+        const pde_wterm *t = &m->terms[i];
+        const double complex z = t->alpha + I * t->beta;
+        double complex q[8];   /* (A - iB)^(j)(w), j <= n */
+        for (int j = 0; j <= n; j++) {
+            q[j] = 0.0;
+            for (int k = t->deg; k >= j; k--)
+                q[j] = q[j] * w + falling(k, j) * (t->A[k] - I * t->B[k]);
+        }
+        const double complex e = exp(t->alpha * (w - t->shift)) * cexp(I * t->beta * w);
+        for (int k = 0; k <= n; k++) {
+            double complex sum = 0.0, zp = 1.0;
+            double binom = 1.0;
+            for (int j = k; j >= 0; j--) {
+                sum += binom * zp * q[j];
+                zp *= z;
+                binom = binom * j / (k - j + 1);
+            }
+            d[k] += creal(e * sum);
+        }
+    }
+}
+
+/* max |sin| over [a, b] */
+static double maxabs_sin(double a, double b)
+{
+    if (b - a >= M_PI)
+        return 1.0;
+    double m = ceil((a - M_PI_2) / M_PI);
+    if (M_PI_2 + m * M_PI <= b)
+        return 1.0;
+    return fmax(fabs(sin(a)), fabs(sin(b)));
+}
+
+void factor_bounds(pde_factor f, double t0, double t1, int n, double *d)
+{
+    const double T = fmax(fabs(t0), fabs(t1));
+    switch (f.kind) {
+    case PDE_POW: {
+        int p = (int)f.p;
+        for (int k = 0; k <= n; k++)
+            d[k] = k > p ? 0.0 : falling(p, k) * ipow(T, p - k);
+        return;
+    }
+    case PDE_SIN:
+    case PDE_COS: {
+        double w = fabs(f.p) * M_PI, wk = 1.0;
+        for (int k = 0; k <= n; k++, wk *= w) {
+            double ph = (k + (f.kind == PDE_COS)) * M_PI_2;
+            d[k] = wk * maxabs_sin(w * t0 + ph, w * t1 + ph);
+        }
+        return;
+    }
+    case PDE_EXP: {
+        double e = exp(f.p * (f.p >= 0 ? t1 : t0)), a = fabs(f.p);
+        for (int k = 0; k <= n; k++, e *= a)
+            d[k] = e;
+        return;
+    }
+    case PDE_SINH:
+    case PDE_COSH: {
+        double a = fabs(f.p), s = sinh(a * T), c = cosh(a * T), wk = 1.0;
+        for (int k = 0; k <= n; k++, wk *= a)
+            d[k] = wk * (((k & 1) == (f.kind == PDE_SINH)) ? c : s);
+        return;
+    }
+    }
+    for (int k = 0; k <= n; k++)
+        d[k] = 0.0;
+}
+
+void mode_h_bounds(const pde_mode *m, double w0, double w1, int n, double *d)
+{
+    const double W = fmax(fabs(w0), fabs(w1));
+    for (int k = 0; k <= n; k++)
+        d[k] = 0.0;
+    for (size_t i = 0; i < m->nterms; i++) {
+        const pde_wterm *t = &m->terms[i];
+        const double az = hypot(t->alpha, t->beta);
+        double q[8];   /* bounds of |(A - iB)^(j)| over the interval */
+        for (int j = 0; j <= n; j++) {
+            q[j] = 0.0;
+            for (int k = t->deg; k >= j; k--)
+                q[j] = q[j] * W + falling(k, j) * hypot(t->A[k], t->B[k]);
+        }
+        const double E = exp(t->alpha * ((t->alpha >= 0 ? w1 : w0) - t->shift));
+        for (int k = 0; k <= n; k++) {
+            double sum = 0.0, zp = 1.0, binom = 1.0;
+            for (int j = k; j >= 0; j--) {
+                sum += binom * zp * q[j];
+                zp *= az;
+                binom = binom * j / (k - j + 1);
+            }
+            d[k] += E * sum;
+        }
+    }
+}

@@ -74,6 +74,14 @@ double factor_lambda(pde_factor f);
 /* d^n/dw^n of one w-term at w. */
 double wterm_deriv(const pde_wterm *t, double w, int n);
 
+/* f^(k)(t) for k = 0..n (n <= 7) into d[0..n]; the same for a mode's h(w). */
+void factor_derivs(pde_factor f, double t, int n, double *d);
+void mode_h_derivs(const pde_mode *m, double w, int n, double *d);
+
+/* Bounds of |f^(k)| over [t0, t1], k = 0..n (n <= 7), into d[0..n]; the same for a mode's h(w). */
+void factor_bounds(pde_factor f, double t0, double t1, int n, double *d);
+void mode_h_bounds(const pde_mode *m, double w0, double w1, int n, double *d);
+
 /* h(w) and h'(w) of a mode. */
 void mode_h(const pde_mode *m, double w, double *h, double *dh);
 

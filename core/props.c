@@ -1,31 +1,31 @@
 /*
- * props.c: properties of a solved solid, from its closed form.
+ * props.c: properties of a solved solid, from its closed form (pde.h,
+ * docs/MATH.md "Properties").
  *
- * Bounds and the extremes of det J are sampled on a uniform grid and on the
- * quadrature nodes, then polished by a compass search from the best sample.
- * The volume is composite Gauss-Legendre quadrature of |det J|, with panels
- * sized to the fastest oscillation along each axis. The accuracy certificate
- * measures what the solve promises: the boundary conditions against the
- * model's own boundary terms, relative to the problem's size and not the
- * solution's (which an ill-conditioned fit inflates), and the PDE with the
- * closed form's exact fourth derivatives (docs/MATH.md).
+ * 1. Extremes: a uniform sample, a compass search from the best samples, then
+ *    branch and bound (bound.h) from there, until the certified bound is
+ *    within 1e-9 of the solid's size of the best value (or a box budget ends:
+ *    the gap says how far it got).
+ * 2. Integrals over the solid weighted by |det J| (quad.h): volume, signed
+ *    volume, first and second moments about the box's centre, hence the
+ *    centroid, the inertia tensor about it and its principal axes (Jacobi).
+ * 3. The skin's area (quad.h).
+ * 4. The accuracy certificate: the boundary conditions against the model's
+ *    own boundary terms, relative to the problem's size and not the
+ *    solution's (which an ill-conditioned fit inflates), and the PDE with the
+ *    closed form's exact fourth derivatives.
  */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
-#include "internal.h"
+#include "bound.h"
+#include "quad.h"
 
-#define GL_N 8
-static const double gl_x[GL_N] = { -0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
-                                   -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
-                                   0.7966664774136267,  0.9602898564975363 };
-static const double gl_w[GL_N] = { 0.1012285362903763, 0.2223810344533745, 0.3137066458778873,
-                                   0.3626837833783620, 0.3626837833783620, 0.3137066458778873,
-                                   0.2223810344533745, 0.1012285362903763 };
-#define MAX_PANELS 64
-#define MAX_NODES (2u << 20)   /* quadrature nodes in all, to bound the time */
 #define POLISH_EVALS 400       /* evaluations of one compass search, at most */
+#define BB_BOXES 2000          /* boxes of one branch and bound of a coordinate, at most */
+#define BB_BOXES_J 200         /* of det J, whose bounds are looser and dearer (bound.h) */
 
 /*
  * Cancellation: the caller's stop() is polled once per POLL_WORK units of
@@ -59,41 +59,6 @@ static double det3(const double a[3], const double b[3], const double c[3])
 {
     return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
            a[2] * (b[0] * c[1] - b[1] * c[0]);
-}
-
-static double factor_freq(pde_factor f)
-{
-    switch (f.kind) {
-    case PDE_POW: return f.p;
-    case PDE_SIN:
-    case PDE_COS: return fabs(f.p) * M_PI;
-    default: return fabs(f.p);
-    }
-}
-
-/* Panels for each axis: one per 3 radians of the fastest factor (det J multiplies three). */
-static void panel_counts(const pde_solution *s, int np[3])
-{
-    double f[3] = { 0, 0, 0 };
-    for (int c = 0; c < 3; c++)
-        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
-            const pde_mode *md = &s->comp[c].modes[m];
-            f[0] = fmax(f[0], factor_freq(md->u));
-            f[1] = fmax(f[1], factor_freq(md->v));
-            for (size_t k = 0; k < md->nterms; k++) {
-                const pde_wterm *t = &md->terms[k];
-                f[2] = fmax(f[2], fmax(fmax(fabs(t->alpha), t->beta), (double)t->deg));
-            }
-        }
-    for (int a = 0; a < 3; a++) {
-        double n = 1.0 + f[a] / 3.0;
-        np[a] = n > MAX_PANELS ? MAX_PANELS : (int)n;
-    }
-    /* Fast oscillation along all three axes: halve the busiest axis until the work is bounded. */
-    while ((size_t)np[0] * np[1] * np[2] * GL_N * GL_N * GL_N > MAX_NODES) {
-        int a = np[0] >= np[1] && np[0] >= np[2] ? 0 : np[1] >= np[2] ? 1 : 2;
-        np[a] = (np[a] + 1) / 2;
-    }
 }
 
 static double detj_at(const pde_solution *s, const double p[3])
@@ -379,18 +344,104 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
 
 void pde_properties_nodes(const pde_solution *s, size_t nodes[3])
 {
-    int np[3];
-    panel_counts(s, np);
+    int np[3], n;
+    quad_panels(s, np, &n);
     for (int a = 0; a < 3; a++)
-        nodes[a] = (size_t)np[a] * GL_N;
+        nodes[a] = (size_t)np[a] * (size_t)n;
+}
+
+/*
+ * Eigenvalues (ascending) and unit eigenvectors (rows) of a symmetric 3 x 3 matrix, by cyclic
+ * Jacobi rotations (Golub and Van Loan, section 8.5): accurate to rounding for every spectrum.
+ * The axes form a right-handed frame; the first two have their largest component positive.
+ */
+static void eigen_sym3(const double A[3][3], double val[3], double vec[3][3])
+{
+    double a[3][3], v[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+    memcpy(a, A, sizeof a);
+    for (int sweep_ = 0; sweep_ < 50; sweep_++) {
+        double off = fabs(a[0][1]) + fabs(a[0][2]) + fabs(a[1][2]);
+        if (off == 0.0)
+            break;
+        for (int p = 0; p < 2; p++)
+            for (int q = p + 1; q < 3; q++) {
+                if (a[p][q] == 0.0)
+                    continue;
+                double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), sn = t * c;
+                for (int k = 0; k < 3; k++) {   /* a = J' a J */
+                    double akp = a[k][p], akq = a[k][q];
+                    a[k][p] = c * akp - sn * akq;
+                    a[k][q] = sn * akp + c * akq;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = c * apk - sn * aqk;
+                    a[q][k] = sn * apk + c * aqk;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = c * vkp - sn * vkq;
+                    v[k][q] = sn * vkp + c * vkq;
+                }
+            }
+    }
+    int ord[3] = { 0, 1, 2 };
+    for (int i = 0; i < 3; i++)
+        for (int j = i + 1; j < 3; j++)
+            if (a[ord[j]][ord[j]] < a[ord[i]][ord[i]]) {
+                int t = ord[i];
+                ord[i] = ord[j], ord[j] = t;
+            }
+    for (int i = 0; i < 3; i++) {
+        val[i] = a[ord[i]][ord[i]];
+        for (int k = 0; k < 3; k++)
+            vec[i][k] = v[k][ord[i]];
+    }
+    for (int i = 0; i < 2; i++) {
+        int big = 0;
+        for (int k = 1; k < 3; k++)
+            if (fabs(vec[i][k]) > fabs(vec[i][big]))
+                big = k;
+        if (vec[i][big] < 0)
+            for (int k = 0; k < 3; k++)
+                vec[i][k] = -vec[i][k];
+    }
+    vec[2][0] = vec[0][1] * vec[1][2] - vec[0][2] * vec[1][1];
+    vec[2][1] = vec[0][2] * vec[1][0] - vec[0][0] * vec[1][2];
+    vec[2][2] = vec[0][0] * vec[1][1] - vec[0][1] * vec[1][0];
+}
+
+/* Volume, signed volume, centroid, inertia and principal axes from the integrals about x0. */
+static void mass_properties(const quad_result *q, const double x0[3], pde_props *r)
+{
+    const double V = q->acc[Q_VOL];
+    r->volume = V;
+    r->signed_volume = q->acc[Q_SIGNED];
+    double d[3] = { 0, 0, 0 }, S[3][3];
+    for (int i = 0; i < 3; i++) {
+        d[i] = V > 0.0 ? q->acc[Q_M1 + i] / V : 0.0;
+        r->centroid[i] = x0[i] + d[i];
+    }
+    /* Second moments about x0 (r0r0, r1r1, r2r2, r0r1, r0r2, r1r2), then about the centroid. */
+    static const int pi[6] = { 0, 1, 2, 0, 0, 1 }, pj[6] = { 0, 1, 2, 1, 2, 2 };
+    for (int k = 0; k < 6; k++)
+        S[pi[k]][pj[k]] = S[pj[k]][pi[k]] = q->acc[Q_M2 + k] - V * d[pi[k]] * d[pj[k]];
+    double tr = S[0][0] + S[1][1] + S[2][2];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            r->inertia[i][j] = (i == j ? tr : 0.0) - S[i][j];
+    eigen_sym3(r->inertia, r->principal_moments, r->principal_axes);
 }
 
 pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde_props *out)
 {
     if (!s || !out)
         return PDE_ERR_INVALID;
-    int res = opts && opts->res > 0 ? opts->res : 17;
-    poller pl = { .cancel = opts ? opts->cancel : NULL };
+    int res = opts && opts->res > 0 ? opts->res : 9;
+    const pde_cancel *cancel = opts ? opts->cancel : NULL;
+    poller pl = { .cancel = cancel };
     for (int c = 0; c < 3; c++)
         for (size_t m = 0; m < s->comp[c].nmodes; m++) {
             const pde_mode *md = &s->comp[c].modes[m];
@@ -401,66 +452,75 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         }
     if (res < 2 || res > 1025)
         return PDE_ERR_INVALID;
-    int np[3];
-    panel_counts(s, np);
-    size_t nq[3], total = 0;
-    for (int a = 0; a < 3; a++) {
-        nq[a] = (size_t)np[a] * GL_N;
-        total += 2 * nq[a];
-    }
-    double *buf = malloc((total + (size_t)res) * sizeof *buf);
-    if (!buf)
+    double *uni = malloc((size_t)res * sizeof *uni);
+    if (!uni)
         return PDE_ERR_NOMEM;
-    double *node[3], *wt[3], *uni = buf + total, *p = buf;
-    for (int a = 0; a < 3; a++) {
-        node[a] = p;
-        wt[a] = p + nq[a];
-        p += 2 * nq[a];
-        double h = 1.0 / np[a];
-        for (int q = 0; q < np[a]; q++)
-            for (int r = 0; r < GL_N; r++) {
-                node[a][q * GL_N + r] = h * (q + 0.5 * (gl_x[r] + 1.0));
-                wt[a][q * GL_N + r] = 0.5 * h * gl_w[r];
-            }
-    }
     for (int i = 0; i < res; i++)
         uni[i] = (double)i / (res - 1);
-
     extremes e;
     for (int c = 0; c < 3; c++)
         e.lo[c] = DBL_MAX, e.hi[c] = -DBL_MAX;
     e.jmin = DBL_MAX;
     e.jmax = -DBL_MAX;
-    double vol, svol;
-    pde_status st = sweep(s, node[0], nq[0], node[1], nq[1], node[2], nq[2], wt[0], wt[1], wt[2],
-                          &pl, &e, &vol, &svol);
-    if (st == PDE_OK)
-        st = sweep(s, uni, res, uni, res, uni, res, NULL, NULL, NULL, &pl, &e, NULL, NULL);
-    free(buf);
+    pde_status st = sweep(s, uni, res, uni, res, uni, res, NULL, NULL, NULL, &pl, &e, NULL, NULL);
+    free(uni);
     if (st != PDE_OK)
         return st;
 
     /* Into a local result, so that a cancelled call leaves *out untouched. */
     pde_props r = { 0 };
-    double step = 1.0 / (res - 1);
+    const double step = 1.0 / (res - 1);
+    double best[8], *at[8];
     for (int c = 0; c < 3; c++) {
-        r.bbox_min[c] = polish(s, c, 1.0, e.lo_at[c], step, &pl);
-        r.bbox_max[c] = polish(s, c, -1.0, e.hi_at[c], step, &pl);
+        best[2 * c] = polish(s, c, 1.0, at[2 * c] = e.lo_at[c], step, &pl);
+        best[2 * c + 1] = polish(s, c, -1.0, at[2 * c + 1] = e.hi_at[c], step, &pl);
     }
-    r.detj_min = polish(s, 3, 1.0, e.jmin_at, step, &pl);
-    r.detj_max = polish(s, 3, -1.0, e.jmax_at, step, &pl);
-    for (int a = 0; a < 3; a++)
-        r.detj_min_at[a] = e.jmin_at[a];
-    double tol = 1e-9 * fmax(fabs(r.detj_min), fabs(r.detj_max));
-    r.folds = r.detj_min < -tol && r.detj_max > tol;
-    r.volume = vol;
-    r.signed_volume = svol;
+    best[6] = polish(s, 3, 1.0, at[6] = e.jmin_at, step, &pl);
+    best[7] = polish(s, 3, -1.0, at[7] = e.jmax_at, step, &pl);
     if (pl.stopped)
         return PDE_ERR_CANCELLED;
-    double own[3];
+    double size = 0.0, jscale = fmax(fabs(best[6]), fabs(best[7]));
     for (int c = 0; c < 3; c++)
-        own[c] = fmax(fabs(r.bbox_min[c]), fabs(r.bbox_max[c]));
-    if ((st = bc_residual(s, res, own, &pl, &r.bc_residual)) != PDE_OK ||
+        size = fmax(size, best[2 * c + 1] - best[2 * c]);
+    if (!(size > 0.0))
+        size = 1.0;
+    if (!(jscale > 0.0))
+        jscale = 1.0;
+    /* Certify each extreme from its polished point. */
+    for (int o = 0; o < 8; o++) {
+        const int what = o < 6 ? o / 2 : 3;
+        const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
+        bb_result b;
+        if ((st = bb_minimise(s, what, sign, at[o], tol, o < 6 ? BB_BOXES : BB_BOXES_J, cancel, &b)) != PDE_OK)
+            return st;
+        const double bound = sign * b.lower, gap = b.best - b.lower;
+        best[o] = sign * b.best;
+        if (o < 6) {
+            (o & 1 ? r.bbox_max : r.bbox_min)[what] = bound;
+            r.bbox_gap = fmax(r.bbox_gap, gap);
+        } else {
+            *(o == 6 ? &r.detj_min : &r.detj_max) = bound;
+            memcpy(o == 6 ? r.detj_min_at : r.detj_max_at, b.at, sizeof b.at);
+            r.detj_gap = fmax(r.detj_gap, gap);
+        }
+    }
+    /* Folds are witnessed by attained values of both signs. */
+    double tol = 1e-9 * jscale;
+    r.folds = best[6] < -tol && best[7] > tol;
+
+    double x0[3];
+    for (int c = 0; c < 3; c++)
+        x0[c] = 0.5 * (r.bbox_min[c] + r.bbox_max[c]);
+    quad_result q;
+    if ((st = quad_solid(s, x0, jscale, cancel, &q)) != PDE_OK ||
+        (st = quad_area(s, size, cancel, &r.surface_area)) != PDE_OK)
+        return st;
+    mass_properties(&q, x0, &r);
+
+    double own[3];   /* the solution's size: attained values, not bounds (which may be loose) */
+    for (int c = 0; c < 3; c++)
+        own[c] = fmax(fabs(best[2 * c]), fabs(best[2 * c + 1]));
+    if ((st = bc_residual(s, res < 17 ? 17 : res, own, &pl, &r.bc_residual)) != PDE_OK ||
         (st = pde_residual(s, res < 9 ? res : 9, &pl, &r.pde_residual)) != PDE_OK)
         return st;
     *out = r;

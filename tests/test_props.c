@@ -49,10 +49,12 @@ static void props_should_give_unit_volume_and_exact_bounds_for_the_cuboid(void *
     assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
     assert_rel(p.volume, 1.0, 1e-12, 0);
     assert_rel(p.signed_volume, 1.0, 1e-12, 0);
+    /* The box is certified: it holds the cuboid, and lies within its gap (at most 1e-12) of it. */
     const double lo[3] = { -0.5, -0.5, 0 }, hi[3] = { 0.5, 0.5, 1 };
+    assert_true(p.bbox_gap >= 0 && p.bbox_gap <= 1e-12);
     for (int c = 0; c < 3; c++) {
-        assert_rel(p.bbox_min[c], lo[c], 1e-12, 1);
-        assert_rel(p.bbox_max[c], hi[c], 1e-12, 1);
+        assert_true(p.bbox_min[c] <= lo[c] && p.bbox_min[c] >= lo[c] - p.bbox_gap);
+        assert_true(p.bbox_max[c] >= hi[c] && p.bbox_max[c] <= hi[c] + p.bbox_gap);
     }
     /* det J = z'(w) = 6w(1 - w): 0 on the faces w = 0, 1, and 1.5 at w = 1/2. */
     assert_rel(p.detj_min, 0.0, 1e-12, 1);

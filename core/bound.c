@@ -1,0 +1,362 @@
+/*
+ * bound.c: derivatives of x, their bounds over boxes, and branch and bound
+ * (bound.h).
+ */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+
+#include "bound.h"
+
+/* Partial derivatives of total order <= 4, ordered by order, then by the u order, then the v order. */
+enum { MIN = 35 };
+static const int mi_count[5] = { 1, 4, 10, 20, 35 };
+static const unsigned char mi_u[MIN] = { 0, 1, 0, 0, 2, 1, 1, 0, 0, 0, 3, 2, 2, 1, 1, 1, 0, 0,
+                                         0, 0, 4, 3, 3, 2, 2, 2, 1, 1, 1, 1, 0, 0, 0, 0, 0 };
+static const unsigned char mi_v[MIN] = { 0, 0, 1, 0, 0, 1, 0, 2, 1, 0, 0, 1, 0, 2, 1, 0, 3, 2,
+                                         1, 0, 0, 1, 0, 2, 1, 0, 3, 2, 1, 0, 4, 3, 2, 1, 0 };
+static const unsigned char mi_w[MIN] = { 0, 0, 0, 1, 0, 0, 1, 0, 1, 2, 0, 0, 1, 0, 1, 2, 0, 1,
+                                         2, 3, 0, 0, 1, 0, 1, 2, 0, 1, 2, 3, 0, 1, 2, 3, 4 };
+
+static int mi(const int n[3])
+{
+    static const int base[5] = { 0, 1, 4, 10, 20 };
+    int o = n[0] + n[1] + n[2];
+    return base[o] + (o - n[0]) * (o - n[0] + 1) / 2 + (o - n[0] - n[1]);
+}
+
+typedef struct {
+    double d[3][MIN];
+} xjet;
+
+/* bound = 0: x's partials up to order at the point b->lo; 1: bounds of their magnitudes over b. */
+static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, xjet *j)
+{
+    const int n = mi_count[order];
+    for (int c = 0; c < 3; c++) {
+        const comp_solution *cs = &s->comp[c];
+        for (int q = 0; q < n; q++)
+            j->d[c][q] = 0.0;
+        for (size_t m = 0; m < cs->nmodes; m++) {
+            const pde_mode *md = &cs->modes[m];
+            double fu[5], fv[5], h[5];
+            if (bound) {
+                factor_bounds(md->u, b->lo[0], b->hi[0], order, fu);
+                factor_bounds(md->v, b->lo[1], b->hi[1], order, fv);
+                mode_h_bounds(md, b->lo[2], b->hi[2], order, h);
+            } else {
+                factor_derivs(md->u, b->lo[0], order, fu);
+                factor_derivs(md->v, b->lo[1], order, fv);
+                mode_h_derivs(md, b->lo[2], order, h);
+            }
+            for (int q = 0; q < n; q++)
+                j->d[c][q] += fu[mi_u[q]] * fv[mi_v[q]] * h[mi_w[q]];
+        }
+    }
+}
+
+static const int perm[6][3] = { { 0, 1, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 0, 2, 1 }, { 2, 1, 0 }, { 1, 0, 2 } };
+
+/*
+ * The derivative of the objective along the nd directions dirs (nd <= 3). For det J, the sum
+ * over permutations of the product rule: each derivative falls on one of the three factors
+ * d x_r / d axis perm[r]. With a bound jet (bound = 1), every product counts positively: a bound
+ * of the derivative's magnitude.
+ */
+static double obj_deriv(const xjet *j, int what, const int *dirs, int nd, int bound)
+{
+    if (what < 3) {
+        int n[3] = { 0, 0, 0 };
+        for (int q = 0; q < nd; q++)
+            n[dirs[q]]++;
+        return j->d[what][mi(n)];
+    }
+    static const int pow3[4] = { 1, 3, 9, 27 };
+    double sum = 0.0;
+    for (int p = 0; p < 6; p++) {
+        const int *P = perm[p];
+        for (int code = 0; code < pow3[nd]; code++) {
+            int n[3][3] = { { 0 } };
+            for (int r = 0; r < 3; r++)
+                n[r][P[r]]++;
+            for (int q = 0, c = code; q < nd; q++, c /= 3)
+                n[c % 3][dirs[q]]++;
+            double prod = j->d[0][mi(n[0])] * j->d[1][mi(n[1])] * j->d[2][mi(n[2])];
+            sum += (bound || p < 3) ? prod : -prod;
+        }
+    }
+    return sum;
+}
+
+void obj_model_at(const pde_solution *s, int what, const pbox *b, obj_model *m)
+{
+    pbox c;
+    for (int a = 0; a < 3; a++)
+        c.lo[a] = c.hi[a] = 0.5 * (b->lo[a] + b->hi[a]);
+    const int order = what < 3 ? 2 : 3;
+    xjet pt, mx;
+    xjet_fill(s, &c, order, 0, &pt);
+    xjet_fill(s, b, order + 1, 1, &mx);
+    m->v = obj_deriv(&pt, what, NULL, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        m->g[k] = obj_deriv(&pt, what, &k, 1, 0);
+        for (int l = k; l < 3; l++) {
+            const int d2[2] = { k, l };
+            m->H[k][l] = m->H[l][k] = obj_deriv(&pt, what, d2, 2, 0);
+            for (int q = l; q < 3; q++) {
+                const int d3[3] = { k, l, q };
+                double t = obj_deriv(&mx, what, d3, 3, 1);
+                m->T[k][l][q] = m->T[k][q][l] = m->T[l][k][q] = m->T[l][q][k] = m->T[q][k][l] =
+                    m->T[q][l][k] = t;
+            }
+        }
+    }
+}
+
+/* The half-widths of the partial derivatives' ranges over a box of radii r around the centre. */
+static void grad_spread(const obj_model *m, const double r[3], double spread[3])
+{
+    for (int k = 0; k < 3; k++) {
+        double s = 0.0;
+        for (int l = 0; l < 3; l++) {
+            s += fabs(m->H[k][l]) * r[l];
+            for (int q = 0; q < 3; q++)
+                s += 0.5 * m->T[k][l][q] * r[l] * r[q];
+        }
+        spread[k] = s;
+    }
+}
+
+/* A lower bound of g.d + d'Hd/2 over |d_k| <= r_k. */
+static double quad_lower(const double g[3], const double H[3][3], const double r[3])
+{
+    double simple = 0.0;
+    for (int k = 0; k < 3; k++) {
+        simple -= fabs(g[k]) * r[k];
+        simple += 0.5 * fmin(0.0, H[k][k]) * r[k] * r[k];
+        for (int l = 0; l < 3; l++)
+            if (l != k)
+                simple -= 0.5 * fabs(H[k][l]) * r[k] * r[l];
+    }
+    /* On the axes the box spans, a positive definite H bounds the quadratic by its minimum over all d. */
+    int ax[3], n = 0;
+    for (int k = 0; k < 3; k++)
+        if (r[k] > 0.0)
+            ax[n++] = k;
+    double L[3][3] = { { 0 } }, y[3];
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j <= i; j++) {
+            double t = H[ax[i]][ax[j]];
+            for (int q = 0; q < j; q++)
+                t -= L[i][q] * L[j][q];
+            if (i == j) {
+                if (!(t > 0.0))
+                    return simple;
+                L[i][i] = sqrt(t);
+            } else
+                L[i][j] = t / L[j][j];
+        }
+    double gHg = 0.0;   /* g' H^-1 g = |L^-1 g|^2 */
+    for (int i = 0; i < n; i++) {
+        double t = g[ax[i]];
+        for (int q = 0; q < i; q++)
+            t -= L[i][q] * y[q];
+        y[i] = t / L[i][i];
+        gHg += y[i] * y[i];
+    }
+    return fmax(simple, -0.5 * gHg);
+}
+
+static double cubic_rest(const obj_model *m, const double r[3])
+{
+    double t = 0.0;
+    for (int k = 0; k < 3; k++)
+        for (int l = 0; l < 3; l++)
+            for (int q = 0; q < 3; q++)
+                t += m->T[k][l][q] * r[k] * r[l] * r[q];
+    return t / 6.0;
+}
+
+double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *val, double at[3])
+{
+    obj_model m;
+    double r[3], spread[3];
+    for (int pass = 0;; pass++) {
+        obj_model_at(s, what, b, &m);
+        for (int k = 0; k < 3; k++)
+            r[k] = 0.5 * (b->hi[k] - b->lo[k]);
+        if (pass == 3)
+            break;
+        grad_spread(&m, r, spread);
+        int moved = 0;
+        for (int k = 0; k < 3; k++) {
+            if (r[k] == 0.0)
+                continue;
+            double g = sign * m.g[k];
+            if (g - spread[k] > 0.0)
+                b->hi[k] = b->lo[k], moved = 1;   /* increasing: the minimum is on the low face */
+            else if (g + spread[k] < 0.0)
+                b->lo[k] = b->hi[k], moved = 1;
+        }
+        if (!moved)
+            break;
+    }
+    double g[3], H[3][3];
+    for (int k = 0; k < 3; k++) {
+        g[k] = sign * m.g[k];
+        for (int l = 0; l < 3; l++)
+            H[k][l] = sign * m.H[k][l];
+    }
+    *val = sign * m.v;
+    for (int k = 0; k < 3; k++)
+        at[k] = 0.5 * (b->lo[k] + b->hi[k]);
+    return sign * m.v + quad_lower(g, H, r) - cubic_rest(&m, r);
+}
+
+void detj_grad_range(const pde_solution *s, const pbox *b, double lo[3], double hi[3])
+{
+    obj_model m;
+    obj_model_at(s, OBJ_DETJ, b, &m);
+    double r[3], spread[3];
+    for (int k = 0; k < 3; k++)
+        r[k] = 0.5 * (b->hi[k] - b->lo[k]);
+    grad_spread(&m, r, spread);
+    for (int k = 0; k < 3; k++) {
+        lo[k] = m.g[k] - spread[k];
+        hi[k] = m.g[k] + spread[k];
+    }
+}
+
+/* ---- branch and bound ---- */
+
+typedef struct {
+    pbox b;
+    double lb;
+} bb_node;
+
+typedef struct {
+    bb_node *a;
+    size_t n, cap;
+} heap;
+
+static int heap_push(heap *h, const bb_node *x)
+{
+    if (h->n == h->cap) {
+        size_t cap = h->cap ? 2 * h->cap : 64;
+        bb_node *a = realloc(h->a, cap * sizeof *a);
+        if (!a)
+            return -1;
+        h->a = a, h->cap = cap;
+    }
+    size_t i = h->n++;
+    while (i > 0 && h->a[(i - 1) / 2].lb > x->lb) {
+        h->a[i] = h->a[(i - 1) / 2];
+        i = (i - 1) / 2;
+    }
+    h->a[i] = *x;
+    return 0;
+}
+
+static bb_node heap_pop(heap *h)
+{
+    bb_node top = h->a[0], last = h->a[--h->n];
+    size_t i = 0;
+    for (;;) {
+        size_t c = 2 * i + 1;
+        if (c >= h->n)
+            break;
+        if (c + 1 < h->n && h->a[c + 1].lb < h->a[c].lb)
+            c++;
+        if (h->a[c].lb >= last.lb)
+            break;
+        h->a[i] = h->a[c];
+        i = c;
+    }
+    if (h->n)
+        h->a[i] = last;
+    return top;
+}
+
+int obj_split_axis(const pde_solution *s, int what, const pbox *b)
+{
+    obj_model m;
+    obj_model_at(s, what, b, &m);
+    double r[3], spread[3];
+    for (int k = 0; k < 3; k++)
+        r[k] = 0.5 * (b->hi[k] - b->lo[k]);
+    grad_spread(&m, r, spread);
+    int best = -1;
+    double most = -1.0;
+    for (int k = 0; k < 3; k++) {
+        double c = r[k] * (fabs(m.g[k]) + spread[k]);
+        if (r[k] > 0.0 && c > most)
+            most = c, best = k;
+    }
+    return best;
+}
+
+pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], double tol,
+                       size_t budget, const pde_cancel *cancel, bb_result *out)
+{
+    bb_result r = { .lower = DBL_MAX, .boxes = 0 };
+    pbox p0 = { { start[0], start[1], start[2] }, { start[0], start[1], start[2] } };
+    obj_model m0;
+    obj_model_at(s, what, &p0, &m0);
+    r.best = sign * m0.v;
+    for (int k = 0; k < 3; k++)
+        r.at[k] = start[k];
+
+    heap h = { 0 };
+    bb_node n = { { { 0, 0, 0 }, { 1, 1, 1 } }, 0 };
+    double val, at[3];
+    n.lb = obj_lower(s, what, sign, &n.b, &val, at);
+    r.boxes++;
+    if (val < r.best)
+        r.best = val, r.at[0] = at[0], r.at[1] = at[1], r.at[2] = at[2];
+    pde_status st = PDE_OK;
+    if (heap_push(&h, &n))
+        return PDE_ERR_NOMEM;
+    while (h.n) {
+        if (h.a[0].lb >= r.best - tol || r.boxes >= budget)
+            break;
+        if ((r.boxes & 63) == 0 && pde_stopped(cancel)) {
+            st = PDE_ERR_CANCELLED;
+            break;
+        }
+        bb_node top = heap_pop(&h);
+        int k = obj_split_axis(s, what, &top.b);
+        if (k < 0) {   /* a point: its bound is its value */
+            r.lower = fmin(r.lower, top.lb);
+            continue;
+        }
+        double mid = 0.5 * (top.b.lo[k] + top.b.hi[k]);
+        for (int half = 0; half < 2; half++) {
+            bb_node c = top;
+            if (half)
+                c.b.lo[k] = mid;
+            else
+                c.b.hi[k] = mid;
+            c.lb = obj_lower(s, what, sign, &c.b, &val, at);
+            r.boxes++;
+            if (val < r.best)
+                r.best = val, r.at[0] = at[0], r.at[1] = at[1], r.at[2] = at[2];
+            c.lb = fmax(c.lb, top.lb);   /* a child's minimum is at least its parent's bound */
+            if (c.lb < r.best - tol) {
+                if (heap_push(&h, &c)) {
+                    st = PDE_ERR_NOMEM;
+                    break;
+                }
+            } else
+                r.lower = fmin(r.lower, c.lb);
+        }
+        if (st != PDE_OK)
+            break;
+    }
+    if (h.n)
+        r.lower = fmin(r.lower, h.a[0].lb);
+    r.lower = fmin(r.lower, r.best);
+    free(h.a);
+    if (st == PDE_OK)
+        *out = r;
+    return st;
+}

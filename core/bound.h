@@ -1,0 +1,65 @@
+/*
+ * bound.h: derivatives of x at points, their bounds over boxes of the
+ * parameter cube, and certified extremes by branch and bound (internal to
+ * core/; used by props.c and quad.c).
+ *
+ * A box of the cube may be flat along some axes (lo == hi): a face, an edge
+ * or a point. An objective is one of x, y, z (0..2) or det J (3), times a
+ * sign: its model over a box is its value, gradient and Hessian at the
+ * centre and a bound T of the third derivatives over the whole box, so that
+ *
+ *     |f(c + d) - f(c) - g.d - d'Hd/2| <= 1/6 sum_klm T_klm |d_k d_l d_m|   for c + d in the box.
+ *
+ * Bounds of derivatives come from bounds of each factor's derivatives over
+ * the box's intervals (factor_bounds, mode_h_bounds), combined as majorants:
+ * no rounding-error analysis, so "certified" holds up to the rounding of the
+ * closed form's own evaluation (about 1e-16 of its terms).
+ */
+#ifndef PDE_BOUND_H
+#define PDE_BOUND_H
+
+#include "internal.h"
+
+typedef struct {
+    double lo[3], hi[3];
+} pbox;
+
+enum { OBJ_DETJ = 3 };
+
+typedef struct {
+    double v, g[3], H[3][3];   /* value, gradient and Hessian at the centre */
+    double T[3][3][3];         /* bounds of the third derivatives' magnitudes over the box */
+} obj_model;
+
+/* The model of objective what (0..2: x_what, 3: det J) over b, unsigned. */
+void obj_model_at(const pde_solution *s, int what, const pbox *b, obj_model *m);
+
+/*
+ * A lower bound of sign * f over b. Where sign * f is certified monotone along an axis, b shrinks
+ * to the face holding the minimum, so b is changed. *val gets sign * f at the final box's centre,
+ * a value the solid attains, and at that centre.
+ */
+double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *val, double at[3]);
+
+/* The axis along which b's half-width contributes most to its bound, or -1 for a point. */
+int obj_split_axis(const pde_solution *s, int what, const pbox *b);
+
+/* The range of d(det J)/d(axis k) over b, for each k. */
+void detj_grad_range(const pde_solution *s, const pbox *b, double lo[3], double hi[3]);
+
+typedef struct {
+    double best;      /* smallest sign * f found, at `at` */
+    double at[3];
+    double lower;     /* certified: sign * f >= lower over the cube */
+    size_t boxes;     /* boxes bounded */
+} bb_result;
+
+/*
+ * Minimises sign * f over the unit cube by branch and bound, from a known point start, until the
+ * gap best - lower is at most tol or `budget` boxes have been bounded. stop() is polled every
+ * 64 boxes; returns PDE_ERR_CANCELLED then.
+ */
+pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], double tol,
+                       size_t budget, const pde_cancel *cancel, bb_result *out);
+
+#endif

@@ -1,0 +1,30 @@
+/*
+ * quad.h: integrals over the solid, weighted by |det J|, and its skin's area
+ * (internal to core/; used by props.c).
+ */
+#ifndef PDE_QUAD_H
+#define PDE_QUAD_H
+
+#include "internal.h"
+
+/* The integrals of |det J| times 1, r_i, r_i r_j (r = x - x0), and of det J. */
+enum { Q_VOL = 0, Q_M1 = 1, Q_M2 = 4, Q_SIGNED = 10, Q_N = 11 };
+/* Q_M2 + 0..5: r0r0, r1r1, r2r2, r0r1, r0r2, r1r2 */
+
+typedef struct {
+    double acc[Q_N];
+    size_t evals;       /* points evaluated */
+    size_t lined;       /* panels integrated along lines, where det J may change sign */
+} quad_result;
+
+/* jscale: the size of det J over the solid, for what counts as zero. */
+pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, const pde_cancel *cancel,
+                      quad_result *out);
+
+/* The area of the skin; size: the solid's extent, for deciding that two faces coincide. */
+pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area);
+
+/* Gauss-Legendre points per panel and panels per axis (for api/cost.h's estimate). */
+void quad_panels(const pde_solution *s, int np[3], int *n);
+
+#endif
