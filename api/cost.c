@@ -49,6 +49,11 @@
 #define K_GROUP    0.5    /* a comparison of pde_grid_create's grouping of u-factors */
 #define K_TOUCH    0.1    /* a byte of fresh memory (page faults, zeroing) */
 #define K_PT_PROPS 10.0   /* a point of a properties sweep: det J and extremes */
+#define K_BOX_MODE 150.0  /* a mode of a box's model in branch and bound: its factors' bounds and jets */
+#define K_BOX_X    100.0  /* a coordinate's model beyond its modes */
+#define K_BOXES_X  150.0  /* boxes of a coordinate's branch and bound, typically */
+#define K_BOX_J    1500.0 /* det J's model beyond its modes: the series products */
+#define K_LINE_PT  4.5    /* points per integration node: 2n + 1 samples, roots, a rule per piece */
 #define K_PT_F32   1.0    /* a sample written as f32 */
 #define K_FMT_F32  17.0   /* a float32 printed for grid json */
 #define K_DET      4.0    /* det J of a vts point */
@@ -217,22 +222,30 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
     stats_of(sol, st);
     size_t nq[3];
     pde_properties_nodes(sol, nq);
-    const double res = 17.0, rres = 9.0;
+    const double res = 9.0, bres = 17.0, rres = 9.0, pt = point_cost(st);
+    double modes = st[0].nm + st[1].nm + st[2].nm;
     double w = 0.0;
-    /* The two sweeps fill x, xu, xv and xw of every row. */
-    w += sweep_work(st, (double)nq[0], (double)nq[1], (double)nq[2], 4.0, 1) +
-         K_PT_PROPS * (double)nq[0] * (double)nq[1] * (double)nq[2];
+    /* The sample sweep, then eight compass searches. */
     w += sweep_work(st, res, res, res, 4.0, 1) + K_PT_PROPS * res * res * res;
-    /* Polish: eight compass searches of pde_eval_d points. */
-    double pt = point_cost(st);
     w += 8.0 * POLISH_EVALS * pt;
-    /* Boundary residual: per component, res^2 points at w = 0 and 1 (each a full pde_eval_d). */
-    w += 3.0 * res * res * 2.0 * pt;
+    /* Branch and bound: a box is two or three models, each a bound and a point jet of every mode,
+     * and for det J its series products (core/bound.c). Coordinates typically take K_BOXES_X
+     * boxes (at most PDE_PROPS_BOXES, a bounded error), det J half its budget. */
+    w += 6.0 * K_BOXES_X * 2.5 * (K_BOX_MODE * modes + K_BOX_X);
+    w += 2.0 * 0.5 * PDE_PROPS_BOXES_J * 2.5 * (2.0 * K_BOX_MODE * modes + K_BOX_J);
+    /* The integrals: lines through the panels' nodes, each node a few points (sampling, roots and
+     * the rule on each piece where det J may change sign), each a factor per mode. */
+    double nodes = (double)nq[0] * (double)nq[1] * (double)nq[2];
+    w += K_LINE_PT * nodes * (pt / 3.0 + K_EV_MODE * modes);
+    /* The skin: six faces of nodes, full points. */
+    w += 2.0 * ((double)nq[0] * (double)nq[1] + (double)nq[1] * (double)nq[2] + (double)nq[0] * (double)nq[2]) * pt;
+    /* Boundary residual: per component, bres^2 points at w = 0 and 1 (each a full pde_eval_d). */
+    w += 3.0 * bres * bres * 2.0 * pt;
     /* PDE residual: per component, 9^3 points of x_uuuu, x_vvvv (h itself) and x_wwww. */
     for (int i = 0; i < 3; i++)
         w += rres * rres * rres * (st[i].d4 + 2.0 * st[i].d0 + 3.0 * (st[i].fu + st[i].fv));
     c->work = w;
-    c->bytes = grid_bytes(st, (double)nq[0], (double)nq[1]) + 16.0 * (double)(nq[0] + nq[1] + nq[2]);
+    c->bytes = grid_bytes(st, res, res) + 64.0 * (PDE_PROPS_BOXES + PDE_PROPS_BOXES_J) + 64.0 * modes + 65536.0;
 }
 
 /* ---- outputs ---- */

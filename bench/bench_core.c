@@ -3,7 +3,8 @@
  *
  *   1. pde_solve() + pde_solution_free() of each paper figure's model, in
  *      microseconds (goal: <= 5 us).
- *   2. Grid sampling on one thread into float32 x, y, z: bytes per second as
+ *   2. pde_properties() of each figure's solution (goal: <= 100 us), median of rounds.
+ *   3. Grid sampling on one thread into float32 x, y, z: bytes per second as
  *      a ratio of memcpy's bandwidth over the same number of bytes, both
  *      measured in this run, interleaved (goal: >= 0.3).
  *
@@ -91,6 +92,42 @@ static void bench_solve(char **names, int nnames)
            median(med, nnames), worst);
 }
 
+/* pde_properties() per figure: rounds over all figures, one call each per round; median and min. */
+static void bench_props(char **names, int nnames)
+{
+    enum { ROUNDS = 7, MAXF = 64 };
+    static double t[MAXF][ROUNDS];
+    pde_solution *sols[MAXF];
+    for (int i = 0; i < nnames; i++) {
+        api_model *m = load(names[i]);
+        if (!m || pde_solve(api_model_get(m), &sols[i], NULL) != PDE_OK)
+            return;
+        api_model_free(m);
+    }
+    for (int r = 0; r < ROUNDS; r++)
+        for (int i = 0; i < nnames; i++) {
+            pde_props p;
+            double t0 = now();
+            pde_properties(sols[i], NULL, &p);
+            t[i][r] = (now() - t0) * 1e6;
+            sink += p.volume;
+        }
+    printf("| model | properties, median us | min us | folds | bbox gap | det J gap |\n|---|---|---|---|---|---|\n");
+    double med[MAXF];
+    for (int i = 0; i < nnames; i++) {
+        pde_props p;
+        pde_properties(sols[i], NULL, &p);
+        double lo = t[i][0];
+        for (int r = 1; r < ROUNDS; r++)
+            lo = t[i][r] < lo ? t[i][r] : lo;
+        med[i] = median(t[i], ROUNDS);
+        printf("| %s | %.0f | %.0f | %s | %.1e | %.1e |\n", names[i], med[i], lo, p.folds ? "yes" : "no",
+               p.bbox_gap, p.detj_gap);
+        pde_solution_free(sols[i]);
+    }
+    printf("\nmedian over the %d figures: %.0f us\n\n", nnames, median(med, nnames));
+}
+
 static void bench_sample(const char *name, size_t n)
 {
     api_model *m = load(name);
@@ -147,6 +184,8 @@ int main(int argc, char **argv)
                       "fig4q", "fig4r", "fig4s", "fig4t", "fig4u", "fig4v", "fig4w", "fig4x" };
     printf("## pde_solve\n\n");
     bench_solve(names, (int)(sizeof names / sizeof *names));
+    printf("## pde_properties\n\n");
+    bench_props(names, (int)(sizeof names / sizeof *names));
     printf("## Grid sampling, one thread, float32 x,y,z\n\n");
     printf("| model | grid | output | sampling | memcpy | ratio (median of per-run ratios) |\n|---|---|---|---|---|---|\n");
     const char *grids[] = { "fig1a", "fig4a", "fig3d" };

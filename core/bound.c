@@ -9,7 +9,7 @@
 #include "bound.h"
 
 /* Partial derivatives of total order <= 4, ordered by order, then by the u order, then the v order. */
-enum { MIN = 35 };
+enum { MI2 = 10, MI3 = 20, MIN = 35 };
 static const int mi_count[5] = { 1, 4, 10, 20, 35 };
 static const unsigned char mi_u[MIN] = { 0, 1, 0, 0, 2, 1, 1, 0, 0, 0, 3, 2, 2, 1, 1, 1, 0, 0,
                                          0, 0, 4, 3, 3, 2, 2, 2, 1, 1, 1, 1, 0, 0, 0, 0, 0 };
@@ -55,37 +55,63 @@ static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound
     }
 }
 
-static const int perm[6][3] = { { 0, 1, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 0, 2, 1 }, { 2, 1, 0 }, { 1, 0, 2 } };
+/*
+ * Truncated Taylor series in (u, v, w) up to order 3, coefficients t[a] = d^a f / a! indexed like
+ * the jets: products of series are then plain convolutions. conv lists (c, a, b) with a + b = c,
+ * sorted by c, so that the first conv_n[K] entries make the product to order K.
+ */
+static const unsigned char conv[84][3] = {
+    { 0, 0, 0 }, { 1, 0, 1 }, { 1, 1, 0 }, { 2, 0, 2 }, { 2, 2, 0 }, { 3, 0, 3 }, { 3, 3, 0 }, {
+    4, 0, 4 }, { 4, 1, 1 }, { 4, 4, 0 }, { 5, 0, 5 }, { 5, 1, 2 }, { 5, 2, 1 }, { 5, 5, 0 }, {
+    6, 0, 6 }, { 6, 1, 3 }, { 6, 3, 1 }, { 6, 6, 0 }, { 7, 0, 7 }, { 7, 2, 2 }, { 7, 7, 0 }, {
+    8, 0, 8 }, { 8, 2, 3 }, { 8, 3, 2 }, { 8, 8, 0 }, { 9, 0, 9 }, { 9, 3, 3 }, { 9, 9, 0 }, {
+    10, 0, 10 }, { 10, 1, 4 }, { 10, 4, 1 }, { 10, 10, 0 }, { 11, 0, 11 }, { 11, 1, 5 }, { 11,
+    2, 4 }, { 11, 4, 2 }, { 11, 5, 1 }, { 11, 11, 0 }, { 12, 0, 12 }, { 12, 1, 6 }, { 12, 3, 4
+    }, { 12, 4, 3 }, { 12, 6, 1 }, { 12, 12, 0 }, { 13, 0, 13 }, { 13, 1, 7 }, { 13, 2, 5 }, {
+    13, 5, 2 }, { 13, 7, 1 }, { 13, 13, 0 }, { 14, 0, 14 }, { 14, 1, 8 }, { 14, 2, 6 }, { 14, 3,
+    5 }, { 14, 5, 3 }, { 14, 6, 2 }, { 14, 8, 1 }, { 14, 14, 0 }, { 15, 0, 15 }, { 15, 1, 9 }, {
+    15, 3, 6 }, { 15, 6, 3 }, { 15, 9, 1 }, { 15, 15, 0 }, { 16, 0, 16 }, { 16, 2, 7 }, { 16, 7,
+    2 }, { 16, 16, 0 }, { 17, 0, 17 }, { 17, 2, 8 }, { 17, 3, 7 }, { 17, 7, 3 }, { 17, 8, 2 }, {
+    17, 17, 0 }, { 18, 0, 18 }, { 18, 2, 9 }, { 18, 3, 8 }, { 18, 8, 3 }, { 18, 9, 2 }, { 18,
+    18, 0 }, { 19, 0, 19 }, { 19, 3, 9 }, { 19, 9, 3 }, { 19, 19, 0 }
+};
+static const int conv_n[4] = { 1, 7, 28, 84 };
+
+static void series_mul(const double *a, const double *b, double *out, int K)
+{
+    for (int q = 0; q < mi_count[K]; q++)
+        out[q] = 0.0;
+    for (int i = 0; i < conv_n[K]; i++)
+        out[conv[i][0]] += a[conv[i][1]] * b[conv[i][2]];
+}
 
 /*
- * The derivative of the objective along the nd directions dirs (nd <= 3). For det J, the sum
- * over permutations of the product rule: each derivative falls on one of the three factors
- * d x_r / d axis perm[r]. With a bound jet (bound = 1), every product counts positively: a bound
- * of the derivative's magnitude.
+ * det J as a series to order K, from a jet of x (order K + 1): entry (r, a) of J is d x_r / d axis
+ * a, whose series coefficients are x_r's derivatives at index e_a + b over b!. With a bound jet
+ * (bound = 1), every term counts positively: the result bounds the series of det J term by term.
  */
-static double obj_deriv(const xjet *j, int what, const int *dirs, int nd, int bound)
+static void detj_series(const xjet *j, int K, int bound, double *out)
 {
-    if (what < 3) {
-        int n[3] = { 0, 0, 0 };
-        for (int q = 0; q < nd; q++)
-            n[dirs[q]]++;
-        return j->d[what][mi(n)];
+    static const double fact[4] = { 1, 1, 2, 6 };
+    double e[3][3][MI3], t[MI3], p[MI3];
+    for (int r = 0; r < 3; r++)
+        for (int a = 0; a < 3; a++)
+            for (int q = 0; q < mi_count[K]; q++) {
+                int n[3] = { mi_u[q], mi_v[q], mi_w[q] };
+                double f = fact[n[0]] * fact[n[1]] * fact[n[2]];
+                n[a]++;
+                e[r][a][q] = j->d[r][mi(n)] / f;
+            }
+    for (int q = 0; q < mi_count[K]; q++)
+        out[q] = 0.0;
+    static const int perm[6][3] = { { 0, 1, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 0, 2, 1 }, { 2, 1, 0 }, { 1, 0, 2 } };
+    for (int s = 0; s < 6; s++) {
+        series_mul(e[0][perm[s][0]], e[1][perm[s][1]], t, K);
+        series_mul(t, e[2][perm[s][2]], p, K);
+        const double sign = (bound || s < 3) ? 1.0 : -1.0;
+        for (int q = 0; q < mi_count[K]; q++)
+            out[q] += sign * p[q];
     }
-    static const int pow3[4] = { 1, 3, 9, 27 };
-    double sum = 0.0;
-    for (int p = 0; p < 6; p++) {
-        const int *P = perm[p];
-        for (int code = 0; code < pow3[nd]; code++) {
-            int n[3][3] = { { 0 } };
-            for (int r = 0; r < 3; r++)
-                n[r][P[r]]++;
-            for (int q = 0, c = code; q < nd; q++, c /= 3)
-                n[c % 3][dirs[q]]++;
-            double prod = j->d[0][mi(n[0])] * j->d[1][mi(n[1])] * j->d[2][mi(n[2])];
-            sum += (bound || p < 3) ? prod : -prod;
-        }
-    }
-    return sum;
 }
 
 void obj_model_at(const pde_solution *s, int what, const pbox *b, obj_model *m)
@@ -97,15 +123,33 @@ void obj_model_at(const pde_solution *s, int what, const pbox *b, obj_model *m)
     xjet pt, mx;
     xjet_fill(s, &c, order, 0, &pt);
     xjet_fill(s, b, order + 1, 1, &mx);
-    m->v = obj_deriv(&pt, what, NULL, 0, 0);
+    /* Taylor coefficients: the value, the gradient, the Hessian at the centre, the third-order bound. */
+    double tp[MI3], tb[MI3];
+    if (what < 3) {
+        static const double fact[4] = { 1, 1, 2, 6 };
+        for (int q = 0; q < MI3; q++) {
+            double f = fact[mi_u[q]] * fact[mi_v[q]] * fact[mi_w[q]];
+            tp[q] = q < MI2 ? pt.d[what][q] / f : 0.0;
+            tb[q] = mx.d[what][q] / f;
+        }
+    } else {
+        detj_series(&pt, 2, 0, tp);
+        detj_series(&mx, 3, 1, tb);
+    }
+    m->v = tp[0];
     for (int k = 0; k < 3; k++) {
-        m->g[k] = obj_deriv(&pt, what, &k, 1, 0);
+        int n[3] = { 0, 0, 0 };
+        n[k]++;
+        m->g[k] = tp[mi(n)];
         for (int l = k; l < 3; l++) {
-            const int d2[2] = { k, l };
-            m->H[k][l] = m->H[l][k] = obj_deriv(&pt, what, d2, 2, 0);
+            int n2[3] = { n[0], n[1], n[2] };
+            n2[l]++;
+            m->H[k][l] = m->H[l][k] = tp[mi(n2)] * (k == l ? 2.0 : 1.0);
             for (int q = l; q < 3; q++) {
-                const int d3[3] = { k, l, q };
-                double t = obj_deriv(&mx, what, d3, 3, 1);
+                int n3[3] = { n2[0], n2[1], n2[2] };
+                n3[q]++;
+                double f = (k == q) ? 6.0 : (k == l || l == q) ? 2.0 : 1.0;
+                double t = tb[mi(n3)] * f;
                 m->T[k][l][q] = m->T[k][q][l] = m->T[l][k][q] = m->T[l][q][k] = m->T[q][k][l] =
                     m->T[q][l][k] = t;
             }
@@ -319,7 +363,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
     while (h.n) {
         if (h.a[0].lb >= r.best - tol || r.boxes >= budget)
             break;
-        if ((r.boxes & 63) == 0 && pde_stopped(cancel)) {
+        if ((r.boxes & 15) == 0 && pde_stopped(cancel)) {
             st = PDE_ERR_CANCELLED;
             break;
         }

@@ -249,6 +249,10 @@ typedef struct {
     double pde_residual;     /* largest a x_uuuu + b x_vvvv + c x_wwww - p, relative to its largest term */
 } pde_props;
 
+/* Boxes of one branch and bound, at most: of a coordinate's extreme, and of det J's (pde_properties). */
+#define PDE_PROPS_BOXES   2000
+#define PDE_PROPS_BOXES_J 1000
+
 /* A zeroed options struct gives the defaults. */
 typedef struct {
     int res;                    /* samples per axis for bounds, det J and residuals; 0: 17 */

@@ -24,8 +24,6 @@
 #include "quad.h"
 
 #define POLISH_EVALS 400       /* evaluations of one compass search, at most */
-#define BB_BOXES 2000          /* boxes of one branch and bound of a coordinate, at most */
-#define BB_BOXES_J 200         /* of det J, whose bounds are looser and dearer (bound.h) */
 
 /*
  * Cancellation: the caller's stop() is polled once per POLL_WORK units of
@@ -344,10 +342,10 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
 
 void pde_properties_nodes(const pde_solution *s, size_t nodes[3])
 {
-    int np[3], n;
-    quad_panels(s, np, &n);
+    int np[3], n[3];
+    quad_panels(s, np, n);
     for (int a = 0; a < 3; a++)
-        nodes[a] = (size_t)np[a] * (size_t)n;
+        nodes[a] = (size_t)np[a] * (size_t)n[a];
 }
 
 /*
@@ -491,7 +489,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         const int what = o < 6 ? o / 2 : 3;
         const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
         bb_result b;
-        if ((st = bb_minimise(s, what, sign, at[o], tol, o < 6 ? BB_BOXES : BB_BOXES_J, cancel, &b)) != PDE_OK)
+        if ((st = bb_minimise(s, what, sign, at[o], tol, o < 6 ? PDE_PROPS_BOXES : PDE_PROPS_BOXES_J, cancel, &b)) != PDE_OK)
             return st;
         const double bound = sign * b.lower, gap = b.best - b.lower;
         best[o] = sign * b.best;

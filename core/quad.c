@@ -33,6 +33,9 @@
 
 #define GMAX 24        /* Gauss points per panel axis, at most */
 #define MAX_PANELS 32
+#define PANEL_PHASE 8.0       /* radians of the integrand per panel */
+#define MAX_NODES (1u << 21)  /* nodes of the rules in all: bounded work */
+#define POLL_WORK 65536       /* factor evaluations between polls of the caller's stop() */
 
 typedef struct {
     const pde_solution *s;
@@ -47,6 +50,7 @@ typedef struct {
     double *P, *Pi, *Pj;         /* 3 x maxmodes each */
     size_t maxm;
     quad_result r;
+    size_t modes, next_poll;
     int stopped;
 } qctx;
 
@@ -202,11 +206,13 @@ static void line_integrate(qctx *q, double a, double b, double wt)
     line_gauss(q, t0, b, wt);
 }
 
+/* Polls the caller's stop() once per POLL_WORK factor evaluations. */
 static int poll(qctx *q)
 {
-    if (!q->stopped && pde_stopped(q->cancel))
-        q->stopped = 1;
-    return q->stopped;
+    if (q->stopped || q->r.evals * q->modes < q->next_poll)
+        return q->stopped;
+    q->next_poll = q->r.evals * q->modes + POLL_WORK;
+    return q->stopped = pde_stopped(q->cancel);
 }
 
 /* det J has a certified sign on b, up to jtol. */
@@ -218,19 +224,6 @@ static int sign_definite(qctx *q, const pbox *b)
         return 1;
     c = *b;
     return obj_lower(q->s, OBJ_DETJ, -1.0, &c, &val, at) > -q->jtol;
-}
-
-/* Points per axis for the box: the fewest whose rule's error on exp(i f t) over the box is below
- * 1e-14, (e phi / 8n)^(2n) for a phase phi = f h (the asymptotic Gauss-Legendre error). */
-static void set_rule(qctx *q, const pbox *b)
-{
-    for (int a = 0; a < 3; a++) {
-        double phi = (b->hi[a] - b->lo[a]) * q->f[a];
-        int n = 3;
-        while (n < GMAX && 2 * n * log(M_E * phi / (8.0 * n)) > log(1e-14))
-            n++;
-        q->n[a] = n;
-    }
 }
 
 /*
@@ -273,7 +266,6 @@ static int line_axis(qctx *q, const pbox *b)
 
 static void panel(qctx *q, const pbox *b)
 {
-    set_rule(q, b);
     const int definite = sign_definite(q, b);
     int k = 0;
     if (definite) {   /* lines along the axis with the fewest points, the cheapest */
@@ -292,6 +284,8 @@ static void panel(qctx *q, const pbox *b)
         for (int c = 0; c < nj; c++) {
             p[i] = b->lo[i] + hi * q->gx[ni][a];
             p[j] = b->lo[j] + hj * q->gx[nj][c];
+            if (poll(q))
+                return;
             line_set(q, k, p);
             double wt = hi * q->gw[ni][a] * hj * q->gw[nj][c];
             if (definite)
@@ -325,15 +319,35 @@ static void frequencies(const pde_solution *s, double f[3])
         f[a] = fmax(5.0 * f[a], 1.0);
 }
 
-void quad_panels(const pde_solution *s, int np[3], int *n)
+/* The fewest Gauss-Legendre points whose error on exp(i f t) over a panel of phase phi = f h is
+ * below 1e-14: (e phi / 8n)^(2n), the rule's asymptotic error. */
+static int rule_points(double phi)
+{
+    int n = 3;
+    while (n < GMAX && 2 * n * log(M_E * phi / (8.0 * n)) > log(1e-14))
+        n++;
+    return n;
+}
+
+void quad_panels(const pde_solution *s, int np[3], int n[3])
 {
     double f[3];
     frequencies(s, f);
-    *n = 12;
     for (int a = 0; a < 3; a++) {
-        /* 12 points per panel integrate exp(i f t) to ~1e-14 while a panel spans <= 8 radians. */
-        double p = ceil(f[a] / 8.0);
+        double p = ceil(f[a] / PANEL_PHASE);   /* then 12 points per panel */
         np[a] = p < 1 ? 1 : p > MAX_PANELS ? MAX_PANELS : (int)p;
+    }
+    /* Bounded work: past MAX_NODES in all, the busiest axis gets fewer, wider panels, and its rule
+     * more points, up to GMAX: beyond, the integrals lose digits (docs/MATH.md). */
+    for (;;) {
+        for (int a = 0; a < 3; a++)
+            n[a] = rule_points(f[a] / np[a]);
+        if ((double)np[0] * n[0] * np[1] * n[1] * np[2] * n[2] <= MAX_NODES)
+            break;
+        int a = np[0] * n[0] >= np[1] * n[1] && np[0] * n[0] >= np[2] * n[2] ? 0 : np[1] * n[1] >= np[2] * n[2] ? 1 : 2;
+        if (np[a] == 1)
+            break;
+        np[a] = (np[a] + 1) / 2;
     }
 }
 
@@ -355,15 +369,16 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     memcpy(q->x0, x0, sizeof q->x0);
     q->jtol = 1e-13 * jscale;
     q->maxm = maxm;
+    q->modes = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes + 1;
     q->P = buf, q->Pi = buf + 3 * maxm, q->Pj = buf + 6 * maxm;
-    int np[3], n;
-    quad_panels(s, np, &n);
+    int np[3];
+    quad_panels(s, np, q->n);
     frequencies(s, q->f);
     for (int k = 1; k <= GMAX; k++)
         gauss_legendre(k, q->gx[k], q->gw[k]);
-    for (int i = 0; i < np[0] && !q->stopped; i++)
-        for (int j = 0; j < np[1] && !poll(q); j++)
-            for (int l = 0; l < np[2]; l++) {
+    for (int i = 0; i < np[0]; i++)
+        for (int j = 0; j < np[1]; j++)
+            for (int l = 0; l < np[2] && !q->stopped; l++) {
                 pbox b = { { (double)i / np[0], (double)j / np[1], (double)l / np[2] },
                            { (double)(i + 1) / np[0], (double)(j + 1) / np[1], (double)(l + 1) / np[2] } };
                 panel(q, &b);
@@ -411,10 +426,11 @@ static int faces_coincide(const pde_solution *s, int axis, double size)
 
 pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area)
 {
-    int np[3], n;
-    quad_panels(s, np, &n);
-    double gx[GMAX], gw[GMAX];
-    gauss_legendre(n, gx, gw);
+    int np[3], n[3];
+    quad_panels(s, np, n);
+    double gx[3][GMAX], gw[3][GMAX];
+    for (int a = 0; a < 3; a++)
+        gauss_legendre(n[a], gx[a], gw[a]);
     double total = 0.0;
     for (int axis = 0; axis < 3; axis++) {
         if (faces_coincide(s, axis, size))
@@ -423,20 +439,22 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
         for (int k = 0; k < 3; k++)
             if (k != axis)
                 o[m++] = k;
-        for (int side = 0; side < 2; side++) {
-            if (pde_stopped(cancel))
-                return PDE_ERR_CANCELLED;
+        const int na = n[o[0]], nb = n[o[1]];
+        const double ha = 1.0 / np[o[0]], hb = 1.0 / np[o[1]];
+        for (int side = 0; side < 2; side++)
             for (int pa = 0; pa < np[o[0]]; pa++)
-                for (int pb = 0; pb < np[o[1]]; pb++)
-                    for (int i = 0; i < n; i++)
-                        for (int j = 0; j < n; j++) {
-                            double ha = 1.0 / np[o[0]], hb = 1.0 / np[o[1]], x[3], ta[3], tb[3];
-                            face_point(s, axis, side, (pa + gx[i]) * ha, (pb + gx[j]) * hb, x, ta, tb);
+                for (int pb = 0; pb < np[o[1]]; pb++) {
+                    if (pde_stopped(cancel))   /* a panel of a face: na nb points */
+                        return PDE_ERR_CANCELLED;
+                    for (int i = 0; i < na; i++)
+                        for (int j = 0; j < nb; j++) {
+                            double x[3], ta[3], tb[3];
+                            face_point(s, axis, side, (pa + gx[o[0]][i]) * ha, (pb + gx[o[1]][j]) * hb, x, ta, tb);
                             double c0 = ta[1] * tb[2] - ta[2] * tb[1], c1 = ta[2] * tb[0] - ta[0] * tb[2],
                                    c2 = ta[0] * tb[1] - ta[1] * tb[0];
-                            total += ha * hb * gw[i] * gw[j] * sqrt(c0 * c0 + c1 * c1 + c2 * c2);
+                            total += ha * hb * gw[o[0]][i] * gw[o[1]][j] * sqrt(c0 * c0 + c1 * c1 + c2 * c2);
                         }
-        }
+                }
     }
     *area = total;
     return PDE_OK;

@@ -24,7 +24,7 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
 /* The area of the skin; size: the solid's extent, for deciding that two faces coincide. */
 pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area);
 
-/* Gauss-Legendre points per panel and panels per axis (for api/cost.h's estimate). */
-void quad_panels(const pde_solution *s, int np[3], int *n);
+/* Panels per axis and Gauss-Legendre points per panel on each axis (also for api/cost.h). */
+void quad_panels(const pde_solution *s, int np[3], int n[3]);
 
 #endif
