@@ -125,15 +125,44 @@ void api_describe(FILE *out, const pde_solution *sol, const pde_props *props)
         api_describe_props(out, props);
 }
 
+static void triple(FILE *out, const char *fmt, const double v[3])
+{
+    fprintf(out, "(");
+    for (int i = 0; i < 3; i++) {
+        fprintf(out, i ? ", " : "");
+        fprintf(out, fmt, v[i]);
+    }
+    fprintf(out, ")");
+}
+
 void api_describe_props(FILE *out, const pde_props *props)
 {
+    const pde_props *p = props;
     fprintf(out, "properties:\n");
-    fprintf(out, "  bounding box: [%.10g, %.10g, %.10g] to [%.10g, %.10g, %.10g]\n", props->bbox_min[0],
-            props->bbox_min[1], props->bbox_min[2], props->bbox_max[0], props->bbox_max[1], props->bbox_max[2]);
-    fprintf(out, "  volume: %.10g (integral of |det J|; of det J: %.10g)\n", props->volume, props->signed_volume);
-    fprintf(out, "  det J: min %.10g at (u,v,w) = (%.6g, %.6g, %.6g), max %.10g\n", props->detj_min,
-            props->detj_min_at[0], props->detj_min_at[1], props->detj_min_at[2], props->detj_max);
-    fprintf(out, "  folds: %s\n", props->folds ? "yes: det J changes sign, the solid overlaps itself" : "no");
-    fprintf(out, "  accuracy: boundary residual %.3g, PDE residual %.3g (relative)\n", props->bc_residual,
-            props->pde_residual);
+    fprintf(out, "  bounding box: [%.10g, %.10g, %.10g] to [%.10g, %.10g, %.10g]\n", p->bbox_min[0], p->bbox_min[1],
+            p->bbox_min[2], p->bbox_max[0], p->bbox_max[1], p->bbox_max[2]);
+    fprintf(out, "    certified: the solid lies inside and comes within %.3g of each face\n", p->bbox_gap);
+    fprintf(out, "  volume: %.10g (integral of |det J|; of det J: %.10g)\n", p->volume, p->signed_volume);
+    fprintf(out, "  surface area: %.10g\n", p->surface_area);
+    fprintf(out, "  centroid: ");
+    triple(out, "%.10g", p->centroid);
+    fprintf(out, "\n  inertia about the centroid (unit density):\n");
+    for (int i = 0; i < 3; i++)
+        fprintf(out, "    [%17.10g %17.10g %17.10g ]\n", p->inertia[i][0], p->inertia[i][1], p->inertia[i][2]);
+    fprintf(out, "  principal moments: %.10g, %.10g, %.10g (ascending)\n", p->principal_moments[0],
+            p->principal_moments[1], p->principal_moments[2]);
+    fprintf(out, "  principal axes: ");
+    for (int k = 0; k < 3; k++) {
+        fprintf(out, k ? ", " : "");
+        triple(out, "%.6g", p->principal_axes[k]);
+    }
+    fprintf(out, " (right-handed)\n");
+    fprintf(out, "  det J: min %.10g at (u,v,w) = ", p->detj_min);
+    triple(out, "%.6g", p->detj_min_at);
+    fprintf(out, ", max %.10g at ", p->detj_max);
+    triple(out, "%.6g", p->detj_max_at);
+    fprintf(out, "\n    certified: det J lies inside and comes within %.3g of each bound\n", p->detj_gap);
+    fprintf(out, "  folds: %s\n", p->folds ? "yes: det J changes sign, the solid overlaps itself" : "no");
+    fprintf(out, "  accuracy: boundary residual %.3g, PDE residual %.3g (relative)\n", p->bc_residual,
+            p->pde_residual);
 }

@@ -6,7 +6,9 @@
  * (their welding needs every face) and streamed from one binary blob.
  */
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -24,13 +26,13 @@
 #define CHUNK_WORK (1u << 21)
 
 static const api_format_info formats[API_FMT_COUNT] = {
-    { "json", "application/json", ".json", 0 },
-    { "grid", "application/json", ".grid.json", 0 },
-    { "f32", "application/octet-stream", ".f32", 0 },
-    { "gltf", "model/gltf+json", ".gltf", 1 },
-    { "glb", "model/gltf-binary", ".glb", 1 },
-    { "vts", "application/xml", ".vts", 0 },
-    { "stl", "model/stl", ".stl", 1 },
+    { "json", "application/json", ".json", 0, 1 },
+    { "grid", "application/json", ".grid.json", 0, 0 },
+    { "f32", "application/octet-stream", ".f32", 0, 0 },
+    { "gltf", "model/gltf+json", ".gltf", 1, 1 },
+    { "glb", "model/gltf-binary", ".glb", 1, 1 },
+    { "vts", "application/xml", ".vts", 0, 1 },
+    { "stl", "model/stl", ".stl", 1, 0 },
 };
 
 const api_format_info *api_format_info_of(api_format f)
@@ -179,35 +181,130 @@ static double axis(size_t i, size_t n)
 
 /* ---- the properties, and the json format ---- */
 
-static void add_vec3(cJSON *o, const char *name, const double v[3])
+/*
+ * The properties, one row each: the object they sit in under "properties" (NULL: at its top), their
+ * name there, where they are in pde_props, and their shape (rows x 3, or one number; folds is the one
+ * int). The json format and glTF's extras (props_tree), the CLI's reading of a server's answer
+ * (api_props_from_tree) and the vts field data (group_name) all read this table.
+ */
+typedef struct {
+    const char *group, *name;
+    size_t off;
+    int rows, cols;     /* 1 x 1: a number; 1 x 3: [3]; 3 x 3: [[3],[3],[3]], row by row */
+    int flag;           /* an int read as a JSON boolean */
+} prop_row;
+
+#define PROP(g, n, field, r, c) { g, n, offsetof(pde_props, field), r, c, 0 }
+static const prop_row prop_rows[] = {
+    PROP("bbox", "min", bbox_min, 1, 3),
+    PROP("bbox", "max", bbox_max, 1, 3),
+    PROP("bbox", "gap", bbox_gap, 1, 1),
+    PROP(NULL, "volume", volume, 1, 1),
+    PROP(NULL, "signed_volume", signed_volume, 1, 1),
+    PROP("detJ", "min", detj_min, 1, 1),
+    PROP("detJ", "max", detj_max, 1, 1),
+    PROP("detJ", "min_at", detj_min_at, 1, 3),
+    PROP("detJ", "max_at", detj_max_at, 1, 3),
+    PROP("detJ", "gap", detj_gap, 1, 1),
+    { NULL, "folds", offsetof(pde_props, folds), 1, 1, 1 },
+    PROP(NULL, "centroid", centroid, 1, 3),
+    PROP(NULL, "inertia", inertia, 3, 3),
+    PROP("principal", "moments", principal_moments, 1, 3),
+    PROP("principal", "axes", principal_axes, 3, 3),
+    PROP(NULL, "surface_area", surface_area, 1, 1),
+    PROP("residuals", "boundary", bc_residual, 1, 1),
+    PROP("residuals", "pde", pde_residual, 1, 1),
+};
+#undef PROP
+#define PROP_ROWS (sizeof prop_rows / sizeof prop_rows[0])
+
+static const double *prop_at(const pde_props *p, const prop_row *r)
 {
-    cJSON *a = cJSON_AddArrayToObject(o, name);
-    for (int i = 0; a && i < 3; i++)
-        cJSON_AddItemToArray(a, cJSON_CreateNumber(v[i]));
+    return (const double *)(const void *)((const char *)p + r->off);
+}
+
+/* v in the fewest digits that read back as v exactly (cJSON_CreateNumber settles for 15 digits within an
+ * epsilon, so the last bit of a certified bound could move); null when not finite. */
+static cJSON *prop_number(double v)
+{
+    char s[32];
+    if (!isfinite(v))
+        return cJSON_CreateNull();
+    for (int digits = 15; digits <= 17; digits++) {
+        snprintf(s, sizeof s, "%.*g", digits, v);
+        if (strtod(s, NULL) == v)
+            break;
+    }
+    return cJSON_CreateRaw(s);
+}
+
+static cJSON *prop_numbers(const double *v, int n)
+{
+    cJSON *a = cJSON_CreateArray();
+    for (int i = 0; a && i < n; i++)
+        cJSON_AddItemToArray(a, prop_number(v[i]));
+    return a;
+}
+
+static cJSON *prop_value(const pde_props *p, const prop_row *r)
+{
+    const double *v = prop_at(p, r);
+    if (r->flag)
+        return cJSON_CreateBool(*(const int *)(const void *)v);
+    if (r->cols == 1)
+        return prop_number(*v);
+    if (r->rows == 1)
+        return prop_numbers(v, r->cols);
+    cJSON *m = cJSON_CreateArray();
+    for (int i = 0; m && i < r->rows; i++)
+        cJSON_AddItemToArray(m, prop_numbers(v + i * r->cols, r->cols));
+    return m;
+}
+
+/* The object a row goes in: o itself, or its group, made on first use. */
+static cJSON *prop_parent(cJSON *o, const prop_row *r)
+{
+    if (!r->group)
+        return o;
+    cJSON *g = cJSON_GetObjectItemCaseSensitive(o, r->group);
+    return g ? g : cJSON_AddObjectToObject(o, r->group);
 }
 
 static cJSON *props_tree(const pde_props *p)
 {
-    cJSON *o = cJSON_CreateObject(), *b, *d, *r;
-    if (!o)
-        return NULL;
-    if ((b = cJSON_AddObjectToObject(o, "bbox"))) {
-        add_vec3(b, "min", p->bbox_min);
-        add_vec3(b, "max", p->bbox_max);
-    }
-    cJSON_AddNumberToObject(o, "volume", p->volume);
-    cJSON_AddNumberToObject(o, "signed_volume", p->signed_volume);
-    if ((d = cJSON_AddObjectToObject(o, "detJ"))) {
-        cJSON_AddNumberToObject(d, "min", p->detj_min);
-        cJSON_AddNumberToObject(d, "max", p->detj_max);
-        add_vec3(d, "min_at", p->detj_min_at);
-    }
-    cJSON_AddBoolToObject(o, "folds", p->folds);
-    if ((r = cJSON_AddObjectToObject(o, "residuals"))) {
-        cJSON_AddNumberToObject(r, "boundary", p->bc_residual);
-        cJSON_AddNumberToObject(r, "pde", p->pde_residual);
+    cJSON *o = cJSON_CreateObject();
+    for (size_t i = 0; o && i < PROP_ROWS; i++) {
+        cJSON *parent = prop_parent(o, &prop_rows[i]);
+        if (parent)
+            cJSON_AddItemToObject(parent, prop_rows[i].name, prop_value(p, &prop_rows[i]));
     }
     return o;
+}
+
+struct cJSON *api_props_tree(const pde_props *p)
+{
+    return props_tree(p);
+}
+
+void api_props_from_tree(const struct cJSON *t, pde_props *out)
+{
+    memset(out, 0, sizeof *out);
+    for (size_t i = 0; i < PROP_ROWS; i++) {
+        const prop_row *r = &prop_rows[i];
+        const cJSON *parent = r->group ? cJSON_GetObjectItemCaseSensitive(t, r->group) : t;
+        const cJSON *v = cJSON_GetObjectItemCaseSensitive(parent, r->name);
+        double *d = (double *)(void *)((char *)out + r->off);
+        if (r->flag) {
+            *(int *)(void *)d = cJSON_IsTrue(v);
+            continue;
+        }
+        for (int k = 0; k < r->rows * r->cols; k++) {
+            const cJSON *x = r->cols == 1 ? v
+                             : r->rows == 1 ? cJSON_GetArrayItem(v, k)
+                                            : cJSON_GetArrayItem(cJSON_GetArrayItem(v, k / r->cols), k % r->cols);
+            d[k] = cJSON_IsNumber(x) ? x->valuedouble : cJSON_IsRaw(x) ? strtod(x->valuestring, NULL) : 0.0;
+        }
+    }
 }
 
 char *api_props_json(const pde_props *p)
@@ -458,26 +555,56 @@ static long long points(const api_output *o)
     return (long long)o->res[0] * o->res[1] * o->res[2];
 }
 
+/* The properties as VTK field data, one array per row of prop_rows named group_name ("detJ_min_at"),
+ * in ascii at 17 digits, so ParaView lists them with the dataset. */
+static int vts_field_data(api_output *o)
+{
+    if (puts_(o, "    <FieldData>\n"))
+        return -1;
+    for (size_t i = 0; i < PROP_ROWS; i++) {
+        const prop_row *r = &prop_rows[i];
+        const double *v = prop_at(&o->props, r);
+        int n = r->rows * r->cols;
+        char line[1024], *p = line;
+        p += sprintf(p, "      <DataArray type=\"%s\" Name=\"%s%s%s\" NumberOfComponents=\"%d\" NumberOfTuples=\"1\" "
+                        "format=\"ascii\">",
+                     r->flag ? "Int8" : "Float64", r->group ? r->group : "", r->group ? "_" : "", r->name, n);
+        if (r->flag)
+            p += sprintf(p, "%d", *(const int *)(const void *)v != 0);
+        for (int k = 0; !r->flag && k < n; k++)
+            p += sprintf(p, "%s%.17g", k ? " " : "", v[k]);
+        p += sprintf(p, "</DataArray>\n");
+        if (put(o, line, (size_t)(p - line)))
+            return -1;
+    }
+    return puts_(o, "    </FieldData>\n");
+}
+
 static int vts_header(api_output *o)
 {
     unsigned a = o->res[0] - 1, b = o->res[1] - 1, c = o->res[2] - 1;
     char h[1024];
     int n = snprintf(h, sizeof h,
                      "<?xml version=\"1.0\"?>\n"
-                     "<!-- pdesolid: the solid %s, x(u,v,w) at u, v, w = i/(n-1); detJ = det d(x,y,z)/d(u,v,w) -->\n"
+                     "<!-- pdesolid: the solid %s, x(u,v,w) at u, v, w = i/(n-1); detJ = det d(x,y,z)/d(u,v,w); "
+                     "the field data are its properties (docs/API.md) -->\n"
                      "<VTKFile type=\"StructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-                     "  <StructuredGrid WholeExtent=\"0 %u 0 %u 0 %u\">\n"
-                     "    <Piece Extent=\"0 %u 0 %u 0 %u\">\n"
-                     "      <PointData Scalars=\"detJ\">\n"
-                     "        <DataArray type=\"Float32\" Name=\"detJ\" NumberOfComponents=\"1\" format=\"appended\" offset=\"%lld\"/>\n"
-                     "      </PointData>\n"
-                     "      <Points>\n"
-                     "        <DataArray type=\"Float32\" Name=\"Points\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/>\n"
-                     "      </Points>\n"
-                     "    </Piece>\n"
-                     "  </StructuredGrid>\n"
-                     "  <AppendedData encoding=\"raw\">\n   _",
-                     o->id[0] ? o->id : "(no id)", a, b, c, a, b, c, 8 + 12 * points(o));
+                     "  <StructuredGrid WholeExtent=\"0 %u 0 %u 0 %u\">\n",
+                     o->id[0] ? o->id : "(no id)", a, b, c);
+    if (put(o, h, (size_t)n) || vts_field_data(o))
+        return -1;
+    n = snprintf(h, sizeof h,
+                 "    <Piece Extent=\"0 %u 0 %u 0 %u\">\n"
+                 "      <PointData Scalars=\"detJ\">\n"
+                 "        <DataArray type=\"Float32\" Name=\"detJ\" NumberOfComponents=\"1\" format=\"appended\" offset=\"%lld\"/>\n"
+                 "      </PointData>\n"
+                 "      <Points>\n"
+                 "        <DataArray type=\"Float32\" Name=\"Points\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/>\n"
+                 "      </Points>\n"
+                 "    </Piece>\n"
+                 "  </StructuredGrid>\n"
+                 "  <AppendedData encoding=\"raw\">\n   _",
+                 a, b, c, 8 + 12 * points(o));
     return put(o, h, (size_t)n);
 }
 
@@ -734,7 +861,7 @@ api_output *api_output_open(const pde_solution *sol, const char *id, const pde_p
         o->size = 12 * points(o);
         break;
     case API_FMT_VTS: {
-        rc = grid_open(o);
+        rc = props_of(o, cancel, err) ? grid_open(o) : -1;
         if (!rc && !vts_header(o)) {  /* measure the header once for the size */
             o->size = (long long)o->len + 8 + 12 * points(o) + 8 + 4 * points(o) + (long long)strlen(vts_footer);
             o->len = 0;

@@ -9,7 +9,8 @@
  *   f32   little-endian float32 x, y, z per point, in the same order
  *   gltf  glTF 2.0 of the closed skin, the buffer in a base64 data URI
  *   glb   the same as binary glTF
- *   vts   the volume as a VTK XML StructuredGrid with det J as a point field
+ *   vts   the volume as a VTK XML StructuredGrid with det J as a point field,
+ *         the properties as field data
  *   stl   binary STL of the closed skin
  *
  * USAGE
@@ -39,6 +40,7 @@ typedef struct {
     const char *mime;
     const char *ext;       /* file extension, with the dot */
     int mesh;              /* resolution per face edge rather than per volume axis */
+    int props;             /* carries the properties: api_output_open() computes them when not given */
 } api_format_info;
 
 const api_format_info *api_format_info_of(api_format f);
@@ -58,7 +60,7 @@ typedef struct api_output api_output;
 
 /*
  * id: the model's id (id.h), or NULL. props: the solution's properties if the
- * caller has them (json, gltf and glb carry them), or NULL to compute them.
+ * caller has them (the formats with props set carry them), or NULL to compute them.
  * NULL and err on failure (out of memory, a mesh out of range). The long work
  * happens here: the properties it computes, the mesh (gltf, glb, stl), the
  * whole json document; cancel (NULL: never) is polled through it, and when
@@ -82,6 +84,10 @@ void api_output_free(api_output *o);
 
 /* The properties as JSON text (for asset.extras and the json format); malloc'd, NULL if out of memory. */
 char *api_props_json(const pde_props *p);
+/* The same as a cJSON tree (cJSON_Delete it); NULL if out of memory. */
+struct cJSON *api_props_tree(const pde_props *p);
+/* Reads such a tree back (a server's answer); what is missing or not a number reads as 0. Cannot fail. */
+void api_props_from_tree(const struct cJSON *t, pde_props *out);
 
 /* An eval answer {"id", "values": [[x, y, z], ...]} and, when given, "du", "dv", "dw" (3 n doubles
  * each), at 17 significant digits; malloc'd, NULL if out of memory. */

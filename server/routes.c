@@ -163,7 +163,7 @@ static void answer_entry(srv_req *r, srv_entry *e)
         return;
     }
     const pde_solution *sol = srv_entry_solution(e);
-    int with_props = f == API_FMT_JSON || f == API_FMT_GLTF || f == API_FMT_GLB;
+    int with_props = api_format_info_of(f)->props;
     api_cost part;
     api_cost_output(sol, f, res, &part);
     int over = over_budget(r, &part);

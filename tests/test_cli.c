@@ -122,7 +122,9 @@ static void solve_should_print_the_closed_form_and_properties(void **state)
     assert_int_equal(run(0, "solve fig4a.json", &out, &err), 0);
     const char *want[] = { "x(u,v,w) = sum over 2 modes", "u * sin(2*pi*v)", "t = e^(1/4) = 3.578895",
                            "sin(9.424777961*w)", "z(u,v,w) = sum over 1 mode", "(1.5*w^2 + 1.5*w^3)",
-                           "bounding box:", "volume:", "det J: min", "folds:", "accuracy:" };
+                           "bounding box:", "volume:", "det J: min", "folds:", "accuracy:",
+                           "surface area:", "centroid: (", "inertia about the centroid", "principal moments:",
+                           "principal axes: (", "certified: the solid lies inside" };
     for (size_t i = 0; i < sizeof want / sizeof *want; i++)
         if (!strstr(out, want[i]))
             fail_msg("missing \"%s\" in:\n%s", want[i], out);

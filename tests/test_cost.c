@@ -256,8 +256,8 @@ static void output_open_should_stop_in_the_properties_and_the_mesh_it_computes(v
 {
     (void)state;
     pde_solution *sol = solve_heavy(MODES, 16);
-    /* json: the properties; glb: the mesh, then the properties; stl: the mesh alone. */
-    static const api_format fmts[] = { API_FMT_JSON, API_FMT_GLB, API_FMT_STL };
+    /* json and vts: the properties; glb: the mesh, then the properties; stl: the mesh alone. */
+    static const api_format fmts[] = { API_FMT_JSON, API_FMT_VTS, API_FMT_GLB, API_FMT_STL };
     for (size_t i = 0; i < sizeof fmts / sizeof *fmts; i++) {
         out_arg a = { sol, { 16, 16, 16 }, fmts[i] };
         check_cancellation(call_output, &a, 0, -1, 10);

@@ -2,7 +2,8 @@
  * test_output.c: presets, templates, ids and every output format. Presets
  * against the paper's text and the tests' own transcription; glTF and GLB
  * through the Khronos glTF-Validator; grids read back against f32; the STL
- * skin closed and enclosing the computed volume; VTS offsets and det J.
+ * skin closed and enclosing the computed volume; VTS offsets and det J; every
+ * property under its documented name in json, glTF extras and VTS field data.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -49,11 +50,12 @@ static pde_solution *solve_preset(const char *name, char id[API_ID_LEN + 1])
     return sol;
 }
 
-/* The whole output in memory; checks the declared size. */
-static unsigned char *render(const pde_solution *sol, const char *id, api_format f, const unsigned res[3], size_t *len)
+/* The whole output in memory, with the caller's properties (NULL: computed); checks the declared size. */
+static unsigned char *render_props(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
+                                   const unsigned res[3], size_t *len)
 {
     api_error err;
-    api_output *o = api_output_open(sol, id, NULL, f, res, NULL, &err);
+    api_output *o = api_output_open(sol, id, props, f, res, NULL, &err);
     if (!o)
         fail_msg("%s: %s", api_format_info_of(f)->name, err.message);
     size_t cap = 1 << 16, n = 0;
@@ -71,6 +73,187 @@ static unsigned char *render(const pde_solution *sol, const char *id, api_format
     api_output_free(o);
     *len = n;
     return buf;
+}
+
+static unsigned char *render(const pde_solution *sol, const char *id, api_format f, const unsigned res[3], size_t *len)
+{
+    return render_props(sol, id, NULL, f, res, len);
+}
+
+/*
+ * The properties by their names in docs/API.md, the tests' own transcription: the object under
+ * "properties" (NULL: its top), the name, the vts field's name, and where the value is in p (n numbers,
+ * a 3x3 matrix row by row). folds, the one boolean, is checked apart.
+ */
+typedef struct {
+    const char *group, *name, *vts;
+    double *v;
+    int n;
+} prop_path;
+
+static size_t prop_paths(pde_props *p, prop_path out[32])
+{
+    const prop_path all[] = {
+        { "bbox", "min", "bbox_min", p->bbox_min, 3 },
+        { "bbox", "max", "bbox_max", p->bbox_max, 3 },
+        { "bbox", "gap", "bbox_gap", &p->bbox_gap, 1 },
+        { NULL, "volume", "volume", &p->volume, 1 },
+        { NULL, "signed_volume", "signed_volume", &p->signed_volume, 1 },
+        { "detJ", "min", "detJ_min", &p->detj_min, 1 },
+        { "detJ", "max", "detJ_max", &p->detj_max, 1 },
+        { "detJ", "min_at", "detJ_min_at", p->detj_min_at, 3 },
+        { "detJ", "max_at", "detJ_max_at", p->detj_max_at, 3 },
+        { "detJ", "gap", "detJ_gap", &p->detj_gap, 1 },
+        { NULL, "centroid", "centroid", p->centroid, 3 },
+        { NULL, "inertia", "inertia", &p->inertia[0][0], 9 },
+        { "principal", "moments", "principal_moments", p->principal_moments, 3 },
+        { "principal", "axes", "principal_axes", &p->principal_axes[0][0], 9 },
+        { NULL, "surface_area", "surface_area", &p->surface_area, 1 },
+        { "residuals", "boundary", "residuals_boundary", &p->bc_residual, 1 },
+        { "residuals", "pde", "residuals_pde", &p->pde_residual, 1 },
+    };
+    memcpy(out, all, sizeof all);
+    return sizeof all / sizeof *all;
+}
+
+/* Properties whose every number differs from every other, so a value under a wrong name shows. */
+static void distinct_props(pde_props *p)
+{
+    memset(p, 0, sizeof *p);
+    prop_path paths[32];
+    size_t n = prop_paths(p, paths);
+    double x = 1.0;
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < paths[i].n; k++, x += 1.0)
+            paths[i].v[k] = x + 1.0 / 3.0 + x * 1e-9;
+    p->folds = 1;
+}
+
+/* Every property of want in a "properties" tree, bit for bit (17 digits round-trip). */
+static void props_tree_should_hold(const cJSON *t, const pde_props *want, const char *where)
+{
+    pde_props copy = *want;
+    prop_path paths[32];
+    size_t n = prop_paths(&copy, paths);
+    assert_non_null(t);
+    for (size_t i = 0; i < n; i++) {
+        const cJSON *parent = paths[i].group ? cJSON_GetObjectItemCaseSensitive(t, paths[i].group) : t;
+        const cJSON *v = cJSON_GetObjectItemCaseSensitive(parent, paths[i].name);
+        if (!v)
+            fail_msg("%s: no %s%s%s", where, paths[i].group ? paths[i].group : "", paths[i].group ? "." : "",
+                     paths[i].name);
+        for (int k = 0; k < paths[i].n; k++) {
+            const cJSON *x = paths[i].n == 1 ? v
+                             : paths[i].n == 3 ? cJSON_GetArrayItem(v, k)
+                                               : cJSON_GetArrayItem(cJSON_GetArrayItem(v, k / 3), k % 3);
+            if (!cJSON_IsNumber(x) || x->valuedouble != paths[i].v[k])
+                fail_msg("%s: %s[%d] is %.17g, want %.17g", where, paths[i].vts, k,
+                         cJSON_IsNumber(x) ? x->valuedouble : NAN, paths[i].v[k]);
+        }
+        if (paths[i].n == 9)
+            assert_int_equal(cJSON_GetArraySize(v), 3);
+    }
+    assert_int_equal(cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(t, "folds")), want->folds != 0);
+}
+
+/* The same of a vts document's field data. */
+static void vts_field_data_should_hold(const char *text, const pde_props *want)
+{
+    pde_props copy = *want;
+    prop_path paths[32];
+    size_t n = prop_paths(&copy, paths);
+    const char *fd = strstr(text, "<FieldData>"), *end = strstr(text, "</FieldData>");
+    assert_true(fd && end && fd < strstr(text, "<Piece"));
+    for (size_t i = 0; i < n; i++) {
+        char key[128];
+        snprintf(key, sizeof key, "Name=\"%s\" NumberOfComponents=\"%d\" NumberOfTuples=\"1\" format=\"ascii\">",
+                 paths[i].vts, paths[i].n);
+        const char *at = strstr(fd, key);
+        if (!at || at > end)
+            fail_msg("vts: no field %s", key);
+        char *p = (char *)at + strlen(key);
+        for (int k = 0; k < paths[i].n; k++) {
+            double x = strtod(p, &p);
+            if (x != paths[i].v[k])
+                fail_msg("vts: %s[%d] is %.17g, want %.17g", paths[i].vts, k, x, paths[i].v[k]);
+        }
+        assert_true(!strncmp(p, "</DataArray>", 12));
+    }
+    char folds[128];
+    snprintf(folds, sizeof folds, "Name=\"folds\" NumberOfComponents=\"1\" NumberOfTuples=\"1\" format=\"ascii\">%d<",
+             want->folds != 0);
+    assert_non_null(strstr(fd, folds));
+}
+
+/* The properties object of a json document or of a GLB's asset.extras; cJSON_Delete *doc. */
+static const cJSON *props_of_output(const unsigned char *bytes, size_t len, api_format f, cJSON **doc)
+{
+    if (f == API_FMT_GLB) {
+        uint32_t jlen;
+        memcpy(&jlen, bytes + 12, 4);
+        *doc = cJSON_ParseWithLength((const char *)bytes + 20, jlen);
+        return cJSON_GetObjectItem(cJSON_GetObjectItem(cJSON_GetObjectItem(*doc, "asset"), "extras"), "properties");
+    }
+    *doc = cJSON_ParseWithLength((const char *)bytes, len);
+    return cJSON_GetObjectItem(*doc, "properties");
+}
+
+static void every_output_with_properties_should_carry_each_of_them_by_name(void **state)
+{
+    (void)state;
+    pde_solution *sol = solve_preset("fig4a", NULL);
+    pde_props computed, distinct;
+    assert_int_equal(pde_properties(sol, NULL, &computed), PDE_OK);
+    distinct_props(&distinct);
+    const pde_props *cases[] = { NULL, &distinct };   /* computed by the output, and given to it */
+    const api_format fmts[] = { API_FMT_JSON, API_FMT_GLB, API_FMT_VTS };
+    for (size_t c = 0; c < 2; c++)
+        for (size_t i = 0; i < 3; i++) {
+            const pde_props *want = cases[c] ? cases[c] : &computed;
+            assert_true(api_format_info_of(fmts[i])->props);
+            const unsigned res[3] = { 4, 4, 4 };
+            size_t len;
+            unsigned char *b = render_props(sol, "abc", cases[c], fmts[i], res, &len);
+            if (fmts[i] == API_FMT_VTS) {
+                b = realloc(b, len + 1);
+                b[len] = '\0';
+                vts_field_data_should_hold((const char *)b, want);
+            } else {
+                cJSON *doc;
+                props_tree_should_hold(props_of_output(b, len, fmts[i], &doc), want,
+                                       api_format_info_of(fmts[i])->name);
+                cJSON_Delete(doc);
+            }
+            free(b);
+        }
+    assert_false(api_format_info_of(API_FMT_STL)->props);
+    pde_solution_free(sol);
+}
+
+static void properties_should_read_back_from_their_tree(void **state)
+{
+    (void)state;
+    pde_props p, back;
+    distinct_props(&p);
+    cJSON *t = api_props_tree(&p);
+    pde_props direct;
+    api_props_from_tree(t, &direct);
+    char *text = cJSON_PrintUnformatted(t);
+    cJSON_Delete(t);
+    t = cJSON_Parse(text);
+    free(text);
+    props_tree_should_hold(t, &p, "api_props_tree");
+    api_props_from_tree(t, &back);
+    cJSON_Delete(t);
+    assert_memory_equal(&direct, &back, sizeof back);
+    pde_props copy = back;
+    prop_path a[32], b[32];
+    size_t n = prop_paths(&p, a);
+    prop_paths(&copy, b);
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < a[i].n; k++)
+            assert_true(a[i].v[k] == b[i].v[k]);
+    assert_int_equal(back.folds, 1);
 }
 
 static void presets_should_carry_the_papers_values(void **state)
@@ -336,7 +519,10 @@ static void vts_should_hold_the_points_and_det_j(void **state)
     assert_non_null(off);
     assert_int_equal(atoll(off + strlen("Name=\"detJ\" NumberOfComponents=\"1\" format=\"appended\" offset=\"")),
                      (long long)(8 + 12 * n));
-    const float *pts = (const float *)(data + 8), *dj = (const float *)(data + 8 + 12 * n + 8);
+    /* The appended data start wherever the header ends: copy them out to aligned floats. */
+    float pts[3 * 5 * 9 * 4], dj[5 * 9 * 4];
+    memcpy(pts, data + 8, sizeof pts);
+    memcpy(dj, data + 8 + 12 * n + 8, sizeof dj);
     for (size_t k = 0; k < 4; k++)
         for (size_t j = 0; j < 9; j++)
             for (size_t i = 0; i < 5; i++) {
@@ -349,7 +535,7 @@ static void vts_should_hold_the_points_and_det_j(void **state)
                     assert_rel(pts[3 * at + q], x[q], 1e-6, 1);
                 assert_rel(dj[at], d, 1e-5, 1);
             }
-    assert_non_null(strstr((const char *)dj + 4 * n, "</AppendedData>\n</VTKFile>\n"));
+    assert_non_null(strstr((const char *)data + 8 + 12 * n + 8 + 4 * n, "</AppendedData>\n</VTKFile>\n"));
     free(b);
     pde_solution_free(sol);
 }
@@ -477,6 +663,8 @@ int main(void)
         cmocka_unit_test(stl_skin_should_be_closed_and_enclose_the_computed_volume),
         cmocka_unit_test(vts_should_hold_the_points_and_det_j),
         cmocka_unit_test(json_should_hold_the_closed_form_properties_and_id),
+        cmocka_unit_test(every_output_with_properties_should_carry_each_of_them_by_name),
+        cmocka_unit_test(properties_should_read_back_from_their_tree),
         cmocka_unit_test(id_should_not_depend_on_how_the_model_is_spelled),
         cmocka_unit_test(bad_formats_and_resolutions_should_name_the_limit),
     };

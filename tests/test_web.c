@@ -3,7 +3,9 @@
  * with the front-end and runs tests/node/browser.mjs, which drives Debian's
  * Chromium through playwright-core: the page loads with no console errors and
  * draws fig4a; the gallery loads every preset; a control re-solves and changes
- * the picture; an invalid value shows the server's error beside its field.
+ * the picture; an invalid value shows the server's error beside its field;
+ * the panel shows the centroid, surface area, moments and inertia the server
+ * computed.
  * Screenshots go to build/artifacts/web/.
  */
 #include <setjmp.h>

@@ -8,6 +8,7 @@
 #include <curl/curl.h>
 
 #include "describe.h"
+#include "output.h"
 #include "remote.h"
 
 typedef struct {
@@ -87,21 +88,6 @@ static int problem(const char *server, const reply *r)
     return r->status >= 400 && r->status < 500 ? 2 : 1;
 }
 
-static double num(const cJSON *o, const char *k)
-{
-    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, k);
-    return cJSON_IsNumber(v) ? v->valuedouble : 0.0;
-}
-
-static void vec3(const cJSON *o, const char *k, double out[3])
-{
-    const cJSON *a = cJSON_GetObjectItemCaseSensitive(o, k);
-    for (int i = 0; i < 3; i++) {
-        const cJSON *v = cJSON_GetArrayItem(a, i);
-        out[i] = cJSON_IsNumber(v) ? v->valuedouble : 0.0;
-    }
-}
-
 /* The text of `pdesolid solve` from the json format's document. */
 static int print_solve(const char *json, FILE *out)
 {
@@ -115,20 +101,7 @@ static int print_solve(const char *json, FILE *out)
         return 1;
     }
     pde_props p;
-    memset(&p, 0, sizeof p);
-    const cJSON *bbox = cJSON_GetObjectItemCaseSensitive(props, "bbox");
-    const cJSON *dj = cJSON_GetObjectItemCaseSensitive(props, "detJ");
-    const cJSON *res = cJSON_GetObjectItemCaseSensitive(props, "residuals");
-    vec3(bbox, "min", p.bbox_min);
-    vec3(bbox, "max", p.bbox_max);
-    p.volume = num(props, "volume");
-    p.signed_volume = num(props, "signed_volume");
-    p.detj_min = num(dj, "min");
-    p.detj_max = num(dj, "max");
-    vec3(dj, "min_at", p.detj_min_at);
-    p.folds = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(props, "folds"));
-    p.bc_residual = num(res, "boundary");
-    p.pde_residual = num(res, "pde");
+    api_props_from_tree(props, &p);
     fprintf(out, "solid %s\n%s", cJSON_IsString(id) ? id->valuestring : "", text->valuestring);
     api_describe_props(out, &p);
     cJSON_Delete(d);

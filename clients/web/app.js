@@ -66,19 +66,37 @@ function fmt(x) {
   return a !== 0 && (a < 1e-3 || a >= 1e5) ? x.toExponential(4) : String(+x.toPrecision(6));
 }
 
+const vec = (v) => `(${v.map(fmt).join(', ')})`;
+
+// The inertia tensor and the principal axes, folded away until asked for.
+function inertiaDetails(p) {
+  const d = document.createElement('details'), summary = document.createElement('summary'), pre = document.createElement('pre');
+  summary.textContent = 'about the centroid';
+  const row = (r) => r.map((x) => fmt(x).padStart(10)).join(' ');
+  pre.textContent = [...p.inertia.map(row), 'principal axes (rows):', ...p.principal.axes.map(row)].join('\n');
+  d.append(summary, pre);
+  return d;
+}
+
 function showProps(p, times) {
   const rows = [
     ['solid', state.id],
     ['volume', fmt(p.volume)],
-    ['det J', `${fmt(p.detJ.min)} to ${fmt(p.detJ.max)}`],
-    ['bounds', `[${p.bbox.min.map(fmt).join(', ')}] to [${p.bbox.max.map(fmt).join(', ')}]`],
+    ['surface area', fmt(p.surface_area)],
+    ['centroid', vec(p.centroid)],
+    ['principal', `moments ${p.principal.moments.map(fmt).join(', ')}`],
+    ['inertia', inertiaDetails(p)],
+    ['det J', `${fmt(p.detJ.min)} to ${fmt(p.detJ.max)}, certified to ${fmt(p.detJ.gap)}`],
+    ['bounds', `[${p.bbox.min.map(fmt).join(', ')}] to [${p.bbox.max.map(fmt).join(', ')}], certified to ${fmt(p.bbox.gap)}`],
     ['accuracy', `boundary ${p.residuals.boundary.toExponential(1)}, PDE ${p.residuals.pde.toExponential(1)}`],
     ['times', times],
   ];
   el('props').replaceChildren(...rows.flatMap(([k, v]) => {
     const dt = document.createElement('dt'), dd = document.createElement('dd');
     dt.textContent = k;
-    dd.textContent = v;
+    if (typeof v === 'string') dd.textContent = v;
+    else dd.append(v);
+    dd.dataset.prop = k;
     return [dt, dd];
   }));
   el('fold').hidden = !p.folds;

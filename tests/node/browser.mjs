@@ -61,6 +61,35 @@ await check('choosing fig4a in the gallery draws it', async () => {
   if (!/4a: b = 1, c = -9\.5/.test(caption)) throw new Error(`caption: ${caption}`);
 });
 
+await check('the panel shows the centroid, surface area and certified bounds the server computed', async () => {
+  const id = (await state()).id;
+  const want = await page.evaluate(async (solid) =>
+    (await (await fetch(`/solids/${solid}?format=json&res=2`)).json()).properties, id);
+  const text = async (k) => (await page.textContent(`#props dd[data-prop="${k}"]`)) || '';
+  const nums = (t) => (t.match(/-?\d+(\.\d+)?(e[-+]?\d+)?/gi) || []).map(Number);
+  const near = (a, b) => Math.abs(a - b) <= 1e-5 * Math.max(1e-12, Math.abs(b)) || a === b;
+  const c = nums(await text('centroid'));
+  if (c.length !== 3 || !c.every((x, i) => near(x, want.centroid[i])))
+    throw new Error(`centroid ${await text('centroid')}, the server says ${want.centroid}`);
+  const area = nums(await text('surface area'));
+  if (area.length !== 1 || !near(area[0], want.surface_area))
+    throw new Error(`surface area ${await text('surface area')}, the server says ${want.surface_area}`);
+  const m = nums(await text('principal'));
+  if (m.length !== 3 || !m.every((x, i) => near(x, want.principal.moments[i])))
+    throw new Error(`principal ${await text('principal')}`);
+  const bounds = await text('bounds');
+  const gap = nums(bounds.split('certified to')[1] || '');
+  if (gap.length !== 1 || !near(gap[0], want.bbox.gap)) throw new Error(`bounds: ${bounds}`);
+  const pre = page.locator('#props dd[data-prop="inertia"] pre');
+  if (await pre.isVisible()) throw new Error('the inertia shows before it is asked for');
+  await page.click('#props dd[data-prop="inertia"] summary');
+  const rows = ((await pre.textContent()) || '').split('\n');
+  if (rows.length !== 7 || !rows.slice(0, 3).every((r, i) => nums(r).every((x, j) => near(x, want.inertia[i][j]))))
+    throw new Error(`inertia: ${rows.join(' / ')}`);
+  await page.screenshot({ path: `${out}/props.png` });
+  await page.click('#props dd[data-prop="inertia"] summary');
+});
+
 await check('dragging a slider solves again and changes the picture', async () => {
   const before = await snapshot(), s0 = await state();
   const slider = page.locator('[data-param="p0"] .lil-slider');
