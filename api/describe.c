@@ -157,11 +157,11 @@ void api_describe_props(FILE *out, const pde_props *props)
         triple(out, "%.6g", p->principal_axes[k]);
     }
     fprintf(out, " (right-handed)\n");
-    fprintf(out, "  det J: min %.10g at (u,v,w) = ", p->detj_min);
+    fprintf(out, "  det J: min %.10g at (u,v,w) = ", p->detj_min_found);
     triple(out, "%.6g", p->detj_min_at);
-    fprintf(out, ", max %.10g at ", p->detj_max);
+    fprintf(out, ", max %.10g at ", p->detj_max_found);
     triple(out, "%.6g", p->detj_max_at);
-    fprintf(out, "\n    certified: det J lies inside and comes within %.3g of each bound\n", p->detj_gap);
+    fprintf(out, "\n    certified: every value lies in [%.10g, %.10g]\n", p->detj_min, p->detj_max);
     fprintf(out, "  folds: %s\n", p->folds ? "yes: det J changes sign, the solid overlaps itself" : "no");
     fprintf(out, "  accuracy: boundary residual %.3g, PDE residual %.3g (relative)\n", p->bc_residual,
             p->pde_residual);

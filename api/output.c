@@ -203,6 +203,8 @@ static const prop_row prop_rows[] = {
     PROP(NULL, "signed_volume", signed_volume, 1, 1),
     PROP("detJ", "min", detj_min, 1, 1),
     PROP("detJ", "max", detj_max, 1, 1),
+    PROP("detJ", "min_found", detj_min_found, 1, 1),
+    PROP("detJ", "max_found", detj_max_found, 1, 1),
     PROP("detJ", "min_at", detj_min_at, 1, 3),
     PROP("detJ", "max_at", detj_max_at, 1, 3),
     PROP("detJ", "gap", detj_gap, 1, 1),

@@ -235,10 +235,11 @@ typedef struct {
     double bbox_gap;         /* largest distance from a face of the box to the solid */
     double volume;           /* integral of |det J| over the unit cube */
     double signed_volume;    /* integral of det J */
-    double detj_min, detj_max;
-    double detj_min_at[3];   /* (u, v, w) where det J is within detj_gap of detj_min */
-    double detj_max_at[3];   /* and of detj_max */
-    double detj_gap;
+    double detj_min, detj_max;     /* certified bounds of det J */
+    double detj_min_found, detj_max_found;   /* the extremes found: det J at detj_min_at, detj_max_at */
+    double detj_min_at[3];   /* (u, v, w) */
+    double detj_max_at[3];
+    double detj_gap;         /* largest distance from a bound to the extreme found */
     int folds;               /* det J takes both signs: the solid overlaps itself */
     double centroid[3];
     double inertia[3][3];    /* about the centroid: integral of (|r|^2 I - r r^T) */

@@ -498,6 +498,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             r.bbox_gap = fmax(r.bbox_gap, gap);
         } else {
             *(o == 6 ? &r.detj_min : &r.detj_max) = bound;
+            *(o == 6 ? &r.detj_min_found : &r.detj_max_found) = best[o];
             memcpy(o == 6 ? r.detj_min_at : r.detj_max_at, b.at, sizeof b.at);
             r.detj_gap = fmax(r.detj_gap, gap);
         }

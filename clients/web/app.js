@@ -86,7 +86,7 @@ function showProps(p, times) {
     ['centroid', vec(p.centroid)],
     ['principal', `moments ${p.principal.moments.map(fmt).join(', ')}`],
     ['inertia', inertiaDetails(p)],
-    ['det J', `${fmt(p.detJ.min)} to ${fmt(p.detJ.max)}, certified to ${fmt(p.detJ.gap)}`],
+    ['det J', `${fmt(p.detJ.min_found)} to ${fmt(p.detJ.max_found)} (certified: ${fmt(p.detJ.min)} to ${fmt(p.detJ.max)})`],
     ['bounds', `[${p.bbox.min.map(fmt).join(', ')}] to [${p.bbox.max.map(fmt).join(', ')}], certified to ${fmt(p.bbox.gap)}`],
     ['accuracy', `boundary ${p.residuals.boundary.toExponential(1)}, PDE ${p.residuals.pde.toExponential(1)}`],
     ['times', times],
