@@ -187,21 +187,76 @@ static int sign_changes(double fa, double fb, double tol)
     return (fa < -tol && fb > tol) || (fa > tol && fb < -tol);
 }
 
-/* The current line over [a, b]: roots by sampling 2n + 1 points, a rule on each piece. A sign
- * change is bracketed between the last sample clear of zero and the next one. */
+/*
+ * Where |det J| has a local minimum among the samples t0 < t1 < t2 without a sign change, det J
+ * may dip through zero between them and back: golden-section search for the extreme of sign *
+ * det J; if it crosses, *lo and *hi get the two brackets' inner ends.
+ */
+static int line_dip(qctx *q, double t0, double t2, double sign, double *at, double *fat)
+{
+    const double g = 0.5 * (3.0 - sqrt(5.0));
+    double a = t0, b = t2, x[3];
+    double c = a + g * (b - a), d = b - g * (b - a);
+    double fc = sign * line_eval(q, c, x), fd = sign * line_eval(q, d, x);
+    for (int it = 0; it < 40 && b - a > 1e-9 * (t2 - t0); it++) {
+        if (fc < fd) {
+            b = d, d = c, fd = fc;
+            c = a + g * (b - a);
+            fc = sign * line_eval(q, c, x);
+        } else {
+            a = c, c = d, fc = fd;
+            d = b - g * (b - a);
+            fd = sign * line_eval(q, d, x);
+        }
+        if (fmin(fc, fd) < -q->jtol)
+            break;
+    }
+    *at = fc < fd ? c : d;
+    *fat = sign * fmin(fc, fd);
+    return fmin(fc, fd) < -q->jtol;
+}
+
+/*
+ * The current line over [a, b]: det J sampled at 2n + 1 points; each sign change between
+ * neighbours (bracketed from the last value clear of zero) is located, and so is each dip
+ * through zero and back between samples (line_dip); each piece between roots gets a rule.
+ */
 static void line_integrate(qctx *q, double a, double b, double wt)
 {
     const int m = 2 * q->n[q->k];
-    double x[3], t0 = a, prev = a, fprev = line_eval(q, a, x);
+    double t[2 * GMAX + 1], f[2 * GMAX + 1], x[3];
+    for (int i = 0; i <= m; i++) {
+        t[i] = a + (b - a) * i / m;
+        f[i] = line_eval(q, t[i], x);
+    }
+    double cut[4 * GMAX + 2];
+    int ncut = 0, last = 0;
     for (int i = 1; i <= m; i++) {
-        double t = a + (b - a) * i / m, f = line_eval(q, t, x);
-        if (sign_changes(fprev, f, q->jtol)) {
-            double c = line_root(q, prev, t, fprev, f);
-            line_gauss(q, t0, c, wt);
-            t0 = c;
+        if (sign_changes(f[last], f[i], q->jtol))
+            cut[ncut++] = line_root(q, t[last], t[i], f[last], f[i]);
+        else if (i < m && fabs(f[i]) <= fabs(f[i - 1]) && fabs(f[i]) < fabs(f[i + 1]) &&
+                 fabs(f[i]) > q->jtol && !sign_changes(f[i], f[i + 1], q->jtol)) {
+            double at, fat, sign = f[i] > 0 ? 1.0 : -1.0;
+            if (line_dip(q, t[i - 1], t[i + 1], sign, &at, &fat)) {
+                double lo = t[i - 1], flo = f[i - 1];
+                if (at > t[i])   /* the dip lies right of the sample: bracket from it */
+                    lo = t[i], flo = f[i];
+                double r0 = line_root(q, lo, at, flo, fat);
+                double hi = at < t[i] ? t[i] : t[i + 1], fhi = at < t[i] ? f[i] : f[i + 1];
+                double r1 = line_root(q, at, hi, fat, fhi);
+                cut[ncut++] = r0;
+                cut[ncut++] = r1;
+            }
         }
-        if (fabs(f) > q->jtol || fabs(fprev) <= q->jtol)
-            prev = t, fprev = f;
+        if (fabs(f[i]) > q->jtol || fabs(f[last]) <= q->jtol)
+            last = i;
+    }
+    double t0 = a;
+    for (int c = 0; c < ncut; c++) {
+        if (cut[c] > t0) {
+            line_gauss(q, t0, cut[c], wt);
+            t0 = cut[c];
+        }
     }
     line_gauss(q, t0, b, wt);
 }
