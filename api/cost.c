@@ -53,7 +53,7 @@
 #define K_BOX_X    100.0  /* a coordinate's model beyond its modes */
 #define K_BOXES_X  150.0  /* boxes of a coordinate's branch and bound, typically */
 #define K_BOX_J    1500.0 /* det J's model beyond its modes: the series products */
-#define K_LINE_PT  4.5    /* points per integration node: 2n + 1 samples, roots, a rule per piece */
+#define K_LINE_PT  2.0    /* points per integration node: the samples are the rule, more where roots are */
 #define K_PT_F32   1.0    /* a sample written as f32 */
 #define K_FMT_F32  17.0   /* a float32 printed for grid json */
 #define K_DET      4.0    /* det J of a vts point */

@@ -179,21 +179,11 @@ static int call_props(const void *arg, const pde_cancel *cancel)
     return st;
 }
 
-static pde_solution *solve_heavy(int kind, size_t n)
-{
-    heavy h;
-    heavy_make(&h, kind, n);
-    pde_solution *sol = NULL;
-    assert_int_equal(pde_solve(&h.m, &sol, NULL), PDE_OK);
-    heavy_free(&h);
-    return sol;
-}
-
 static void properties_should_stop_at_the_poll_that_asks_and_leave_out_untouched(void **state)
 {
     (void)state;
-    /* Polled about every millisecond of work: a solid of 51 modes takes tens of polls. */
-    pde_solution *sol = solve_heavy(MODES, 16);
+    /* Polled about every millisecond of work: fig. 4a's properties take tens of polls. */
+    pde_solution *sol = solve_preset("fig4a");
     check_cancellation(call_props, sol, PDE_OK, PDE_ERR_CANCELLED, 10);
     pde_solution_free(sol);
 }
@@ -255,7 +245,7 @@ static int call_output(const void *arg, const pde_cancel *cancel)
 static void output_open_should_stop_in_the_properties_and_the_mesh_it_computes(void **state)
 {
     (void)state;
-    pde_solution *sol = solve_heavy(MODES, 16);
+    pde_solution *sol = solve_preset("fig4a");
     /* json and vts: the properties; glb: the mesh, then the properties; stl: the mesh alone. */
     static const api_format fmts[] = { API_FMT_JSON, API_FMT_VTS, API_FMT_GLB, API_FMT_STL };
     for (size_t i = 0; i < sizeof fmts / sizeof *fmts; i++) {
