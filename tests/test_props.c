@@ -16,6 +16,7 @@
 
 #include <cmocka.h>
 
+#include "mesh.h"
 #include "internal.h"   /* to perturb a solution's closed form, which the public API keeps immutable */
 #include "model.h"
 #include "support.h"
@@ -737,6 +738,55 @@ static void props_should_match_the_reference_quadrature_on_every_preset(void **s
     print_message("reference quadrature of %zu presets: %.2f s\n", api_preset_count(), mono_now() - t0);
 }
 
+/* The area of a mesh's triangles. */
+static double mesh_area(const api_mesh *m)
+{
+    double a = 0;
+    for (size_t t = 0; t < m->ntris; t++) {
+        const float *p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = &m->pos[3 * m->tri[3 * t + k]];
+        double e[2][3];
+        for (int c = 0; c < 3; c++)
+            e[0][c] = (double)p[1][c] - p[0][c], e[1][c] = (double)p[2][c] - p[0][c];
+        double n[3] = { e[0][1] * e[1][2] - e[0][2] * e[1][1], e[0][2] * e[1][0] - e[0][0] * e[1][2],
+                        e[0][0] * e[1][1] - e[0][1] * e[1][0] };
+        a += 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    }
+    return a;
+}
+
+static void reference_surface_area_should_agree_with_the_mesh_of_every_preset(void **state)
+{
+    (void)state;
+    /* The mesh's rule for the skin (collapsed faces vanish, coincident faces cancel) against the
+     * reference's: two resolutions, Richardson-extrapolated (the error of flat triangles goes as h^2). */
+    double worst = 0;
+    for (size_t i = 0; i < api_preset_count(); i++) {
+        const char *name = api_preset_at(i)->name;
+        if (slow_reference(name))
+            continue;
+        pde_solution *sol = preset_solution(name);
+        const ref_props_out *r = preset_ref(i, sol);
+        double area[2];
+        for (int k = 0; k < 2; k++) {
+            const unsigned res[3] = { 40u << k, 160u << k, 40u << k };
+            api_mesh m;
+            api_error err;
+            assert_int_equal(api_mesh_build(sol, res, NULL, &m, &err), 0);
+            area[k] = mesh_area(&m);
+            api_mesh_free(&m);
+        }
+        double extrapolated = (4 * area[1] - area[0]) / 3;
+        worst = fmax(worst, fabs(extrapolated - r->surface_area) / r->surface_area);
+        if (!close_rel(extrapolated, r->surface_area, 1e-3, 0))   /* a seam counted would add ~10% */
+            fail_msg("%s: mesh area %.9g (%.9g, %.9g at two resolutions), reference %.12g", name, extrapolated,
+                     area[0], area[1], r->surface_area);
+        pde_solution_free(sol);
+    }
+    print_message("largest relative difference of mesh and reference areas: %.3g\n", worst);
+}
+
 /*
  * Bounds against a dense sampling: a grid of nu x nv x nw points (u and v uniform, w at Chebyshev-Lobatto
  * points, which crowd towards the boundary layers of w = 0 and 1), each face and edge included, plus
@@ -910,6 +960,7 @@ int main(void)
         cmocka_unit_test(certificate_should_show_the_digits_lost_when_a_large_particular_solution_cancels),
         cmocka_unit_test(reference_quadrature_should_match_the_hand_derived_cuboid_and_frustum),
         cmocka_unit_test(reference_quadrature_should_match_the_160_digit_volume_of_fig4a_which_folds),
+        cmocka_unit_test(reference_surface_area_should_agree_with_the_mesh_of_every_preset),
         cmocka_unit_test(props_should_give_the_cuboid_of_figure_1a_its_hand_derived_mass_properties),
         cmocka_unit_test(props_should_give_the_square_frustum_of_figure_1c_its_hand_derived_mass_properties),
         cmocka_unit_test(props_should_match_the_160_digit_volume_of_fig4a_which_folds),
