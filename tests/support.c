@@ -1491,15 +1491,12 @@ static void rp_wline(double v, double *out, void *ctx)
         int right = i == N || (s * r > 0 && fabs(f[i]) <= fabs(r));
         if (!left || !right)
             continue;
-        /* Searched unless a parabola through the samples stays well away from 0, with a wide margin. */
+        /* Every such least is searched: a parabola through the samples can miss a narrow lobe; the
+         * search ends early once a bound on det J'' (four times the samples' second difference) puts
+         * 0 out of reach. */
         double a = i > 0 ? t - h : t, b = i < N ? t + h : t, fa = i > 0 ? l : f[i], fb = i < N ? r : f[i];
-        double vert = 0;
-        if (i > 0 && i < N && s * (fa - 2 * f[i] + fb) > 0)
-            vert = s * (f[i] - (fb - fa) * (fb - fa) / (8 * (fa - 2 * f[i] + fb)));
-        /* Four times the samples' second difference bounds det J'' (0 at an end: no bound). */
         double curv = i > 0 && i < N ? 4 * fabs(fa - 2 * f[i] + fb) / (h * h) : 0;
-        if (vert <= 0.5 * s * f[i] || fabs(f[i]) < 0.2 * fmax(fabs(fa), fabs(fb)))
-            nr += rp_dip(e, a, fa, b, fb, s, curv, roots + nr);
+        nr += rp_dip(e, a, fa, b, fb, s, curv, roots + nr);
     }
     qsort(roots, (size_t)nr, sizeof *roots, rp_cmp);
     for (int k = 0; k < RP_N; k++)
@@ -1803,7 +1800,7 @@ int ref_props(const pde_solution *s, ref_props_out *out)
     /* Volume and moments: outer u, then v, then the w-lines. */
     double tol[RP_N], m[RP_N];
     for (int q = 0; q < RP_N; q++)
-        tol[q] = 1e-10 * vol0 * (q < 2 ? 1 : q < 5 ? ext : ext * ext);
+        tol[q] = 1e-12 * vol0 * (q < 2 ? 1 : q < 5 ? ext : ext * ext);
     /*
      * The lines cross the fold: along the axis where det J changes sign most often between neighbours
      * of a 24^3 grid (or, without a fold, the fastest axis). Of the other two the harder is outer, where

@@ -186,12 +186,14 @@ void test_filter_from_env(void);
  * What pde_properties() reports, computed another way: the solid evaluated from the published closed
  * form (pde_solution_modes, checked against pde_eval_d), and every integral over the unit cube weighted
  * by |det J| by nested global-adaptive Gauss-Kronrod 7-15 over two axes, each line along the third
- * integrated exactly between the roots of det J (dense samples, a golden-section search of every
- * suspicious least of |det J| for a hidden lobe, roots by Illinois to 1e-15, Gauss-Legendre 20
+ * integrated exactly between the roots of det J (dense samples, a golden-section search at every
+ * least of |det J| among them for a hidden lobe, roots by Illinois to 1e-15, Gauss-Legendre 20
  * between). The line runs along the axis where det J changes sign most often, so that it crosses the
- * fold. Error estimates are kept below 1e-10 of each integral's scale; being pessimistic, the values
- * agree to about 1e-13 with runs at 1e-11 and 1e-12. Surface area: |x_s x x_t| over the six faces by
- * nested adaptive GK 7-15; a face that collapses gives 0 by itself, and two opposite faces that coincide
+ * fold. Error estimates are kept below 1e-12 of each integral's scale (looser, a lobe can hide from the
+ * first few Kronrod nodes); the values agree to about 1e-12 with runs at 1e-13 and with the lines along
+ * the other axes, and fig4a's volume with the 160-digit value to 1e-15. Surface area: |x_s x x_t| over
+ * the six faces by nested adaptive GK 7-15 to 1e-10 (agreeing to 1e-11 with runs at 1e-13); a face
+ * that collapses gives 0 by itself, and two opposite faces that coincide
  * point for point (the seam v = 0, 1 of a solid of revolution) are both left out, as api/mesh.c does.
  */
 typedef struct {
