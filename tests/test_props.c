@@ -787,12 +787,52 @@ static void reference_surface_area_should_agree_with_the_mesh_of_every_preset(vo
     print_message("largest relative difference of mesh and reference areas: %.3g\n", worst);
 }
 
+/* x, y, z (what 0..2) or det J (3) at p. */
+static double sample_at(const pde_solution *sol, int what, const double p[3])
+{
+    double x[3], xu[3], xv[3], xw[3];
+    pde_eval_d(sol, p[0], p[1], p[2], x, xu, xv, xw);
+    return what < 3 ? x[what] : det_cols(xu, xv, xw);
+}
+
+/* A compass search from p for the least of sign * (what) in the unit cube; returns the value reached. */
+static double compass(const pde_solution *sol, int what, double sign, const double from[3], double value)
+{
+    double p[3] = { from[0], from[1], from[2] }, best = sign * value;
+    for (double step = 0.02; step > 1e-12;) {
+        int moved = 0;
+        for (int a = 0; a < 3; a++)
+            for (int d = -1; d <= 1; d += 2) {
+                double q[3] = { p[0], p[1], p[2] };
+                q[a] = fmin(1, fmax(0, q[a] + d * step));
+                double f = sign * sample_at(sol, what, q);
+                if (f < best)
+                    best = f, p[0] = q[0], p[1] = q[1], p[2] = q[2], moved = 1;
+            }
+        if (!moved)
+            step *= 0.5;
+    }
+    return sign * best;
+}
+
+static void note_extremes(const double q[4], const double at[3], double lo[4], double hi[4], double lo_at[4][3],
+                          double hi_at[4][3])
+{
+    for (int c = 0; c < 4; c++) {
+        if (q[c] < lo[c])
+            lo[c] = q[c], memcpy(lo_at[c], at, 3 * sizeof *at);
+        if (q[c] > hi[c])
+            hi[c] = q[c], memcpy(hi_at[c], at, 3 * sizeof *at);
+    }
+}
+
 /*
  * Bounds against a dense sampling: a grid of nu x nv x nw points (u and v uniform, w at Chebyshev-Lobatto
  * points, which crowd towards the boundary layers of w = 0 and 1), each face and edge included, plus
- * nrand random points. Every sampled x and det J must lie within the reported bounds, exactly: they are
- * certified. And each bound must be reached within its gap, up to the sampling's reach: twice the largest
- * change between neighbouring samples along each axis, summed over the axes.
+ * nrand random points, and each extreme among them polished by a compass search. Every sampled x and
+ * det J must lie within the reported bounds, exactly: they are certified. And each bound must be reached
+ * within its gap, up to the sampling's reach: twice the largest change between neighbouring samples along
+ * each axis, summed over the axes.
  */
 static void expect_bounds_contain_samples(const char *name, const pde_solution *sol, size_t nu, size_t nv, size_t nw,
                                           size_t nrand)
@@ -805,6 +845,7 @@ static void expect_bounds_contain_samples(const char *name, const pde_solution *
     assert_non_null(prev);
     assert_non_null(cur);
     double lo[4] = { INFINITY, INFINITY, INFINITY, INFINITY }, hi[4] = { -INFINITY, -INFINITY, -INFINITY, -INFINITY };
+    double lo_at[4][3] = { { 0 } }, hi_at[4][3] = { { 0 } };
     double step[3][4] = { { 0 } };   /* largest change between neighbours, per axis and quantity */
     for (size_t k = 0; k < nw; k++) {
         double w = 0.5 * (1 - cos(M_PI * (double)k / (double)(nw - 1)));
@@ -815,8 +856,9 @@ static void expect_bounds_contain_samples(const char *name, const pde_solution *
                 pde_eval_d(sol, u, v, w, x, xu, xv, xw);
                 double *q = &cur[4 * (j * nu + i)];
                 q[0] = x[0], q[1] = x[1], q[2] = x[2], q[3] = det_cols(xu, xv, xw);
+                const double at[3] = { u, v, w };
+                note_extremes(q, at, lo, hi, lo_at, hi_at);
                 for (int c = 0; c < 4; c++) {
-                    lo[c] = fmin(lo[c], q[c]), hi[c] = fmax(hi[c], q[c]);
                     if (i > 0)
                         step[0][c] = fmax(step[0][c], fabs(q[c] - q[c - 4]));
                     if (j > 0)
@@ -840,8 +882,13 @@ static void expect_bounds_contain_samples(const char *name, const pde_solution *
         double x[3], xu[3], xv[3], xw[3];
         pde_eval_d(sol, r[0], r[1], r[2], x, xu, xv, xw);
         const double q[4] = { x[0], x[1], x[2], det_cols(xu, xv, xw) };
-        for (int c = 0; c < 4; c++)
-            lo[c] = fmin(lo[c], q[c]), hi[c] = fmax(hi[c], q[c]);
+        note_extremes(q, r, lo, hi, lo_at, hi_at);
+    }
+    /* Each sampled extreme polished by a compass search: the solid's own extremes, nearly. */
+    for (int c = 0; c < 4; c++) {
+        double l = sample_at(sol, c, lo_at[c]), h = sample_at(sol, c, hi_at[c]);
+        lo[c] = fmin(lo[c], compass(sol, c, 1, lo_at[c], l));
+        hi[c] = fmax(hi[c], compass(sol, c, -1, hi_at[c], h));
     }
     const double blo[4] = { p.bbox_min[0], p.bbox_min[1], p.bbox_min[2], p.detj_min };
     const double bhi[4] = { p.bbox_max[0], p.bbox_max[1], p.bbox_max[2], p.detj_max };
