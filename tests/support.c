@@ -1156,3 +1156,747 @@ void test_filter_from_env(void)
     if (f && *f)
         cmocka_set_test_filter(f);
 }
+
+/* ---- independent properties of a solid: nested adaptive quadrature (ref_props) ---- */
+
+/*
+ * The solid is evaluated here from the closed form that pde_solution_modes() publishes, not with the
+ * core's evaluator: x_c = sum over modes f_u(u) f_v(v) h(w), h the sum of its w-terms
+ * exp(alpha (w - shift)) (A(w) cos(beta w) + B(w) sin(beta w)), and f_u, f_v by tfactor(). Along a
+ * w-line (u, v fixed) the u- and v-factors are taken once per line, and each distinct exponential and
+ * trigonometric pair once per point.
+ */
+enum { RP_N = 11 };   /* |J|, J, |J| d (3), |J| d d^T (xx, yy, zz, xy, xz, yz), d = x - x0 */
+
+typedef struct {
+    double alpha, shift, beta;
+} rp_exp;
+
+typedef struct {
+    int exp, deg;
+    const double *A, *B;
+} rp_wterm;
+
+typedef struct {
+    pde_factor u, v;
+    size_t t0, nt;
+} rp_mode;
+
+typedef struct {
+    const pde_solution *sol;
+    size_t cm[4];            /* component c's modes are cm[c] .. cm[c + 1] - 1 */
+    rp_mode *modes;
+    rp_wterm *wt;
+    rp_exp *ex;
+    size_t nex;
+    int axis;                /* the current line runs along this axis */
+    double *P0, *Q;          /* per mode: the fixed factors' product; 3 per mode, with one differentiated */
+    double *E, *C, *S;       /* per exponential, at the current point */
+    double rate[3];          /* per axis, the fastest rate of the factors (and degree of the w-terms) */
+    int nsamp[3];            /* samples of det J per line along each axis, to find its roots */
+    double lmax[3];          /* longest Gauss-Legendre piece along each axis */
+    double x0[3];            /* moments are about x0, near the centroid */
+    double gl_x[20], gl_w[20];
+    size_t lines;
+} rp_eval;
+
+static void rp_free(rp_eval *e)
+{
+    free(e->modes);
+    free(e->wt);
+    free(e->ex);
+    free(e->P0);
+    free(e->E);
+}
+
+/* Gauss-Legendre nodes and weights on [0, 1], by Newton on the three-term recurrence. */
+static void rp_gauss_legendre(int n, double *x, double *w)
+{
+    for (int i = 0; i < n; i++) {
+        double t = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1;
+        for (int it = 0; it < 100; it++) {
+            double p0 = 1, p1 = t;
+            for (int k = 2; k <= n; k++) {
+                double p2 = ((2 * k - 1) * t * p1 - (k - 1) * p0) / k;
+                p0 = p1, p1 = p2;
+            }
+            dp = n * (t * p1 - p0) / (t * t - 1);
+            double dt = p1 / dp;
+            t -= dt;
+            if (fabs(dt) < 1e-17)
+                break;
+        }
+        x[i] = 0.5 * (1 - t);
+        w[i] = 1.0 / ((1 - t * t) * dp * dp);
+    }
+}
+
+/* How fast a factor turns or grows, in radians (or the degree of a power). */
+static double rp_rate(pde_factor f)
+{
+    return f.kind == PDE_SIN || f.kind == PDE_COS ? fabs(f.p) * M_PI : fabs(f.p);
+}
+
+static int rp_init(rp_eval *e, const pde_solution *s)
+{
+    memset(e, 0, sizeof *e);
+    e->sol = s;
+    size_t nm = 0, nt = 0;
+    for (int c = 0; c < 3; c++) {
+        size_t n;
+        const pde_mode *md = pde_solution_modes(s, c, &n);
+        e->cm[c] = nm;
+        nm += n;
+        for (size_t m = 0; m < n; m++)
+            nt += md[m].nterms;
+    }
+    e->cm[3] = nm;
+    e->modes = calloc(nm + 1, sizeof *e->modes);
+    e->wt = calloc(nt + 1, sizeof *e->wt);
+    e->ex = calloc(nt + 1, sizeof *e->ex);
+    e->P0 = calloc(4 * (nm + 1), sizeof *e->P0);
+    e->E = calloc(3 * (nt + 1), sizeof *e->E);
+    if (!e->modes || !e->wt || !e->ex || !e->P0 || !e->E) {
+        rp_free(e);
+        return -1;
+    }
+    e->Q = e->P0 + nm + 1;
+    e->C = e->E + nt + 1, e->S = e->C + nt + 1;
+    size_t k = 0, t = 0;
+    for (int c = 0; c < 3; c++) {
+        size_t n;
+        const pde_mode *md = pde_solution_modes(s, c, &n);
+        for (size_t m = 0; m < n; m++, k++) {
+            e->modes[k] = (rp_mode){ md[m].u, md[m].v, t, md[m].nterms };
+            for (size_t j = 0; j < md[m].nterms; j++, t++) {
+                const pde_wterm *w = &md[m].terms[j];
+                size_t x = 0;
+                while (x < e->nex && !(e->ex[x].alpha == w->alpha && e->ex[x].shift == w->shift &&
+                                       e->ex[x].beta == w->beta))
+                    x++;
+                if (x == e->nex)
+                    e->ex[e->nex++] = (rp_exp){ w->alpha, w->shift, w->beta };
+                e->wt[t] = (rp_wterm){ (int)x, w->deg, w->A, w->B };
+                e->rate[2] = fmax(e->rate[2], fabs(w->alpha) + fabs(w->beta) + w->deg);
+            }
+            e->rate[0] = fmax(e->rate[0], rp_rate(md[m].u));
+            e->rate[1] = fmax(e->rate[1], rp_rate(md[m].v));
+        }
+    }
+    for (int a = 0; a < 3; a++) {
+        /* det J multiplies three derivatives: about 8 samples per period of their rate. */
+        double n = 16 + 8 * 3 * e->rate[a] / (2 * M_PI);
+        e->nsamp[a] = n > 2000 ? 2000 : (int)n;
+        /* A moment multiplies five factors; GL20 on a piece where they turn by 20 radians is exact. */
+        e->lmax[a] = fmin(0.25, 20.0 / (5 * e->rate[a] + 1));
+    }
+    rp_gauss_legendre(20, e->gl_x, e->gl_w);
+    return 0;
+}
+
+/* h and h' of mode m at w; cached: the exponentials of the current point (rp_at) are used. */
+static void rp_h(const rp_eval *e, size_t m, double w, int cached, double *h, double *dh)
+{
+    *h = 0, *dh = 0;
+    for (size_t t = e->modes[m].t0; t < e->modes[m].t0 + e->modes[m].nt; t++) {
+        const rp_wterm *q = &e->wt[t];
+        const rp_exp *x = &e->ex[q->exp];
+        double a = 0, da = 0, b = 0, db = 0;
+        for (int j = q->deg; j >= 0; j--) {
+            da = da * w + a, a = a * w + q->A[j];
+            db = db * w + b, b = b * w + q->B[j];
+        }
+        double E, C, S;
+        if (cached)
+            E = e->E[q->exp], C = e->C[q->exp], S = e->S[q->exp];
+        else
+            E = exp(x->alpha * (w - x->shift)), C = cos(x->beta * w), S = sin(x->beta * w);
+        double val = a * C + b * S;
+        *h += E * val;
+        *dh += E * (x->alpha * val + da * C - a * x->beta * S + db * S + b * x->beta * C);
+    }
+}
+
+/* The line along axis through p (p[axis] is ignored): the other two factors of every mode, once. */
+static void rp_line(rp_eval *e, int axis, const double p[3])
+{
+    e->axis = axis;
+    for (size_t m = 0; m < e->cm[3]; m++) {
+        const rp_mode *md = &e->modes[m];
+        double val[3] = { 1, 1, 1 }, der[3] = { 0, 0, 0 };
+        if (axis != 0)
+            val[0] = tfactor(md->u, p[0], 0), der[0] = tfactor(md->u, p[0], 1);
+        if (axis != 1)
+            val[1] = tfactor(md->v, p[1], 0), der[1] = tfactor(md->v, p[1], 1);
+        if (axis != 2)
+            rp_h(e, m, p[2], 0, &val[2], &der[2]);
+        e->P0[m] = val[0] * val[1] * val[2];
+        for (int b = 0; b < 3; b++)
+            e->Q[3 * m + b] = (b == 0 ? der[0] : val[0]) * (b == 1 ? der[1] : val[1]) * (b == 2 ? der[2] : val[2]);
+    }
+    e->lines++;
+}
+
+/* x and the Jacobian J[c][axis] at t on the current line. */
+static void rp_at(rp_eval *e, double t, double x[3], double J[3][3])
+{
+    const int a = e->axis;
+    if (a == 2)
+        for (size_t k = 0; k < e->nex; k++) {
+            e->E[k] = exp(e->ex[k].alpha * (t - e->ex[k].shift));
+            e->C[k] = e->ex[k].beta == 0 ? 1 : cos(e->ex[k].beta * t);
+            e->S[k] = e->ex[k].beta == 0 ? 0 : sin(e->ex[k].beta * t);
+        }
+    for (int c = 0; c < 3; c++) {
+        double s[4] = { 0, 0, 0, 0 };   /* x, then the derivatives along u, v, w */
+        for (size_t m = e->cm[c]; m < e->cm[c + 1]; m++) {
+            double f, df;
+            if (a == 2)
+                rp_h(e, m, t, 1, &f, &df);
+            else {
+                pde_factor g = a == 0 ? e->modes[m].u : e->modes[m].v;
+                f = tfactor(g, t, 0), df = tfactor(g, t, 1);
+            }
+            s[0] += e->P0[m] * f;
+            for (int b = 0; b < 3; b++)
+                s[1 + b] += b == a ? e->P0[m] * df : e->Q[3 * m + b] * f;
+        }
+        x[c] = s[0], J[c][0] = s[1], J[c][1] = s[2], J[c][2] = s[3];
+    }
+}
+
+static double rp_det(double J[3][3])
+{
+    return J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) - J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
+           J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
+}
+
+static double rp_detj(rp_eval *e, double w)
+{
+    double x[3], J[3][3];
+    rp_at(e, w, x, J);
+    return rp_det(J);
+}
+
+/* A root of det J in [a, b], where it changes sign: Illinois steps, a bisection when they stall. */
+static double rp_root(rp_eval *e, double a, double fa, double b, double fb)
+{
+    int side = 0;
+    for (int it = 0; it < 200 && b - a > 1e-15 * fmax(1.0, fabs(a)); it++) {
+        double m = (it % 4 == 3) ? 0.5 * (a + b) : (a * fb - b * fa) / (fb - fa);
+        if (!(m > a && m < b))
+            m = 0.5 * (a + b);
+        double fm = rp_detj(e, m);
+        if (fm == 0)
+            return m;
+        if ((fm < 0) == (fa < 0)) {
+            a = m, fa = fm;
+            if (side == -1)
+                fb *= 0.5;
+            side = -1;
+        } else {
+            b = m, fb = fm;
+            if (side == 1)
+                fa *= 0.5;
+            side = 1;
+        }
+    }
+    return 0.5 * (a + b);
+}
+
+/*
+ * A pair of roots that dips between two samples of one sign: golden-section search for the least of
+ * sign * det J on [a, b] (fa, fb its values at the ends); if it crosses zero, the two roots on either
+ * side. curv, if not 0, bounds |det J''| there and ends the search once 0 is out of reach. Returns how
+ * many roots it adds.
+ */
+static int rp_dip(rp_eval *e, double a, double fa, double b, double fb, double sign, double curv, double *roots)
+{
+    const double g = 0.5 * (3 - sqrt(5.0));
+    double c = a + g * (b - a), d = b - g * (b - a);
+    double fc = sign * rp_detj(e, c), fd = sign * rp_detj(e, d);
+    fa *= sign, fb *= sign;
+    for (int it = 0; it < 40 && d - c > 1e-12; it++) {
+        if (fc <= 0 || fd <= 0)
+            break;
+        /* With |det J''| below curv, nothing in [a, b] can reach 0: no lobe. */
+        if (curv > 0 && fmin(fc, fd) > 0.5 * curv * (b - a) * (b - a))
+            return 0;
+        if (fc < fd)
+            b = d, d = c, fd = fc, c = a + g * (b - a), fc = sign * rp_detj(e, c);
+        else
+            a = c, c = d, fc = fd, d = b - g * (b - a), fd = sign * rp_detj(e, d);
+    }
+    double p = fc <= fd ? c : d, fp = fmin(fc, fd);
+    if (fp > 0)
+        return 0;
+    if (fp == 0) {
+        roots[0] = p;
+        return 1;
+    }
+    /* Back to det J's own signs for the root finder; an end where det J = 0 is the root itself. */
+    roots[0] = fa == 0 ? a : rp_root(e, a, sign * fa, p, sign * fp);
+    roots[1] = fb == 0 ? b : rp_root(e, p, sign * fp, b, sign * fb);
+    return 2;
+}
+
+static int rp_cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The volume integrands along the w-line through (u, v): roots of det J, then GL20 pieces between them. */
+static void rp_wline(double v, double *out, void *ctx);
+
+typedef struct {
+    rp_eval *e;
+    int order[3];      /* outer, middle and inner (line) axes */
+    double outer;
+    const double *tol;
+    int ok;
+} rp_vctx;
+
+static void rp_adapt(void (*f)(double, double *, void *), void *ctx, int n, const double *tol, double *res,
+                     int *ok);
+
+static void rp_wline(double v, double *out, void *ctx)
+{
+    rp_vctx *vc = ctx;
+    rp_eval *e = vc->e;
+    double pt[3];
+    pt[vc->order[0]] = vc->outer, pt[vc->order[1]] = v, pt[vc->order[2]] = 0;
+    rp_line(e, vc->order[2], pt);
+    const int N = e->nsamp[e->axis];
+    double f[2001], roots[2100];
+    int nr = 0;
+    for (int i = 0; i <= N; i++)
+        f[i] = rp_detj(e, (double)i / N);
+    for (int i = 0; i <= N && nr < 2000; i++) {
+        double t = (double)i / N, h = 1.0 / N;
+        if (f[i] == 0) {
+            /* A root on a sample (det J = 0 on a face, often): a lobe of the other sign may follow it. */
+            roots[nr++] = t;
+            if (i < N && f[i + 1] != 0)
+                nr += rp_dip(e, t, 0, t + h, f[i + 1], f[i + 1] < 0 ? -1 : 1, 0, roots + nr);
+            if (i > 0 && f[i - 1] != 0)
+                nr += rp_dip(e, t - h, f[i - 1], t, 0, f[i - 1] < 0 ? -1 : 1, 0, roots + nr);
+            continue;
+        }
+        if (i < N && f[i + 1] != 0 && (f[i] < 0) != (f[i + 1] < 0))
+            roots[nr++] = rp_root(e, t, f[i], t + h, f[i + 1]);
+        /* A least |det J| among samples of one sign: a lobe of the other sign may hide between them. */
+        double l = i > 0 ? f[i - 1] : NAN, r = i < N ? f[i + 1] : NAN, s = f[i] < 0 ? -1 : 1;
+        int left = i == 0 || (s * l > 0 && fabs(f[i]) <= fabs(l));
+        int right = i == N || (s * r > 0 && fabs(f[i]) <= fabs(r));
+        if (!left || !right)
+            continue;
+        /* Every such least is searched: a parabola through the samples can miss a narrow lobe; the
+         * search ends early once a bound on det J'' (four times the samples' second difference) puts
+         * 0 out of reach. */
+        double a = i > 0 ? t - h : t, b = i < N ? t + h : t, fa = i > 0 ? l : f[i], fb = i < N ? r : f[i];
+        double curv = i > 0 && i < N ? 4 * fabs(fa - 2 * f[i] + fb) / (h * h) : 0;
+        nr += rp_dip(e, a, fa, b, fb, s, curv, roots + nr);
+    }
+    qsort(roots, (size_t)nr, sizeof *roots, rp_cmp);
+    for (int k = 0; k < RP_N; k++)
+        out[k] = 0;
+    double prev = 0;
+    for (int r = 0; r <= nr; r++) {
+        double next = r < nr ? roots[r] : 1;
+        if (next <= prev)
+            continue;
+        int pieces = (int)ceil((next - prev) / e->lmax[e->axis]);
+        double len = (next - prev) / pieces;
+        for (int p = 0; p < pieces; p++)
+            for (int g = 0; g < 20; g++) {
+                double w = prev + len * (p + e->gl_x[g]), x[3], J[3][3];
+                rp_at(e, w, x, J);
+                double dj = rp_det(J), wt = len * e->gl_w[g], aj = wt * fabs(dj);
+                double d[3] = { x[0] - e->x0[0], x[1] - e->x0[1], x[2] - e->x0[2] };
+                out[0] += aj, out[1] += wt * dj;
+                out[2] += aj * d[0], out[3] += aj * d[1], out[4] += aj * d[2];
+                out[5] += aj * d[0] * d[0], out[6] += aj * d[1] * d[1], out[7] += aj * d[2] * d[2];
+                out[8] += aj * d[0] * d[1], out[9] += aj * d[0] * d[2], out[10] += aj * d[1] * d[2];
+            }
+        prev = next;
+    }
+}
+
+/* Gauss-Kronrod 7-15 on [-1, 1]: the Kronrod nodes (the Gauss ones are odd-indexed) and weights. */
+static const double gk_x[8] = { 0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
+                                0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
+                                0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
+                                0.207784955007898467600689403773245, 0.0 };
+static const double gk_wk[8] = { 0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
+                                 0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
+                                 0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
+                                 0.204432940075298892414161999234649, 0.209482141084727828012999174891714 };
+static const double gk_wg[4] = { 0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
+                                 0.381830050505118944950369775488975, 0.417959183673469387755102040816327 };
+
+typedef struct {
+    double a, b, val[RP_N], err[RP_N];
+} rp_iv;
+
+static void rp_gk15(void (*f)(double, double *, void *), void *ctx, int n, rp_iv *iv)
+{
+    double c = 0.5 * (iv->a + iv->b), h = 0.5 * (iv->b - iv->a), y[RP_N], z[RP_N];
+    double k[RP_N] = { 0 }, g[RP_N] = { 0 };
+    f(c, y, ctx);
+    for (int q = 0; q < n; q++)
+        k[q] = gk_wk[7] * y[q], g[q] = gk_wg[3] * y[q];
+    for (int j = 0; j < 7; j++) {
+        f(c - h * gk_x[j], y, ctx);
+        f(c + h * gk_x[j], z, ctx);
+        for (int q = 0; q < n; q++) {
+            k[q] += gk_wk[j] * (y[q] + z[q]);
+            if (j % 2)
+                g[q] += gk_wg[j / 2] * (y[q] + z[q]);
+        }
+    }
+    for (int q = 0; q < n; q++) {
+        iv->val[q] = h * k[q];
+        iv->err[q] = fabs(h * (k[q] - g[q]));
+    }
+}
+
+#define RP_MAX_IV 3000
+
+/*
+ * Global adaptive GK 7-15 of n integrands over [0, 1]: bisects the interval with the largest error
+ * (relative to each integrand's absolute tolerance) until the errors add up to less than tol. *ok
+ * becomes 0 if it cannot get there.
+ */
+static void rp_adapt(void (*f)(double, double *, void *), void *ctx, int n, const double *tol, double *res,
+                     int *ok)
+{
+    int cap = 32, niv = 1;
+    rp_iv *iv = malloc((size_t)cap * sizeof *iv);
+    if (!iv) {
+        *ok = 0;
+        return;
+    }
+    iv[0].a = 0, iv[0].b = 1;
+    rp_gk15(f, ctx, n, &iv[0]);
+    for (;;) {
+        double total[RP_N] = { 0 };
+        for (int i = 0; i < niv; i++)
+            for (int q = 0; q < n; q++)
+                total[q] += iv[i].err[q];
+        int done = 1;
+        for (int q = 0; q < n; q++)
+            done &= total[q] <= tol[q];
+        if (done)
+            break;
+        int worst = -1;
+        double ws = 0;
+        for (int i = 0; i < niv; i++) {
+            if (iv[i].b - iv[i].a < 1e-11)
+                continue;
+            double sc = 0;
+            for (int q = 0; q < n; q++)
+                sc = fmax(sc, iv[i].err[q] / tol[q]);
+            if (sc > ws)
+                ws = sc, worst = i;
+        }
+        if (worst < 0 || niv == RP_MAX_IV) {
+            *ok = 0;
+            break;
+        }
+        if (niv == cap) {
+            rp_iv *more = realloc(iv, 2 * (size_t)cap * sizeof *iv);
+            if (!more) {
+                *ok = 0;
+                break;
+            }
+            iv = more, cap *= 2;
+        }
+        double a = iv[worst].a, b = iv[worst].b, m = 0.5 * (a + b);
+        iv[worst].b = m;
+        iv[niv].a = m, iv[niv].b = b;
+        rp_gk15(f, ctx, n, &iv[worst]);
+        rp_gk15(f, ctx, n, &iv[niv]);
+        niv++;
+    }
+    for (int q = 0; q < n; q++) {
+        res[q] = 0;
+        for (int i = 0; i < niv; i++)
+            res[q] += iv[i].val[q];
+    }
+    free(iv);
+}
+
+/* The outer integrand: at u, the integral over v of the w-lines' integrals. */
+static void rp_vplane(double u, double *out, void *ctx)
+{
+    rp_vctx *vc = ctx;
+    rp_vctx inner = *vc;
+    inner.outer = u;
+    inner.ok = 1;
+    double tol[RP_N];
+    for (int q = 0; q < RP_N; q++)
+        tol[q] = 0.1 * vc->tol[q];
+    rp_adapt(rp_wline, &inner, RP_N, tol, out, &inner.ok);
+    vc->ok &= inner.ok;
+}
+
+/* ---- surface area: nested adaptive GK 7-15 of |x_a x x_b| over each face ---- */
+
+typedef struct {
+    rp_eval *e;
+    int axis, side;
+    double outer;
+    double tol;
+    int ok;
+} rp_fctx;
+
+/* The two axes of face `axis`: the outer parameter s on the first, lines (t) along the faster second. */
+static void rp_face_axes(const rp_fctx *fc, int *b0, int *b1)
+{
+    int a = fc->axis == 0 ? 1 : 0, b = fc->axis == 2 ? 1 : 2;
+    int swap = fc->e->rate[a] > fc->e->rate[b];
+    *b0 = swap ? b : a, *b1 = swap ? a : b;
+}
+
+static void rp_face_set(rp_fctx *fc, double s)
+{
+    double p[3];
+    int b0, b1;
+    rp_face_axes(fc, &b0, &b1);
+    p[fc->axis] = fc->side, p[b0] = s, p[b1] = 0;
+    rp_line(fc->e, b1, p);
+}
+
+/* |x_s x x_t| at t on the current line of the face. */
+static void rp_face_point(double t, double *out, void *ctx)
+{
+    rp_fctx *fc = ctx;
+    double x[3], J[3][3];
+    int a, b;
+    rp_face_axes(fc, &a, &b);
+    rp_at(fc->e, t, x, J);
+    double n[3] = { J[1][a] * J[2][b] - J[2][a] * J[1][b], J[2][a] * J[0][b] - J[0][a] * J[2][b],
+                    J[0][a] * J[1][b] - J[1][a] * J[0][b] };
+    out[0] = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+static void rp_face_line(double s, double *out, void *ctx)
+{
+    rp_fctx *fc = ctx;
+    rp_fctx inner = *fc;
+    inner.outer = s;
+    inner.ok = 1;
+    rp_face_set(&inner, s);
+    double tol = 0.1 * fc->tol;
+    rp_adapt(rp_face_point, &inner, 1, &tol, out, &inner.ok);
+    fc->ok &= inner.ok;
+}
+
+/* x at face (axis = side) parameters (s, t). */
+static void rp_face_x(rp_eval *e, int axis, int side, double s, double t, double x[3])
+{
+    rp_fctx fc = { e, axis, side, s, 0, 1 };
+    double J[3][3];
+    rp_face_set(&fc, s);
+    rp_at(e, t, x, J);
+}
+
+void sym3_eigen(const double (*a)[3], double *val, double (*vec)[3])
+{
+    double m[3][3], v[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            m[i][j] = a[i][j];
+    for (int sweep = 0; sweep < 100; sweep++) {
+        double off = fabs(m[0][1]) + fabs(m[0][2]) + fabs(m[1][2]);
+        if (off == 0)
+            break;
+        for (int p = 0; p < 2; p++)
+            for (int q = p + 1; q < 3; q++) {
+                if (m[p][q] == 0)
+                    continue;
+                /* The Jacobi rotation that zeroes m[p][q]. */
+                double th = (m[q][q] - m[p][p]) / (2 * m[p][q]);
+                double t = (th >= 0 ? 1 : -1) / (fabs(th) + sqrt(th * th + 1));
+                double c = 1 / sqrt(t * t + 1), s = t * c;
+                for (int k = 0; k < 3; k++) {
+                    double mkp = m[k][p], mkq = m[k][q];
+                    m[k][p] = c * mkp - s * mkq, m[k][q] = s * mkp + c * mkq;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double mpk = m[p][k], mqk = m[q][k];
+                    m[p][k] = c * mpk - s * mqk, m[q][k] = s * mpk + c * mqk;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = c * vkp - s * vkq, v[k][q] = s * vkp + c * vkq;
+                }
+            }
+    }
+    int idx[3] = { 0, 1, 2 };
+    for (int i = 0; i < 3; i++)
+        for (int j = i + 1; j < 3; j++)
+            if (m[idx[j]][idx[j]] < m[idx[i]][idx[i]]) {
+                int t = idx[i];
+                idx[i] = idx[j], idx[j] = t;
+            }
+    for (int i = 0; i < 3; i++) {
+        val[i] = m[idx[i]][idx[i]];
+        for (int k = 0; k < 3; k++)
+            vec[i][k] = v[k][idx[i]];
+    }
+    double c[3] = { vec[0][1] * vec[1][2] - vec[0][2] * vec[1][1], vec[0][2] * vec[1][0] - vec[0][0] * vec[1][2],
+                    vec[0][0] * vec[1][1] - vec[0][1] * vec[1][0] };
+    if (c[0] * vec[2][0] + c[1] * vec[2][1] + c[2] * vec[2][2] < 0)
+        for (int k = 0; k < 3; k++)
+            vec[2][k] = -vec[2][k];
+}
+
+int ref_props(const pde_solution *s, ref_props_out *out)
+{
+    rp_eval e;
+    if (rp_init(&e, s) != 0)
+        return -1;
+    memset(out, 0, sizeof *out);
+    out->converged = 1;
+
+    /* A coarse look first: the scales of the tolerances, x0, and this evaluator against pde_eval_d. */
+    double vol0 = 0, m1[3] = { 0, 0, 0 }, size = 0, lo[3] = { INFINITY, INFINITY, INFINITY };
+    double hi[3] = { -INFINITY, -INFINITY, -INFINITY }, diff = 0;
+    const int n0 = 9;
+    for (int i = 0; i < n0; i++)
+        for (int j = 0; j < n0; j++) {
+            double u = (i + 0.5) / n0, v = (j + 0.37) / n0, p[3] = { u, v, 0 };
+            rp_line(&e, 2, p);
+            for (int k = 0; k <= n0; k++) {
+                double w = (double)k / n0, x[3], J[3][3], y[3], yu[3], yv[3], yw[3];
+                rp_at(&e, w, x, J);
+                pde_eval_d(s, u, v, w, y, yu, yv, yw);
+                for (int c = 0; c < 3; c++) {
+                    lo[c] = fmin(lo[c], x[c]), hi[c] = fmax(hi[c], x[c]);
+                    diff = fmax(diff, fmax(fabs(x[c] - y[c]), fabs(J[c][0] - yu[c])));
+                    diff = fmax(diff, fmax(fabs(J[c][1] - yv[c]), fabs(J[c][2] - yw[c])));
+                    size = fmax(size, fmax(fabs(y[c]), fmax(fabs(yu[c]), fmax(fabs(yv[c]), fabs(yw[c])))));
+                }
+                double a = fabs(rp_det(J));
+                vol0 += a;
+                for (int c = 0; c < 3; c++)
+                    m1[c] += a * x[c];
+            }
+        }
+    out->eval_error = diff / fmax(size, 1e-300);
+    double ext = 0;
+    for (int c = 0; c < 3; c++) {
+        e.x0[c] = vol0 > 0 ? m1[c] / vol0 : 0.5 * (lo[c] + hi[c]);
+        ext = fmax(ext, fmax(hi[c] - e.x0[c], e.x0[c] - lo[c]));
+    }
+    vol0 /= n0 * n0 * (n0 + 1);
+    if (!(vol0 > 0))
+        vol0 = 1;
+    if (!(ext > 0))
+        ext = 1;
+
+    /* Volume and moments: outer u, then v, then the w-lines. */
+    double tol[RP_N], m[RP_N];
+    for (int q = 0; q < RP_N; q++)
+        tol[q] = 1e-12 * vol0 * (q < 2 ? 1 : q < 5 ? ext : ext * ext);
+    /*
+     * The lines cross the fold: along the axis where det J changes sign most often between neighbours
+     * of a 24^3 grid (or, without a fold, the fastest axis). Of the other two the harder is outer, where
+     * the tolerance is looser, and the smoother (often a polynomial) is the middle.
+     */
+    rp_vctx vc = { &e, { 0, 1, 2 }, 0, tol, 1 };
+    double score[3] = { 0, 0, 0 };
+    for (int a = 0; a < 3; a++)
+        score[a] = e.rate[a] * 1e-6;
+    {
+        enum { G = 24 };
+        static double dj[G + 1][G + 1][G + 1];
+        for (int i = 0; i <= G; i++)
+            for (int j = 0; j <= G; j++) {
+                double p[3] = { (i + 0.5) / (G + 1), (j + 0.5) / (G + 1), 0 }, x[3], J[3][3];
+                rp_line(&e, 2, p);
+                for (int k = 0; k <= G; k++) {
+                    rp_at(&e, (k + 0.5) / (G + 1), x, J);
+                    dj[i][j][k] = rp_det(J);
+                }
+            }
+        for (int i = 0; i <= G; i++)
+            for (int j = 0; j <= G; j++)
+                for (int k = 0; k <= G; k++) {
+                    if (i < G && (dj[i][j][k] < 0) != (dj[i + 1][j][k] < 0))
+                        score[0]++;
+                    if (j < G && (dj[i][j][k] < 0) != (dj[i][j + 1][k] < 0))
+                        score[1]++;
+                    if (k < G && (dj[i][j][k] < 0) != (dj[i][j][k + 1] < 0))
+                        score[2]++;
+                }
+    }
+    int in = score[1] > score[2] ? (score[0] > score[1] ? 0 : 1) : (score[0] > score[2] ? 0 : 2);
+    int o1 = in == 0 ? 1 : 0, o2 = in == 2 ? 1 : 2;
+    vc.order[0] = score[o1] >= score[o2] ? o1 : o2;
+    vc.order[1] = vc.order[0] == o1 ? o2 : o1;
+    vc.order[2] = in;
+    rp_adapt(rp_vplane, &vc, RP_N, tol, m, &vc.ok);
+    out->converged &= vc.ok;
+    out->volume = m[0];
+    out->signed_volume = m[1];
+    double d[3] = { m[2] / m[0], m[3] / m[0], m[4] / m[0] };
+    double M2[3][3] = { { m[5], m[8], m[9] }, { m[8], m[6], m[10] }, { m[9], m[10], m[7] } };
+    double C[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            C[i][j] = M2[i][j] - m[0] * d[i] * d[j];
+    double tr = C[0][0] + C[1][1] + C[2][2];
+    for (int i = 0; i < 3; i++) {
+        out->centroid[i] = e.x0[i] + d[i];
+        for (int j = 0; j < 3; j++)
+            out->inertia[i][j] = (i == j ? tr : 0) - C[i][j];
+    }
+    double I[3][3], val[3], vec[3][3];
+    memcpy(I, out->inertia, sizeof I);
+    sym3_eigen(I, val, vec);
+    memcpy(out->principal_moments, val, sizeof val);
+    memcpy(out->principal_axes, vec, sizeof vec);
+
+    /* Faces; a pair that coincides point for point is a seam inside the solid (api/mesh.c). */
+    double area0 = 0;
+    for (int f = 0; f < 6; f++) {
+        rp_fctx fc = { &e, f / 2, f % 2, 0, 0, 1 };
+        for (int i = 0; i < 8; i++)
+            for (int j = 0; j < 8; j++) {
+                double a;
+                fc.outer = (i + 0.5) / 8;
+                rp_face_set(&fc, fc.outer);
+                rp_face_point((j + 0.5) / 8, &a, &fc);
+                area0 += a / 64;
+            }
+    }
+    if (!(area0 > 0))
+        area0 = 1;
+    for (int axis = 0; axis < 3; axis++) {
+        double gap = 0;
+        for (int i = 0; i <= 6; i++)
+            for (int j = 0; j <= 6; j++) {
+                double a[3], b[3];
+                rp_face_x(&e, axis, 0, i / 6.0, j / 6.0, a);
+                rp_face_x(&e, axis, 1, i / 6.0, j / 6.0, b);
+                for (int c = 0; c < 3; c++)
+                    gap = fmax(gap, fabs(a[c] - b[c]));
+            }
+        int seam = gap <= 1e-12 * ext;
+        for (int side = 0; side < 2; side++) {
+            int f = 2 * axis + side;
+            rp_fctx fc = { &e, axis, side, 0, 1e-10 * area0, 1 };
+            rp_adapt(rp_face_line, &fc, 1, &fc.tol, &out->face_area[f], &fc.ok);
+            out->converged &= fc.ok;
+            out->face_seam[f] = seam;
+            if (!seam)
+                out->surface_area += out->face_area[f];
+        }
+    }
+    out->lines = e.lines;
+    rp_free(&e);
+    return 0;
+}

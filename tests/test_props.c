@@ -1,17 +1,22 @@
 /*
  * test_props.c: properties of solids, and the accuracy of every paper
  * figure's solution: boundary conditions against the model's own boundary
- * terms, and the PDE by finite differences of the evaluated solution.
+ * terms, and the PDE by finite differences of the evaluated solution. The
+ * volume, mass properties and surface area against values derived by hand
+ * and against the independent quadrature ref_props() of support.c; the
+ * certified bounds against dense samplings.
  */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cmocka.h>
 
+#include "mesh.h"
 #include "internal.h"   /* to perturb a solution's closed form, which the public API keeps immutable */
 #include "model.h"
 #include "support.h"
@@ -479,6 +484,515 @@ static void certificate_should_show_the_digits_lost_when_a_large_particular_solu
     }
 }
 
+/* ---- mass properties, surface area and certified bounds (issue 9) ---- */
+
+/* det J from the three columns of the Jacobian. */
+static double det_cols(const double a[3], const double b[3], const double c[3])
+{
+    return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
+}
+
+/* Values derived by hand: volume, centroid, inertia about the centroid, surface area. */
+typedef struct {
+    double volume, centroid[3], inertia[3][3], area;
+} hand_props;
+
+/* The principal moments of hand-derived (diagonal) inertia, ascending. */
+static void hand_moments(const hand_props *h, double m[3])
+{
+    double v[3][3];
+    sym3_eigen(h->inertia, m, v);
+}
+
+/* Length scale of a solid for absolute floors: the cube root of its volume. */
+static void expect_hand(const char *who, double volume, double signed_volume, const double centroid[3],
+                        const double inertia[3][3], const double moments[3], double area, const hand_props *h,
+                        double tol)
+{
+    double L = cbrt(h->volume), imax = 0, hm[3];
+    for (int i = 0; i < 3; i++)
+        imax = fmax(imax, fabs(h->inertia[i][i]));
+    hand_moments(h, hm);
+    print_message("%s: volume %.15g, area %.15g\n", who, volume, area);
+    assert_rel(volume, h->volume, tol, 0);
+    assert_rel(signed_volume, h->volume, tol, 0);
+    assert_rel(area, h->area, tol, 0);
+    for (int i = 0; i < 3; i++) {
+        assert_rel(centroid[i], h->centroid[i], tol, L);
+        assert_rel(moments[i], hm[i], tol, imax);
+        for (int j = 0; j < 3; j++)
+            assert_rel(inertia[i][j], h->inertia[i][j], tol, imax);
+    }
+}
+
+/*
+ * fig1a is the cuboid [-1/2, 1/2]^2 x [0, 1] (x = u - 1/2, y = v - 1/2, z = 3w^2 - 2w^3): volume 1, centroid
+ * (0, 0, 1/2), inertia of a unit cube about its centre (1 + 1)/12 = 1/6 on the diagonal, area 6.
+ */
+static const hand_props fig1a_hand = { 1, { 0, 0, 0.5 }, { { 1.0 / 6, 0, 0 }, { 0, 1.0 / 6, 0 }, { 0, 0, 1.0 / 6 } }, 6 };
+
+/*
+ * fig1c: x = (1 + s)(u - 1/2), y = (1 + s)(v - 1/2), z = 2s with s = 3w^2 - 2w^3 (every mode has e = 0, so
+ * each coefficient is the cubic Hermite blend of its data). The slice at height z is a square of side
+ * L = 1 + z/2 about the z axis: a square frustum from side 1 at z = 0 to side 2 at z = 2. With t = L
+ * (dz = 2 dt, t from 1 to 2):
+ *   V = int L^2 dz = 2 int t^2 dt = 14/3;
+ *   z_c = int z L^2 dz / V = 4 int (t^3 - t^2) dt / V = (17/3) / (14/3) = 17/14;
+ *   a slice's int x^2 dA = L^4/12, so I_zz = int L^4/6 dz = (2 * 31/5)/6 = 31/15, and
+ *   I_xx = I_yy = int (L^4/12 + L^2 (z - z_c)^2) dz = 31/30 + (124/15 - V z_c^2) = 31/30 + 97/70 = 254/105;
+ *   off the diagonal 0 by the symmetries x -> -x, y -> -y.
+ * Area: the bases 1 and 4, four trapezoids with parallel sides 1 and 2 and slant height
+ * sqrt(2^2 + (1/2)^2) = sqrt(17)/2: 5 + 4 * 1.5 * sqrt(17)/2 = 5 + 3 sqrt(17).
+ */
+static hand_props fig1c_hand(void)
+{
+    double V = 14.0 / 3, zc = 17.0 / 14, izz = 31.0 / 15, ixx = 31.0 / 30 + (124.0 / 15 - V * zc * zc);
+    assert_rel(ixx, 254.0 / 105, 1e-15, 0);
+    return (hand_props){ V, { 0, 0, zc }, { { ixx, 0, 0 }, { 0, ixx, 0 }, { 0, 0, izz } }, 5 + 3 * sqrt(17.0) };
+}
+
+static pde_solution *preset_solution(const char *name)
+{
+    api_model *am = preset_model(name);
+    pde_solution *sol = NULL;
+    assert_int_equal(pde_solve(api_model_get(am), &sol, NULL), PDE_OK);
+    api_model_free(am);
+    return sol;
+}
+
+/* The reference of every preset, computed once for the tests that compare with it. */
+#define MAX_PRESETS 64
+static ref_props_out ref_cache[MAX_PRESETS];
+static int ref_have[MAX_PRESETS];
+
+static const ref_props_out *preset_ref(size_t i, const pde_solution *sol)
+{
+    assert_true(i < MAX_PRESETS);
+    if (!ref_have[i]) {
+        assert_int_equal(ref_props(sol, &ref_cache[i]), 0);
+        ref_have[i] = 1;
+    }
+    const ref_props_out *r = &ref_cache[i];
+    if (!r->converged || !(r->eval_error < 1e-13))
+        fail_msg("%s: reference did not converge (%d) or its evaluator differs by %.3g", api_preset_at(i)->name,
+                 r->converged, r->eval_error);
+    return r;
+}
+
+static size_t preset_index(const char *name)
+{
+    for (size_t i = 0; i < api_preset_count(); i++)
+        if (strcmp(api_preset_at(i)->name, name) == 0)
+            return i;
+    fail_msg("no preset %s", name);
+    return 0;
+}
+
+static void reference_quadrature_should_match_the_hand_derived_cuboid_and_frustum(void **state)
+{
+    (void)state;
+    const hand_props hands[2] = { fig1a_hand, fig1c_hand() };
+    const char *names[2] = { "fig1a", "fig1c" };
+    for (int k = 0; k < 2; k++) {
+        size_t i = preset_index(names[k]);
+        pde_solution *sol = preset_solution(names[k]);
+        const ref_props_out *r = preset_ref(i, sol);
+        expect_hand(names[k], r->volume, r->signed_volume, r->centroid, r->inertia, r->principal_moments,
+                    r->surface_area, &hands[k], 1e-12);
+        pde_solution_free(sol);
+    }
+}
+
+static void reference_quadrature_should_match_the_160_digit_volume_of_fig4a_which_folds(void **state)
+{
+    (void)state;
+    /* Issue 9: 160-digit values with the sign changes of det J located exactly, and a fine quadrature. */
+    size_t i = preset_index("fig4a");
+    pde_solution *sol = preset_solution("fig4a");
+    const ref_props_out *r = preset_ref(i, sol);
+    print_message("fig4a: volume %.15g, signed %.15g, area %.15g\n", r->volume, r->signed_volume, r->surface_area);
+    assert_rel(r->volume, 8.15592346144647, 1e-13, 0);
+    assert_rel(r->signed_volume, 5.710053196007473, 1e-12, 0);
+    /* The seam v = 0, 1 is left out, the face u = 0 collapses onto the axis. */
+    assert_true(r->face_seam[2] && r->face_seam[3]);
+    assert_true(r->face_area[0] < 1e-12 * r->surface_area);
+    pde_solution_free(sol);
+}
+
+static void props_should_give_the_cuboid_of_figure_1a_its_hand_derived_mass_properties(void **state)
+{
+    (void)state;
+    pde_solution *sol = preset_solution("fig1a");
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    expect_hand("fig1a", p.volume, p.signed_volume, p.centroid, p.inertia, p.principal_moments, p.surface_area,
+                &fig1a_hand, 1e-10);
+    pde_solution_free(sol);
+}
+
+static void props_should_give_the_square_frustum_of_figure_1c_its_hand_derived_mass_properties(void **state)
+{
+    (void)state;
+    hand_props h = fig1c_hand();
+    pde_solution *sol = preset_solution("fig1c");
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    expect_hand("fig1c", p.volume, p.signed_volume, p.centroid, p.inertia, p.principal_moments, p.surface_area, &h,
+                1e-10);
+    /* The principal axis of the least moment (31/15) is z. */
+    assert_rel(fabs(p.principal_axes[0][2]), 1.0, 1e-9, 0);
+    pde_solution_free(sol);
+}
+
+static void props_should_match_the_160_digit_volume_of_fig4a_which_folds(void **state)
+{
+    (void)state;
+    pde_solution *sol = preset_solution("fig4a");
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    assert_true(p.folds);
+    assert_rel(p.volume, 8.15592346144647, 1e-9, 0);
+    assert_rel(p.signed_volume, 5.710053196007473, 1e-9, 0);
+    pde_solution_free(sol);
+}
+
+/* pde_properties against the reference: every integral to 1e-9, inertia relative to its largest entry. */
+static void expect_props_match_reference(const char *name, const pde_props *p, const ref_props_out *r)
+{
+    const double tol = 1e-9;
+    double imax = 0, size = cbrt(r->volume);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            imax = fmax(imax, fabs(r->inertia[i][j]));
+#define EXPECT(what, got, want, floor)                                                                     \
+    do {                                                                                                   \
+        if (!close_rel((got), (want), tol, (floor)))                                                       \
+            fail_msg("%s: %s = %.15g, reference %.15g", name, what, (double)(got), (double)(want));        \
+    } while (0)
+    EXPECT("volume", p->volume, r->volume, 0);
+    EXPECT("signed_volume", p->signed_volume, r->signed_volume, r->volume);
+    EXPECT("surface_area", p->surface_area, r->surface_area, 0);
+    for (int i = 0; i < 3; i++) {
+        EXPECT("centroid", p->centroid[i], r->centroid[i], size);
+        EXPECT("principal_moments", p->principal_moments[i], r->principal_moments[i], imax);
+        for (int j = 0; j < 3; j++)
+            EXPECT("inertia", p->inertia[i][j], r->inertia[i][j], imax);
+    }
+#undef EXPECT
+    assert_int_equal(!!p->folds, r->volume - fabs(r->signed_volume) > 1e-9 * r->volume);
+    /* Principal axes: orthonormal, right-handed, and eigenvectors of the reported inertia. */
+    const double (*a)[3] = p->principal_axes;
+    for (int k = 0; k < 3; k++) {
+        for (int l = 0; l < 3; l++) {
+            double dot = a[k][0] * a[l][0] + a[k][1] * a[l][1] + a[k][2] * a[l][2];
+            if (fabs(dot - (k == l)) > 1e-9)
+                fail_msg("%s: axes %d and %d have dot product %.17g", name, k, l, dot);
+        }
+        for (int i = 0; i < 3; i++) {
+            double Ia = p->inertia[i][0] * a[k][0] + p->inertia[i][1] * a[k][1] + p->inertia[i][2] * a[k][2];
+            if (fabs(Ia - p->principal_moments[k] * a[k][i]) > 1e-9 * imax)
+                fail_msg("%s: inertia * axis %d differs from moment * axis by %.3g", name, k,
+                         fabs(Ia - p->principal_moments[k] * a[k][i]));
+        }
+    }
+    if (det_cols(a[0], a[1], a[2]) < 1 - 1e-9)
+        fail_msg("%s: principal axes not a right-handed frame (det %.17g)", name, det_cols(a[0], a[1], a[2]));
+    for (int k = 0; k < 2; k++)
+        assert_true(p->principal_moments[k] <= p->principal_moments[k + 1]);
+}
+
+/*
+ * The reference costs 0.01-0.5 s a preset under the sanitisers, but fig3b, fig3c and fig3d (sin(30 pi v),
+ * and n_z = 10 or 6 folding the z faces) take 15, 19 and 31 s there: they are left out under the
+ * sanitisers unless PDESOLID_SLOW_TESTS=1 (they take about a fifth of that without).
+ */
+static int slow_reference(const char *name)
+{
+#if defined(__SANITIZE_ADDRESS__)
+    const char *all = getenv("PDESOLID_SLOW_TESTS");
+    if (all && strcmp(all, "1") == 0)
+        return 0;
+    return strcmp(name, "fig3b") == 0 || strcmp(name, "fig3c") == 0 || strcmp(name, "fig3d") == 0;
+#else
+    (void)name;
+    return 0;
+#endif
+}
+
+static void props_should_match_the_reference_quadrature_on_every_preset(void **state)
+{
+    (void)state;
+    double t0 = mono_now();
+    for (size_t i = 0; i < api_preset_count(); i++) {
+        const char *name = api_preset_at(i)->name;
+        if (slow_reference(name)) {
+            print_message("%s: left out under the sanitisers (PDESOLID_SLOW_TESTS=1 to include it)\n", name);
+            continue;
+        }
+        pde_solution *sol = preset_solution(name);
+        const ref_props_out *r = preset_ref(i, sol);
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        expect_props_match_reference(name, &p, r);
+        pde_solution_free(sol);
+    }
+    print_message("reference quadrature of %zu presets: %.2f s\n", api_preset_count(), mono_now() - t0);
+}
+
+/* The area of a mesh's triangles. */
+static double mesh_area(const api_mesh *m)
+{
+    double a = 0;
+    for (size_t t = 0; t < m->ntris; t++) {
+        const float *p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = &m->pos[3 * m->tri[3 * t + k]];
+        double e[2][3];
+        for (int c = 0; c < 3; c++)
+            e[0][c] = (double)p[1][c] - p[0][c], e[1][c] = (double)p[2][c] - p[0][c];
+        double n[3] = { e[0][1] * e[1][2] - e[0][2] * e[1][1], e[0][2] * e[1][0] - e[0][0] * e[1][2],
+                        e[0][0] * e[1][1] - e[0][1] * e[1][0] };
+        a += 0.5 * sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    }
+    return a;
+}
+
+static void reference_surface_area_should_agree_with_the_mesh_of_every_preset(void **state)
+{
+    (void)state;
+    /* The mesh's rule for the skin (collapsed faces vanish, coincident faces cancel) against the
+     * reference's: two resolutions, Richardson-extrapolated (the error of flat triangles goes as h^2). */
+    double worst = 0;
+    for (size_t i = 0; i < api_preset_count(); i++) {
+        const char *name = api_preset_at(i)->name;
+        if (slow_reference(name))
+            continue;
+        pde_solution *sol = preset_solution(name);
+        const ref_props_out *r = preset_ref(i, sol);
+        double area[2];
+        for (int k = 0; k < 2; k++) {
+            const unsigned res[3] = { 40u << k, 160u << k, 40u << k };
+            api_mesh m;
+            api_error err;
+            assert_int_equal(api_mesh_build(sol, res, NULL, &m, &err), 0);
+            area[k] = mesh_area(&m);
+            api_mesh_free(&m);
+        }
+        double extrapolated = (4 * area[1] - area[0]) / 3;
+        worst = fmax(worst, fabs(extrapolated - r->surface_area) / r->surface_area);
+        if (!close_rel(extrapolated, r->surface_area, 1e-3, 0))   /* a seam counted would add ~10% */
+            fail_msg("%s: mesh area %.9g (%.9g, %.9g at two resolutions), reference %.12g", name, extrapolated,
+                     area[0], area[1], r->surface_area);
+        pde_solution_free(sol);
+    }
+    print_message("largest relative difference of mesh and reference areas: %.3g\n", worst);
+}
+
+/* x, y, z (what 0..2) or det J (3) at p. */
+static double sample_at(const pde_solution *sol, int what, const double p[3])
+{
+    double x[3], xu[3], xv[3], xw[3];
+    pde_eval_d(sol, p[0], p[1], p[2], x, xu, xv, xw);
+    return what < 3 ? x[what] : det_cols(xu, xv, xw);
+}
+
+/* A compass search from p for the least of sign * (what) in the unit cube; returns the value reached. */
+static double compass(const pde_solution *sol, int what, double sign, const double from[3], double value)
+{
+    double p[3] = { from[0], from[1], from[2] }, best = sign * value;
+    for (double step = 0.02; step > 1e-12;) {
+        int moved = 0;
+        for (int a = 0; a < 3; a++)
+            for (int d = -1; d <= 1; d += 2) {
+                double q[3] = { p[0], p[1], p[2] };
+                q[a] = fmin(1, fmax(0, q[a] + d * step));
+                double f = sign * sample_at(sol, what, q);
+                if (f < best)
+                    best = f, p[0] = q[0], p[1] = q[1], p[2] = q[2], moved = 1;
+            }
+        if (!moved)
+            step *= 0.5;
+    }
+    return sign * best;
+}
+
+static void note_extremes(const double q[4], const double at[3], double lo[4], double hi[4], double lo_at[4][3],
+                          double hi_at[4][3])
+{
+    for (int c = 0; c < 4; c++) {
+        if (q[c] < lo[c])
+            lo[c] = q[c], memcpy(lo_at[c], at, 3 * sizeof *at);
+        if (q[c] > hi[c])
+            hi[c] = q[c], memcpy(hi_at[c], at, 3 * sizeof *at);
+    }
+}
+
+/*
+ * Bounds against a dense sampling: a grid of nu x nv x nw points (u and v uniform, w at Chebyshev-Lobatto
+ * points, which crowd towards the boundary layers of w = 0 and 1), each face and edge included, plus
+ * nrand random points, and each extreme among them polished by a compass search. Every sampled x and
+ * det J must lie within the reported bounds, exactly: they are certified. And each bound must be reached
+ * within its gap, up to the sampling's reach: twice the largest change between neighbouring samples along
+ * each axis, summed over the axes.
+ */
+static void expect_bounds_contain_samples(const char *name, const pde_solution *sol, size_t nu, size_t nv, size_t nw,
+                                          size_t nrand)
+{
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    if (!(p.bbox_gap >= 0 && p.detj_gap >= 0))
+        fail_msg("%s: gaps %.3g %.3g", name, p.bbox_gap, p.detj_gap);
+    double *prev = malloc(4 * nu * nv * sizeof *prev), *cur = malloc(4 * nu * nv * sizeof *cur);
+    assert_non_null(prev);
+    assert_non_null(cur);
+    double lo[4] = { INFINITY, INFINITY, INFINITY, INFINITY }, hi[4] = { -INFINITY, -INFINITY, -INFINITY, -INFINITY };
+    double lo_at[4][3] = { { 0 } }, hi_at[4][3] = { { 0 } };
+    double step[3][4] = { { 0 } };   /* largest change between neighbours, per axis and quantity */
+    for (size_t k = 0; k < nw; k++) {
+        double w = 0.5 * (1 - cos(M_PI * (double)k / (double)(nw - 1)));
+        for (size_t j = 0; j < nv; j++)
+            for (size_t i = 0; i < nu; i++) {
+                double u = (double)i / (double)(nu - 1), v = (double)j / (double)(nv - 1);
+                double x[3], xu[3], xv[3], xw[3];
+                pde_eval_d(sol, u, v, w, x, xu, xv, xw);
+                double *q = &cur[4 * (j * nu + i)];
+                q[0] = x[0], q[1] = x[1], q[2] = x[2], q[3] = det_cols(xu, xv, xw);
+                const double at[3] = { u, v, w };
+                note_extremes(q, at, lo, hi, lo_at, hi_at);
+                for (int c = 0; c < 4; c++) {
+                    if (i > 0)
+                        step[0][c] = fmax(step[0][c], fabs(q[c] - q[c - 4]));
+                    if (j > 0)
+                        step[1][c] = fmax(step[1][c], fabs(q[c] - q[c - 4 * (long)nu]));
+                    if (k > 0)
+                        step[2][c] = fmax(step[2][c], fabs(q[c] - prev[4 * (j * nu + i) + c]));
+                }
+            }
+        double *t = prev;
+        prev = cur, cur = t;
+    }
+    free(prev);
+    free(cur);
+    uint64_t seed = 0x9e3779b97f4a7c15ull;
+    for (size_t n = 0; n < nrand; n++) {
+        double r[3];
+        for (int a = 0; a < 3; a++) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            r[a] = (double)(seed >> 11) / 9007199254740992.0;
+        }
+        double x[3], xu[3], xv[3], xw[3];
+        pde_eval_d(sol, r[0], r[1], r[2], x, xu, xv, xw);
+        const double q[4] = { x[0], x[1], x[2], det_cols(xu, xv, xw) };
+        note_extremes(q, r, lo, hi, lo_at, hi_at);
+    }
+    /* Each sampled extreme polished by a compass search: the solid's own extremes, nearly. */
+    for (int c = 0; c < 4; c++) {
+        double l = sample_at(sol, c, lo_at[c]), h = sample_at(sol, c, hi_at[c]);
+        lo[c] = fmin(lo[c], compass(sol, c, 1, lo_at[c], l));
+        hi[c] = fmax(hi[c], compass(sol, c, -1, hi_at[c], h));
+    }
+    const double blo[4] = { p.bbox_min[0], p.bbox_min[1], p.bbox_min[2], p.detj_min };
+    const double bhi[4] = { p.bbox_max[0], p.bbox_max[1], p.bbox_max[2], p.detj_max };
+    static const char *const what[4] = { "x", "y", "z", "det J" };
+    for (int c = 0; c < 4; c++) {
+        if (!(blo[c] <= lo[c] && hi[c] <= bhi[c]))
+            fail_msg("%s: %s sampled in [%.17g, %.17g], outside the bounds [%.17g, %.17g]", name, what[c], lo[c],
+                     hi[c], blo[c], bhi[c]);
+        double gap = c < 3 ? p.bbox_gap : p.detj_gap;
+        double reach = 2 * (step[0][c] + step[1][c] + step[2][c]);
+        if (lo[c] - blo[c] > gap + reach || bhi[c] - hi[c] > gap + reach)
+            fail_msg("%s: %s bounds [%.17g, %.17g] are farther than the gap %.3g and the sampling's reach %.3g "
+                     "from the samples [%.17g, %.17g]", name, what[c], blo[c], bhi[c], gap, reach, lo[c], hi[c]);
+    }
+    /* det J where the bounds say it is within the gap of its extremes. */
+    double scale = fmax(fabs(p.detj_min), fabs(p.detj_max));
+    const double *at[2] = { p.detj_min_at, p.detj_max_at };
+    for (int e = 0; e < 2; e++) {
+        for (int a = 0; a < 3; a++)
+            assert_true(at[e][a] >= 0 && at[e][a] <= 1);
+        double xu[3], xv[3], xw[3];
+        pde_eval_d(sol, at[e][0], at[e][1], at[e][2], NULL, xu, xv, xw);
+        double dj = det_cols(xu, xv, xw);
+        double off = e == 0 ? dj - p.detj_min : p.detj_max - dj;
+        if (!(off >= -1e-13 * scale && off <= p.detj_gap + 1e-13 * scale))
+            fail_msg("%s: det J at detj_%s_at is %.17g, %.3g from the bound (gap %.3g)", name, e ? "max" : "min", dj,
+                     off, p.detj_gap);
+    }
+}
+
+/* Fewer samples under the sanitisers, which make pde_eval_d about 3 times slower: 10^6 points for each of the
+ * 35 presets would take 12 s there. The stress models keep their 10^6. */
+#if defined(__SANITIZE_ADDRESS__)
+#define PRESET_GRID 60
+#define PRESET_RANDOM 30000
+#else
+#define PRESET_GRID 100
+#define PRESET_RANDOM 100000
+#endif
+
+static void bounds_should_contain_a_dense_sampling_of_every_preset(void **state)
+{
+    (void)state;
+    double t0 = mono_now();
+    for (size_t i = 0; i < api_preset_count(); i++) {
+        const char *name = api_preset_at(i)->name;
+        pde_solution *sol = preset_solution(name);
+        expect_bounds_contain_samples(name, sol, PRESET_GRID, PRESET_GRID, PRESET_GRID, PRESET_RANDOM);
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        /* Issue 9: refined until the gap is below 1e-9 of the solid's size. */
+        double size = 0;
+        for (int c = 0; c < 3; c++)
+            size = fmax(size, p.bbox_max[c] - p.bbox_min[c]);
+        if (!(p.bbox_gap <= 1e-9 * size))
+            fail_msg("%s: bbox_gap %.3g for a solid of size %.3g", name, p.bbox_gap, size);
+        pde_solution_free(sol);
+    }
+    print_message("bounds of %zu presets against their samples: %.2f s\n", api_preset_count(), mono_now() - t0);
+}
+
+static void bounds_should_contain_a_dense_sampling_of_stress_models(void **state)
+{
+    (void)state;
+    /* x = u, y = v, z = w (cubic data), plus one hard term on x: */
+    pde_bterm by = { F_pow(0), F_pow(1), 0, 0, 1, 0 }, bz = { F_pow(0), F_pow(0), 0, 1, 1, 1 };
+    pde_bterm bx[2] = { { F_pow(1), F_pow(0), 1, 0, 1, 0 }, { F_pow(0), F_pow(0), 0, 0, 0, 0 } };
+    pde_fterm fx = { 0, F_pow(0), F_pow(0), F_pow(0) };
+    static const pde_fterm none = { 0, { PDE_POW, 0 }, { PDE_POW, 0 }, { PDE_POW, 0 } };
+    static const pde_bterm nob = { { PDE_POW, 0 }, { PDE_POW, 0 }, 0, 0, 0, 0 };
+    struct {
+        const char *name;
+        double a, b, c;
+        pde_bterm extra;
+        int forced;
+        pde_fterm force;
+        size_t nu, nv, nw;
+    } models[3] = {
+        /* sin(200 pi v) on the boundary with small c: layers of width about 4e-4 at w = 0 and 1. */
+        { "sin(200 pi v), c = -1e-3", 1, 1, -1e-3, { F_pow(1), F_sin(200), 0.05, 0.5, -0.05, 1 }, 0, none, 10, 4000, 25 },
+        /* A forced mode with no boundary term: x is 0 on w = 0, 1, and its extremes are inside. */
+        { "forced only", 1, 1, -1, nob, 1, { 40, F_sin(1), F_sin(3), F_sin(5) }, 100, 100, 100 },
+        /* a/c = -1e12: e = pi^4 1e12, layers of width about 3e-4. */
+        { "a/c = -1e12", 1, 1, -1e-12, { F_sin(1), F_pow(1), 0.3, -2, 0.2, 3 }, 0, none, 100, 25, 400 },
+    };
+    for (size_t k = 0; k < sizeof models / sizeof models[0]; k++) {
+        bx[1] = models[k].extra;
+        fx = models[k].force;
+        pde_model m = { { { models[k].a, models[k].b, models[k].c, bx, models[k].forced ? 1 : 2, &fx, models[k].forced },
+                          { 1, 1, -1, &by, 1, NULL, 0 },
+                          { 1, 1, -1, &bz, 1, NULL, 0 } } };
+        pde_solution *sol = NULL;
+        pde_diag d;
+        if (pde_solve(&m, &sol, &d) != PDE_OK)
+            fail_msg("%s: %s", models[k].name, d.message);
+        double t0 = mono_now();
+        expect_bounds_contain_samples(models[k].name, sol, models[k].nu, models[k].nv, models[k].nw, 100000);
+        print_message("%s: %.2f s\n", models[k].name, mono_now() - t0);
+        pde_solution_free(sol);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -493,6 +1007,15 @@ int main(void)
         cmocka_unit_test(certificate_should_catch_a_closed_form_coefficient_perturbed_by_1e_6),
         cmocka_unit_test(certificate_should_grow_like_one_over_the_distance_to_a_clamped_eigenvalue),
         cmocka_unit_test(certificate_should_show_the_digits_lost_when_a_large_particular_solution_cancels),
+        cmocka_unit_test(reference_quadrature_should_match_the_hand_derived_cuboid_and_frustum),
+        cmocka_unit_test(reference_quadrature_should_match_the_160_digit_volume_of_fig4a_which_folds),
+        cmocka_unit_test(reference_surface_area_should_agree_with_the_mesh_of_every_preset),
+        cmocka_unit_test(props_should_give_the_cuboid_of_figure_1a_its_hand_derived_mass_properties),
+        cmocka_unit_test(props_should_give_the_square_frustum_of_figure_1c_its_hand_derived_mass_properties),
+        cmocka_unit_test(props_should_match_the_160_digit_volume_of_fig4a_which_folds),
+        cmocka_unit_test(props_should_match_the_reference_quadrature_on_every_preset),
+        cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_every_preset),
+        cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_stress_models),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
