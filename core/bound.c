@@ -157,6 +157,18 @@ void obj_model_at(const pde_solution *s, int what, const pbox *b, obj_model *m)
     }
 }
 
+double obj_magnitude(const pde_solution *s, int what)
+{
+    const pbox cube = { { 0, 0, 0 }, { 1, 1, 1 } };
+    xjet mx;
+    xjet_fill(s, &cube, 1, 1, &mx);
+    if (what < 3)
+        return mx.d[what][0];
+    double t[MI3];
+    detj_series(&mx, 0, 1, t);
+    return t[0];
+}
+
 /* The half-widths of the partial derivatives' ranges over a box of radii r around the centre. */
 static void grad_spread(const obj_model *m, const double r[3], double spread[3])
 {

@@ -41,6 +41,10 @@ void obj_model_at(const pde_solution *s, int what, const pbox *b, obj_model *m);
  */
 double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *val, double at[3]);
 
+/* A bound of the sum of the magnitudes of the objective's terms over the cube: the scale of the
+ * rounding error of its evaluation, which a certified bound must allow for. */
+double obj_magnitude(const pde_solution *s, int what);
+
 /* The axis along which b's half-width contributes most to its bound, or -1 for a point. */
 int obj_split_axis(const pde_solution *s, int what, const pbox *b);
 

@@ -491,7 +491,9 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         bb_result b;
         if ((st = bb_minimise(s, what, sign, at[o], tol, o < 6 ? PDE_PROPS_BOXES : PDE_PROPS_BOXES_J, cancel, &b)) != PDE_OK)
             return st;
-        const double bound = sign * b.lower, gap = b.best - b.lower;
+        /* The bound holds for the exact closed form; evaluated values may differ by their rounding. */
+        const double pad = 64.0 * DBL_EPSILON * obj_magnitude(s, what);
+        const double bound = sign * (b.lower - pad), gap = b.best - b.lower + pad;
         best[o] = sign * b.best;
         if (o < 6) {
             (o & 1 ? r.bbox_max : r.bbox_min)[what] = bound;
@@ -507,11 +509,13 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     double tol = 1e-9 * jscale;
     r.folds = best[6] < -tol && best[7] > tol;
 
-    double x0[3];
-    for (int c = 0; c < 3; c++)
+    double x0[3], vol_scale = 1.0;   /* the box's volume, the scale of the solid's */
+    for (int c = 0; c < 3; c++) {
         x0[c] = 0.5 * (r.bbox_min[c] + r.bbox_max[c]);
+        vol_scale *= fmax(r.bbox_max[c] - r.bbox_min[c], 1e-3 * size);
+    }
     quad_result q;
-    if ((st = quad_solid(s, x0, jscale, cancel, &q)) != PDE_OK ||
+    if ((st = quad_solid(s, x0, jscale, vol_scale, cancel, &q)) != PDE_OK ||
         (st = quad_area(s, size, cancel, &r.surface_area)) != PDE_OK)
         return st;
     mass_properties(&q, x0, &r);

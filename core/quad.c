@@ -36,13 +36,16 @@
 #define MAX_PANELS 32
 #define PANEL_PHASE 8.0       /* radians of the integrand per panel */
 #define MAX_NODES (1u << 21)  /* nodes of the rules in all: bounded work */
-#define POLL_WORK 65536       /* factor evaluations between polls of the caller's stop() */
+#define MAX_FACE_NODES (1u << 16)   /* points of one face's area rule, at most */
+#define POLL_WORK 65536
+#define OUTER_DEPTH 4         /* halvings of a panel across its lines, at most */       /* factor evaluations between polls of the caller's stop() */
 
 typedef struct {
     const pde_solution *s;
     const pde_cancel *cancel;
     double x0[3], jtol;
     double f[3];                 /* the integrand's frequencies (at least 1) */
+    double vscale;               /* the solid's volume, roughly: for refinement's tolerance */
     double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];   /* n-point rules on [0, 1] */
     int n[3];                    /* the current panel's points per axis */
     /* The current line: along axis k, per component and mode, the fixed factors' product P and
@@ -321,6 +324,70 @@ static int line_axis(qctx *q, const pbox *b)
     return k;
 }
 
+/* The lines along axis k through the rule's nodes on the other two axes of b, into acc. */
+static void panel_lines(qctx *q, const pbox *b, int k, int definite, double acc[Q_N])
+{
+    double saved[Q_N];
+    memcpy(saved, q->r.acc, sizeof saved);
+    memset(q->r.acc, 0, sizeof q->r.acc);
+    int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
+    const int ni = q->n[i], nj = q->n[j];
+    const double hi = b->hi[i] - b->lo[i], hj = b->hi[j] - b->lo[j];
+    double p[3];
+    for (int a = 0; a < ni && !poll(q); a++)
+        for (int c = 0; c < nj; c++) {
+            p[i] = b->lo[i] + hi * q->gx[ni][a];
+            p[j] = b->lo[j] + hj * q->gx[nj][c];
+            line_set(q, k, p);
+            double wt = hi * q->gw[ni][a] * hj * q->gw[nj][c];
+            if (definite)
+                line_gauss(q, b->lo[k], b->hi[k], wt);
+            else
+                line_integrate(q, b->lo[k], b->hi[k], wt);
+        }
+    memcpy(acc, q->r.acc, sizeof q->r.acc);
+    memcpy(q->r.acc, saved, sizeof saved);
+}
+
+/*
+ * Where det J may change sign, the line integrals are not smooth across lines that touch its zero
+ * set tangentially: the outer rule is checked against the same rule on the four quarters of the
+ * panel (across the lines), and the quarters are refined the same way where the two differ by more
+ * than 1e-12 of the solid's volume, down to OUTER_DEPTH halvings.
+ */
+static void panel_refine(qctx *q, const pbox *b, int k, const double coarse[Q_N], int depth, double out[Q_N])
+{
+    int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
+    pbox sub[4];
+    double part[4][Q_N], fine[Q_N] = { 0 };
+    for (int s = 0; s < 4; s++) {
+        sub[s] = *b;
+        double mi = 0.5 * (b->lo[i] + b->hi[i]), mj = 0.5 * (b->lo[j] + b->hi[j]);
+        if (s & 1)
+            sub[s].lo[i] = mi;
+        else
+            sub[s].hi[i] = mi;
+        if (s & 2)
+            sub[s].lo[j] = mj;
+        else
+            sub[s].hi[j] = mj;
+        panel_lines(q, &sub[s], k, 0, part[s]);
+        for (int e = 0; e < Q_N; e++)
+            fine[e] += part[s][e];
+    }
+    if (depth + 1 >= OUTER_DEPTH || q->stopped || fabs(fine[Q_VOL] - coarse[Q_VOL]) <= 1e-12 * q->vscale) {
+        memcpy(out, fine, sizeof fine);
+        return;
+    }
+    memset(out, 0, Q_N * sizeof *out);
+    for (int s = 0; s < 4; s++) {
+        double o[Q_N];
+        panel_refine(q, &sub[s], k, part[s], depth + 1, o);
+        for (int e = 0; e < Q_N; e++)
+            out[e] += o[e];
+    }
+}
+
 static void panel(qctx *q, const pbox *b)
 {
     const int definite = sign_definite(q, b);
@@ -333,23 +400,15 @@ static void panel(qctx *q, const pbox *b)
         k = line_axis(q, b);
         q->r.lined++;
     }
-    int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
-    const int ni = q->n[i], nj = q->n[j];
-    const double hi = b->hi[i] - b->lo[i], hj = b->hi[j] - b->lo[j];
-    double p[3];
-    for (int a = 0; a < ni; a++)
-        for (int c = 0; c < nj; c++) {
-            p[i] = b->lo[i] + hi * q->gx[ni][a];
-            p[j] = b->lo[j] + hj * q->gx[nj][c];
-            if (poll(q))
-                return;
-            line_set(q, k, p);
-            double wt = hi * q->gw[ni][a] * hj * q->gw[nj][c];
-            if (definite)
-                line_gauss(q, b->lo[k], b->hi[k], wt);
-            else
-                line_integrate(q, b->lo[k], b->hi[k], wt);
-        }
+    double acc[Q_N];
+    panel_lines(q, b, k, definite, acc);
+    if (!definite) {
+        double refined[Q_N];
+        panel_refine(q, b, k, acc, 0, refined);
+        memcpy(acc, refined, sizeof acc);
+    }
+    for (int e = 0; e < Q_N; e++)
+        q->r.acc[e] += acc[e];
 }
 
 /* The fastest change along each axis of a product of `factors` of the solution's factors, in
@@ -414,8 +473,8 @@ void quad_panels(const pde_solution *s, int np[3], int n[3])
     panels_for(s, 5.0, np, n);   /* the second moments times det J: five factors */
 }
 
-pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, const pde_cancel *cancel,
-                      quad_result *out)
+pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale,
+                      const pde_cancel *cancel, quad_result *out)
 {
     size_t maxm = 1;
     for (int c = 0; c < 3; c++)
@@ -431,6 +490,7 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     q->cancel = cancel;
     memcpy(q->x0, x0, sizeof q->x0);
     q->jtol = 1e-13 * jscale;
+    q->vscale = vscale;
     q->maxm = maxm;
     q->modes = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes + 1;
     q->P = buf, q->Pi = buf + 3 * maxm, q->Pj = buf + 6 * maxm;
@@ -624,9 +684,11 @@ static pde_status face_area(const pde_solution *s, int axis, int side, const int
 
 /*
  * Each face's area with panels sized to the element's frequencies (counted, like the solid's
- * integrals, as five factors'). Faces that fold have cuspidal edges where the element vanishes;
- * lines cross them at located roots. Isolated zeros of the element (cone points) are not located:
- * there the rule converges slowly, to about 1e-5 relative on the folded figures (MATH.md).
+ * integrals, as five factors'), then with twice the panels on each axis, until two results agree
+ * to 1e-12 or the face has MAX_FACE_NODES points. Faces that fold have cuspidal edges where the
+ * element vanishes; lines cross them at located roots. Where the element vanishes otherwise
+ * (isolated points), the rule converges slowly: the folded figures stop at the node cap, about
+ * 1e-6 to 1e-8 from the converged value (docs/MATH.md).
  */
 pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area)
 {
@@ -641,11 +703,18 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
             if (k != axis)
                 o[m++] = k;
         for (int side = 0; side < 2; side++) {
-            const int fp[2] = { np[o[0]], np[o[1]] }, fn[2] = { n[o[0]], n[o[1]] };
-            double cur;
-            pde_status st = face_area(s, axis, side, fp, fn, cancel, &cur);
-            if (st != PDE_OK)
-                return st;
+            int fp[2] = { np[o[0]], np[o[1]] }, fn[2] = { n[o[0]], n[o[1]] };
+            double prev = -1.0, cur;
+            for (;;) {
+                pde_status st = face_area(s, axis, side, fp, fn, cancel, &cur);
+                if (st != PDE_OK)
+                    return st;
+                if (fabs(cur - prev) <= 1e-12 * fmax(fabs(cur), fabs(prev)) ||
+                    4.0 * fp[0] * fn[0] * fp[1] * fn[1] > MAX_FACE_NODES)
+                    break;
+                prev = cur;
+                fp[0] *= 2, fp[1] *= 2;
+            }
             total += cur;
         }
     }

@@ -17,9 +17,10 @@ typedef struct {
     size_t lined;       /* panels integrated along lines, where det J may change sign */
 } quad_result;
 
-/* jscale: the size of det J over the solid, for what counts as zero. */
-pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, const pde_cancel *cancel,
-                      quad_result *out);
+/* jscale: the size of det J over the solid, for what counts as zero; vscale: the size of the
+ * volume (jscale will do), for the refinement's tolerance. */
+pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale,
+                      const pde_cancel *cancel, quad_result *out);
 
 /* The area of the skin; size: the solid's extent, for deciding that two faces coincide. */
 pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area);
