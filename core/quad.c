@@ -25,6 +25,7 @@
  * point costs one factor per mode (a polynomial, for u): lines are cheap.
  */
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,8 +38,9 @@
 #define PANEL_PHASE 8.0       /* radians of the integrand per panel */
 #define MAX_NODES (1u << 21)  /* nodes of the rules in all: bounded work */
 #define MAX_FACE_NODES (1u << 16)   /* points of one face's area rule, at most */
-#define POLL_WORK 65536
-#define OUTER_DEPTH 4         /* halvings of a panel across its lines, at most */       /* factor evaluations between polls of the caller's stop() */
+#define POLL_WORK 65536       /* factor evaluations between polls of the caller's stop() */
+#define OUTER_DEPTH 2         /* halvings of a panel in its refinement, at most */
+#define REFINE_PANELS 96      /* panels refined, at most: fig. 4's 24 to 72, not fig. 3's 1024 */
 
 typedef struct {
     const pde_solution *s;
@@ -55,6 +57,7 @@ typedef struct {
     size_t maxm;
     quad_result r;
     size_t modes, next_poll;
+    int cuts_min, cuts_max;      /* the fewest and most roots of the lines since they were reset */
     int stopped;
 } qctx;
 
@@ -252,6 +255,8 @@ static void line_integrate(qctx *q, double a, double b, double wt)
         if (fabs(f[i]) > q->jtol || fabs(f[last]) <= q->jtol)
             last = i;
     }
+    q->cuts_min = ncut < q->cuts_min ? ncut : q->cuts_min;
+    q->cuts_max = ncut > q->cuts_max ? ncut : q->cuts_max;
     if (!ncut) {
         for (int i = 0; i < n; i++)
             add_value(q, x[i + 1], f[i + 1], wt * (b - a) * q->gw[n][i]);
@@ -330,6 +335,7 @@ static void panel_lines(qctx *q, const pbox *b, int k, int definite, double acc[
     double saved[Q_N];
     memcpy(saved, q->r.acc, sizeof saved);
     memset(q->r.acc, 0, sizeof q->r.acc);
+    q->cuts_min = INT_MAX, q->cuts_max = 0;
     int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
     const int ni = q->n[i], nj = q->n[j];
     const double hi = b->hi[i] - b->lo[i], hj = b->hi[j] - b->lo[j];
@@ -349,43 +355,61 @@ static void panel_lines(qctx *q, const pbox *b, int k, int definite, double acc[
     memcpy(q->r.acc, saved, sizeof saved);
 }
 
+/* The fewest Gauss-Legendre points whose error on exp(i f t) over a panel of phase phi = f h is
+ * below 1e-14: (e phi / 8n)^(2n), the rule's asymptotic error. */
+static int rule_points(double phi);
+
 /*
  * Where det J may change sign, the line integrals are not smooth across lines that touch its zero
- * set tangentially: the outer rule is checked against the same rule on the four quarters of the
- * panel (across the lines), and the quarters are refined the same way where the two differ by more
- * than 1e-12 of the solid's volume, down to OUTER_DEPTH halvings.
+ * set tangentially. So the box's result is checked against the sum over its eight octants, each
+ * with lines along its own best axis (in a small box the zero set is nearly flat, and the lines
+ * cross it rather than touch it) and a rule sized to it; octants are refined the same way where
+ * the two differ by more than 1e-12 of the solid's volume, down to OUTER_DEPTH halvings. Lines
+ * that all cross the zero set the same number of times do not show that nothing was missed: a
+ * narrow lobe of det J near tangency can lie between samples (fig. 4b), so every such panel is
+ * refined, within REFINE_PANELS.
  */
-static void panel_refine(qctx *q, const pbox *b, int k, const double coarse[Q_N], int depth, double out[Q_N])
+static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int depth, double out[Q_N])
 {
-    int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
-    pbox sub[4];
-    double part[4][Q_N], fine[Q_N] = { 0 };
-    for (int s = 0; s < 4; s++) {
+    const int saved_n[3] = { q->n[0], q->n[1], q->n[2] };
+    pbox sub[8];
+    int definite[8], axis[8], nsub[8][3], smooth[8];
+    double part[8][Q_N], fine[Q_N] = { 0 };
+    for (int s = 0; s < 8; s++) {
         sub[s] = *b;
-        double mi = 0.5 * (b->lo[i] + b->hi[i]), mj = 0.5 * (b->lo[j] + b->hi[j]);
-        if (s & 1)
-            sub[s].lo[i] = mi;
-        else
-            sub[s].hi[i] = mi;
-        if (s & 2)
-            sub[s].lo[j] = mj;
-        else
-            sub[s].hi[j] = mj;
-        panel_lines(q, &sub[s], k, 0, part[s]);
+        for (int a = 0; a < 3; a++) {
+            double mid = 0.5 * (b->lo[a] + b->hi[a]);
+            if (s >> a & 1)
+                sub[s].lo[a] = mid;
+            else
+                sub[s].hi[a] = mid;
+            nsub[s][a] = q->n[a] = rule_points(q->f[a] * (sub[s].hi[a] - sub[s].lo[a]));
+        }
+        definite[s] = sign_definite(q, &sub[s]);
+        axis[s] = definite[s] ? 0 : line_axis(q, &sub[s]);
+        panel_lines(q, &sub[s], axis[s], definite[s], part[s]);
+        smooth[s] = definite[s];
         for (int e = 0; e < Q_N; e++)
             fine[e] += part[s][e];
     }
     if (depth + 1 >= OUTER_DEPTH || q->stopped || fabs(fine[Q_VOL] - coarse[Q_VOL]) <= 1e-12 * q->vscale) {
         memcpy(out, fine, sizeof fine);
+        memcpy(q->n, saved_n, sizeof saved_n);
         return;
     }
     memset(out, 0, Q_N * sizeof *out);
-    for (int s = 0; s < 4; s++) {
+    for (int s = 0; s < 8; s++) {
         double o[Q_N];
-        panel_refine(q, &sub[s], k, part[s], depth + 1, o);
+        if (smooth[s])
+            memcpy(o, part[s], sizeof o);
+        else {
+            memcpy(q->n, nsub[s], sizeof q->n);
+            box_refine(q, &sub[s], part[s], depth + 1, o);
+        }
         for (int e = 0; e < Q_N; e++)
             out[e] += o[e];
     }
+    memcpy(q->n, saved_n, sizeof saved_n);
 }
 
 static void panel(qctx *q, const pbox *b)
@@ -402,9 +426,10 @@ static void panel(qctx *q, const pbox *b)
     }
     double acc[Q_N];
     panel_lines(q, b, k, definite, acc);
-    if (!definite) {
+    /* Refined within a budget: the first REFINE_PANELS panels where det J may change sign. */
+    if (!definite && q->r.lined <= REFINE_PANELS) {
         double refined[Q_N];
-        panel_refine(q, b, k, acc, 0, refined);
+        box_refine(q, b, acc, 0, refined);
         memcpy(acc, refined, sizeof acc);
     }
     for (int e = 0; e < Q_N; e++)
@@ -435,8 +460,6 @@ static void frequencies(const pde_solution *s, double factors, double f[3])
         f[a] = fmax(factors * f[a], 1.0);
 }
 
-/* The fewest Gauss-Legendre points whose error on exp(i f t) over a panel of phase phi = f h is
- * below 1e-14: (e phi / 8n)^(2n), the rule's asymptotic error. */
 static int rule_points(double phi)
 {
     int n = 3;
