@@ -53,6 +53,7 @@
 #define K_BOX_X    100.0  /* a coordinate's model beyond its modes */
 #define K_BOXES_X  150.0  /* boxes of a coordinate's branch and bound, typically */
 #define K_BOX_J    1500.0 /* det J's model beyond its modes: the series products */
+#define K_REFINE   3.0    /* a refined panel's octants and theirs, per its own work */
 #define K_LINE_PT  2.0    /* points per integration node: the samples are the rule, more where roots are */
 #define K_PT_F32   1.0    /* a sample written as f32 */
 #define K_FMT_F32  17.0   /* a float32 printed for grid json */
@@ -236,7 +237,13 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
     /* The integrals: lines through the panels' nodes, each node a few points (sampling, roots and
      * the rule on each piece where det J may change sign), each a factor per mode. */
     double nodes = (double)nq[0] * (double)nq[1] * (double)nq[2];
-    w += K_LINE_PT * nodes * (pt / 3.0 + K_EV_MODE * modes);
+    /* Panels where det J may change sign are refined by octants, two levels, up to 96 of them
+     * (core/quad.c): about K_REFINE times their own work; assume every panel may be one. */
+    double panels = 1.0;
+    for (int a = 0; a < 3; a++)
+        panels *= fmax(1.0, (double)nq[a] / 12.0);
+    double refined = fmin(1.0, 96.0 / panels);
+    w += K_LINE_PT * nodes * (1.0 + K_REFINE * refined) * (pt / 3.0 + K_EV_MODE * modes);
     /* The skin: six faces of nodes, full points. */
     w += 2.0 * ((double)nq[0] * (double)nq[1] + (double)nq[1] * (double)nq[2] + (double)nq[0] * (double)nq[2]) * pt;
     /* Boundary residual: per component, bres^2 points at w = 0 and 1 (each a full pde_eval_d). */
