@@ -370,12 +370,13 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
     if (val < r.best)
         r.best = val, r.at[0] = at[0], r.at[1] = at[1], r.at[2] = at[2];
     pde_status st = PDE_OK;
+    unsigned iterations = 0;
     if (heap_push(&h, &n))
         return PDE_ERR_NOMEM;
     while (h.n) {
         if (h.a[0].lb >= r.best - tol || r.boxes >= budget)
             break;
-        if ((r.boxes & 15) == 0 && pde_stopped(cancel)) {
+        if ((++iterations & 7) == 0 && pde_stopped(cancel)) {   /* every 16 boxes */
             st = PDE_ERR_CANCELLED;
             break;
         }

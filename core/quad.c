@@ -37,7 +37,7 @@
 #define MAX_PANELS 32
 #define PANEL_PHASE 8.0       /* radians of the integrand per panel */
 #define MAX_NODES (1u << 21)  /* nodes of the rules in all: bounded work */
-#define MAX_FACE_NODES (1u << 16)   /* points of one face's area rule, at most */
+#define FACE_DEPTH 5          /* halvings of a face's panel in its refinement, at most */
 #define POLL_WORK 65536       /* factor evaluations between polls of the caller's stop() */
 #define OUTER_DEPTH 2         /* halvings of a panel in its refinement, at most */
 #define REFINE_PANELS 96      /* panels refined, at most: fig. 4's 24 to 72, not fig. 3's 1024 */
@@ -657,90 +657,111 @@ static double face_line_integral(const face_line *f, double a, double b, int n, 
     return sum;
 }
 
-/* The area of face (axis, side) with np panels of n points on each of its parameters. */
-static pde_status face_area(const pde_solution *s, int axis, int side, const int np[2], const int n[2],
-                            const pde_cancel *cancel, double *area)
+typedef struct {
+    face_line line;
+    double f[2];                 /* the element's frequencies along the face's parameters */
+    double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];
+    double tol;                  /* of a panel's refinement, absolute */
+    const pde_cancel *cancel;
+    int stopped;
+} face_ctx;
+
+/* One panel [lo, lo + h] of the face: lines along the parameter that crosses the sign changes of
+ * the element's component along its direction at the centre most often, rules sized to it. */
+static double face_panel(face_ctx *c, const double lo[2], const double h[2])
 {
-    double gx[2][GMAX], gw[2][GMAX], total = 0.0;
-    for (int a = 0; a < 2; a++)
-        gauss_legendre(n[a], gx[a], gw[a]);
-    const double h[2] = { 1.0 / np[0], 1.0 / np[1] };
-    face_line f = { .s = s, .axis = axis, .side = side };
-    for (int pa = 0; pa < np[0]; pa++)
-        for (int pb = 0; pb < np[1]; pb++) {
-            if (pde_stopped(cancel))   /* a panel of a face */
-                return PDE_ERR_CANCELLED;
-            const double lo[2] = { pa * h[0], pb * h[1] };
-            /* nu: the element's direction at the centre; the lines cross its sign changes most often. */
-            double x[3], ta[3], tb[3], big = 0.0;
-            face_point(s, axis, side, lo[0] + 0.5 * h[0], lo[1] + 0.5 * h[1], x, ta, tb);
-            f.nu[0] = ta[1] * tb[2] - ta[2] * tb[1], f.nu[1] = ta[2] * tb[0] - ta[0] * tb[2];
-            f.nu[2] = ta[0] * tb[1] - ta[1] * tb[0];
-            double nn = sqrt(f.nu[0] * f.nu[0] + f.nu[1] * f.nu[1] + f.nu[2] * f.nu[2]);
-            for (int c = 0; c < 3; c++)
-                f.nu[c] = nn > 0 ? f.nu[c] / nn : (c == 2);
-            enum { S = 4 };
-            double sd[S][S];
-            for (int i = 0; i < S; i++)
-                for (int j = 0; j < S; j++) {
-                    f.la = 0, f.fixed = lo[1] + h[1] * (j + 0.5) / S;
-                    big = fmax(big, face_elem(&f, lo[0] + h[0] * (i + 0.5) / S, &sd[i][j]));
-                }
-            f.tol = 1e-13 * big;
-            int cross[2] = { 0, 0 };
-            for (int i = 0; i < S; i++)
-                for (int j = 0; j + 1 < S; j++) {
-                    cross[0] += sign_changes(sd[j][i], sd[j + 1][i], f.tol);
-                    cross[1] += sign_changes(sd[i][j], sd[i][j + 1], f.tol);
-                }
-            f.la = cross[1] > cross[0];
-            const int lb = 1 - f.la;
-            for (int i = 0; i < n[lb]; i++) {
-                f.fixed = lo[lb] + h[lb] * gx[lb][i];
-                total += h[lb] * gw[lb][i] *
-                         face_line_integral(&f, lo[f.la], lo[f.la] + h[f.la], n[f.la], gx[f.la], gw[f.la]);
-            }
+    face_line *f = &c->line;
+    double x[3], ta[3], tb[3], big = 0.0;
+    face_point(f->s, f->axis, f->side, lo[0] + 0.5 * h[0], lo[1] + 0.5 * h[1], x, ta, tb);
+    f->nu[0] = ta[1] * tb[2] - ta[2] * tb[1], f->nu[1] = ta[2] * tb[0] - ta[0] * tb[2];
+    f->nu[2] = ta[0] * tb[1] - ta[1] * tb[0];
+    double nn = sqrt(f->nu[0] * f->nu[0] + f->nu[1] * f->nu[1] + f->nu[2] * f->nu[2]);
+    for (int k = 0; k < 3; k++)
+        f->nu[k] = nn > 0 ? f->nu[k] / nn : (k == 2);
+    enum { S = 4 };
+    double sd[S][S];
+    for (int i = 0; i < S; i++)
+        for (int j = 0; j < S; j++) {
+            f->la = 0, f->fixed = lo[1] + h[1] * (j + 0.5) / S;
+            big = fmax(big, face_elem(f, lo[0] + h[0] * (i + 0.5) / S, &sd[i][j]));
         }
-    *area = total;
-    return PDE_OK;
+    f->tol = 1e-13 * big;
+    int cross[2] = { 0, 0 };
+    for (int i = 0; i < S; i++)
+        for (int j = 0; j + 1 < S; j++) {
+            cross[0] += sign_changes(sd[j][i], sd[j + 1][i], f->tol);
+            cross[1] += sign_changes(sd[i][j], sd[i][j + 1], f->tol);
+        }
+    f->la = cross[1] > cross[0];
+    const int lb = 1 - f->la, na = rule_points(c->f[f->la] * h[f->la]), nb = rule_points(c->f[lb] * h[lb]);
+    double total = 0.0;
+    for (int i = 0; i < nb; i++) {
+        f->fixed = lo[lb] + h[lb] * c->gx[nb][i];
+        total += h[lb] * c->gw[nb][i] * face_line_integral(f, lo[f->la], lo[f->la] + h[f->la], na, c->gx[na], c->gw[na]);
+    }
+    return total;
+}
+
+/* A panel against its four quarters, each with its own lines, and so on where they differ. */
+static double face_refine(face_ctx *c, const double lo[2], const double h[2], double coarse, int depth)
+{
+    if (!c->stopped && pde_stopped(c->cancel))
+        c->stopped = 1;
+    double q[4], ql[4][2], hh[2] = { 0.5 * h[0], 0.5 * h[1] }, fine = 0.0;
+    for (int k = 0; k < 4; k++) {
+        ql[k][0] = lo[0] + (k & 1) * hh[0], ql[k][1] = lo[1] + (k >> 1) * hh[1];
+        fine += q[k] = face_panel(c, ql[k], hh);
+    }
+    if (c->stopped || depth + 1 >= FACE_DEPTH || fabs(fine - coarse) <= c->tol)
+        return fine;
+    double sum = 0.0;
+    for (int k = 0; k < 4; k++)
+        sum += face_refine(c, ql[k], hh, q[k], depth + 1);
+    return sum;
 }
 
 /*
- * Each face's area with panels sized to the element's frequencies (counted, like the solid's
- * integrals, as five factors'), then with twice the panels on each axis, until two results agree
- * to 1e-12 or the face has MAX_FACE_NODES points. Faces that fold have cuspidal edges where the
- * element vanishes; lines cross them at located roots. Where the element vanishes otherwise
- * (isolated points), the rule converges slowly: the folded figures stop at the node cap, about
- * 1e-6 to 1e-8 from the converged value (docs/MATH.md).
+ * The skin's area: each face's panels (sized to the element's frequencies, counted like the
+ * solid's integrals as five factors') along lines that locate the cuspidal edges of a folded
+ * face, each panel checked against its quarters and refined where they differ by more than
+ * 1e-13 of the solid's size squared, down to FACE_DEPTH halvings: in a small panel the lines
+ * cross an edge rather than touch it.
  */
 pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area)
 {
+    face_ctx *c = calloc(1, sizeof *c);
+    if (!c)
+        return PDE_ERR_NOMEM;
     int np[3], n[3];
     panels_for(s, 5.0, np, n);
+    double f[3];
+    frequencies(s, 5.0, f);
+    for (int k = 1; k <= GMAX; k++)
+        gauss_legendre(k, c->gx[k], c->gw[k]);
+    c->tol = 1e-13 * size * size;
+    c->cancel = cancel;
     double total = 0.0;
-    for (int axis = 0; axis < 3; axis++) {
+    for (int axis = 0; axis < 3 && !c->stopped; axis++) {
         if (faces_coincide(s, axis, size))
             continue;   /* both lie inside the solid, as api/mesh.c drops them */
         int o[2], m = 0;
         for (int k = 0; k < 3; k++)
             if (k != axis)
                 o[m++] = k;
+        c->f[0] = f[o[0]], c->f[1] = f[o[1]];
+        const double h[2] = { 1.0 / np[o[0]], 1.0 / np[o[1]] };
         for (int side = 0; side < 2; side++) {
-            int fp[2] = { np[o[0]], np[o[1]] }, fn[2] = { n[o[0]], n[o[1]] };
-            double prev = -1.0, cur;
-            for (;;) {
-                pde_status st = face_area(s, axis, side, fp, fn, cancel, &cur);
-                if (st != PDE_OK)
-                    return st;
-                if (fabs(cur - prev) <= 1e-12 * fmax(fabs(cur), fabs(prev)) ||
-                    4.0 * fp[0] * fn[0] * fp[1] * fn[1] > MAX_FACE_NODES)
-                    break;
-                prev = cur;
-                fp[0] *= 2, fp[1] *= 2;
-            }
-            total += cur;
+            c->line = (face_line){ .s = s, .axis = axis, .side = side };
+            for (int pa = 0; pa < np[o[0]] && !c->stopped; pa++)
+                for (int pb = 0; pb < np[o[1]] && !c->stopped; pb++) {
+                    const double lo[2] = { pa * h[0], pb * h[1] };
+                    total += face_refine(c, lo, h, face_panel(c, lo, h), 0);
+                }
         }
     }
-    *area = total;
-    return PDE_OK;
+    pde_status st = c->stopped ? PDE_ERR_CANCELLED : PDE_OK;
+    free(c);
+    if (st == PDE_OK)
+        *area = total;
+    return st;
 }

@@ -663,7 +663,7 @@ static void expect_props_match_reference(const char *name, const pde_props *p, c
     /* A known shortfall, which issue 9 leaves open (its notes): fig. 3's sin(20 pi v) to
      * sin(30 pi v) fold in 1024 panels, beyond core/quad.c's budget of refined panels, and need
      * more nodes than its cap of 2^21: about 3e-8. */
-    const double tol = strncmp(name, "fig3", 4) == 0 ? 1e-7 : 1e-9;
+    const double tol = strncmp(name, "fig3", 4) == 0 ? 1e-7 : 1e-9, area_tol = 1e-6;
     double imax = 0, size = cbrt(r->volume);
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
@@ -676,10 +676,10 @@ static void expect_props_match_reference(const char *name, const pde_props *p, c
 #define EXPECT(what, got, want, floor) EXPECT_TOL(what, got, want, floor, tol)
     EXPECT("volume", p->volume, r->volume, 0);
     EXPECT("signed_volume", p->signed_volume, r->signed_volume, r->volume);
-    /* The area element vanishes at points of a skin (cone points, and the cuspidal edges of a skin
-     * that folds) which core/quad.c does not all locate: its rule stops at a node cap, up to about
-     * 1e-5 off (fig. 2c: 3e-6; fig. 4o, which does not fold: 4e-8). Issue 9 leaves this open. */
-    EXPECT_TOL("surface_area", p->surface_area, r->surface_area, 0, 2e-5);
+    /* The area element vanishes at points of a skin (cusps of a skin that folds, cone points)
+     * where core/quad.c's refinement of a face's panels converges slowly: within 1e-6 (fig. 2c:
+     * 3.6e-7). Issue 9 leaves this open. */
+    EXPECT_TOL("surface_area", p->surface_area, r->surface_area, 0, area_tol);
     for (int i = 0; i < 3; i++) {
         EXPECT("centroid", p->centroid[i], r->centroid[i], size);
         EXPECT("principal_moments", p->principal_moments[i], r->principal_moments[i], imax);
