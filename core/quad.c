@@ -37,7 +37,8 @@
 #define MAX_PANELS 32
 #define PANEL_PHASE 8.0       /* radians of the integrand per panel */
 #define MAX_NODES (1u << 21)  /* nodes of the rules in all: bounded work */
-#define FACE_DEPTH 5          /* halvings of a face's panel in its refinement, at most */
+#define FACE_DEPTH 4          /* halvings of a face's panel in its refinement, at most */
+#define FACE_REFINE 256       /* face panels refined, at most: fig. 4's, not all of fig. 3's */
 #define POLL_WORK 65536       /* factor evaluations between polls of the caller's stop() */
 #define OUTER_DEPTH 2         /* halvings of a panel in its refinement, at most */
 #define REFINE_PANELS 96      /* panels refined, at most: fig. 4's 24 to 72, not fig. 3's 1024 */
@@ -663,6 +664,7 @@ typedef struct {
     double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];
     double tol;                  /* of a panel's refinement, absolute */
     const pde_cancel *cancel;
+    int refined;                 /* panels refined so far */
     int stopped;
 } face_ctx;
 
@@ -723,9 +725,9 @@ static double face_refine(face_ctx *c, const double lo[2], const double h[2], do
 /*
  * The skin's area: each face's panels (sized to the element's frequencies, counted like the
  * solid's integrals as five factors') along lines that locate the cuspidal edges of a folded
- * face, each panel checked against its quarters and refined where they differ by more than
- * 1e-13 of the solid's size squared, down to FACE_DEPTH halvings: in a small panel the lines
- * cross an edge rather than touch it.
+ * face. Each panel is checked against its quarters and refined where they differ by more than
+ * 1e-13 of the solid's size squared, down to FACE_DEPTH halvings (in a small panel the lines
+ * cross an edge rather than touch it), for the first FACE_REFINE panels.
  */
 pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area)
 {
@@ -755,7 +757,8 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
             for (int pa = 0; pa < np[o[0]] && !c->stopped; pa++)
                 for (int pb = 0; pb < np[o[1]] && !c->stopped; pb++) {
                     const double lo[2] = { pa * h[0], pb * h[1] };
-                    total += face_refine(c, lo, h, face_panel(c, lo, h), 0);
+                    double a = face_panel(c, lo, h);
+                    total += c->refined++ >= FACE_REFINE ? a : face_refine(c, lo, h, a, 0);
                 }
         }
     }
