@@ -154,15 +154,15 @@ static void add_value(qctx *q, const double x[3], double j, double wt)
     acc[Q_SIGNED] += wt * j;
 }
 
-/* The root of det J on the current line in [a, b], where fa and fb have opposite signs (Illinois). */
-static double line_root(qctx *q, double a, double b, double fa, double fb)
+/* The root of f in [a, b], where fa = f(a) and fb = f(b) have opposite signs (Illinois). */
+static double illinois(double (*f)(void *, double), void *arg, double a, double b, double fa, double fb)
 {
-    double c = 0.5 * (a + b), x[3];
+    double c = 0.5 * (a + b);
     for (int it = 0, side = 0; it < 100 && b - a > 4 * DBL_EPSILON * fmax(fabs(a), fabs(b)); it++) {
         c = (a * fb - b * fa) / (fb - fa);
         if (!(c > a && c < b))
             c = 0.5 * (a + b);
-        double fc = line_eval(q, c, x);
+        double fc = f(arg, c);
         if (fc == 0.0)
             break;
         if ((fc < 0) == (fa < 0)) {
@@ -178,6 +178,18 @@ static double line_root(qctx *q, double a, double b, double fa, double fb)
         }
     }
     return c;
+}
+
+static double line_detj(void *arg, double t)
+{
+    double x[3];
+    return line_eval(arg, t, x);
+}
+
+/* The root of det J on the current line in [a, b], where fa and fb have opposite signs. */
+static double line_root(qctx *q, double a, double b, double fa, double fb)
+{
+    return illinois(line_detj, q, a, b, fa, fb);
 }
 
 static void line_gauss(qctx *q, double a, double b, double wt)
@@ -597,31 +609,16 @@ static double face_elem(const face_line *f, double t, double *sdir)
     return sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
 }
 
+static double face_sign(void *arg, double t)
+{
+    double sd;
+    face_elem(arg, t, &sd);
+    return sd;
+}
+
 static double face_root(const face_line *f, double a, double b, double fa, double fb)
 {
-    double c = 0.5 * (a + b), e;
-    for (int it = 0, side = 0; it < 100 && b - a > 4 * DBL_EPSILON * fmax(fabs(a), fabs(b)); it++) {
-        c = (a * fb - b * fa) / (fb - fa);
-        if (!(c > a && c < b))
-            c = 0.5 * (a + b);
-        double fc;
-        face_elem(f, c, &fc);
-        if (fc == 0.0)
-            break;
-        if ((fc < 0) == (fa < 0)) {
-            a = c, fa = fc;
-            if (side == -1)
-                fb *= 0.5;
-            side = -1;
-        } else {
-            b = c, fb = fc;
-            if (side == 1)
-                fa *= 0.5;
-            side = 1;
-        }
-    }
-    (void)e;
-    return c;
+    return illinois(face_sign, (void *)f, a, b, fa, fb);   /* read only */
 }
 
 /* The integral of |x_a x x_b| along the current line over [a, b], with an n-point rule. */

@@ -1057,6 +1057,15 @@ api_model *preset_model(const char *name)
     return m;
 }
 
+pde_solution *preset_solution(const char *name)
+{
+    api_model *m = preset_model(name);
+    pde_solution *sol = NULL;
+    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
+    api_model_free(m);
+    return sol;
+}
+
 /* ---- HTTP through libcurl ---- */
 
 static size_t on_body(char *p, size_t size, size_t n, void *cls)

@@ -72,6 +72,8 @@ void paper_figure_model(size_t i, pde_model *m);
 
 /* A preset's model with its default parameters (api_model_free it); fails the test if there is none. */
 struct api_model *preset_model(const char *name);
+/* The solution of a preset (a test failure if it does not solve); free with pde_solution_free(). */
+struct pde_solution *preset_solution(const char *name);
 
 /* Reads a whole file into a NUL-terminated buffer; NULL on failure. */
 char *read_file(const char *path, size_t *len);

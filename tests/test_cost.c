@@ -36,15 +36,6 @@ static int count_stop(void *arg)
 
 /* ---- models ---- */
 
-static pde_solution *solve_preset(const char *name)
-{
-    api_model *m = preset_model(name);
-    pde_solution *sol = NULL;
-    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
-    api_model_free(m);
-    return sol;
-}
-
 /* The heavy models of issue 8, with n terms per component (the issue's have 4096):
  * FORCE: force terms sin(a pi u) sin(b pi v) w^100, every (a, b) and every a distinct;
  * (4095 of them and the base term make the limit of 4096 modes)
@@ -183,7 +174,7 @@ static void properties_should_stop_at_the_poll_that_asks_and_leave_out_untouched
 {
     (void)state;
     /* Polled about every millisecond of work: fig. 4a's properties take tens of polls. */
-    pde_solution *sol = solve_preset("fig4a");
+    pde_solution *sol = preset_solution("fig4a");
     check_cancellation(call_props, sol, PDE_OK, PDE_ERR_CANCELLED, 10);
     pde_solution_free(sol);
 }
@@ -215,7 +206,7 @@ static int call_mesh(const void *arg, const pde_cancel *cancel)
 static void mesh_build_should_stop_at_the_poll_that_asks_and_free_everything(void **state)
 {
     (void)state;
-    pde_solution *sol = solve_preset("fig4a");
+    pde_solution *sol = preset_solution("fig4a");
     /* Faces are polled per row or plane (6 x 48), welding per 8192 samples (6 x 48^2 of them). */
     out_arg a = { sol, { 48, 48, 48 }, API_FMT_GLB };
     check_cancellation(call_mesh, &a, 0, -1, 6 * 48 + 6 * 48 * 48 / 8192);
@@ -245,7 +236,7 @@ static int call_output(const void *arg, const pde_cancel *cancel)
 static void output_open_should_stop_in_the_properties_and_the_mesh_it_computes(void **state)
 {
     (void)state;
-    pde_solution *sol = solve_preset("fig4a");
+    pde_solution *sol = preset_solution("fig4a");
     /* json and vts: the properties; glb: the mesh, then the properties; stl: the mesh alone. */
     static const api_format fmts[] = { API_FMT_JSON, API_FMT_VTS, API_FMT_GLB, API_FMT_STL };
     for (size_t i = 0; i < sizeof fmts / sizeof *fmts; i++) {
@@ -332,7 +323,7 @@ static void grid_memory_should_grow_with_the_modes(void **state)
 static void eval_work_should_be_linear_in_the_points(void **state)
 {
     (void)state;
-    pde_solution *sol = solve_preset("fig4a");
+    pde_solution *sol = preset_solution("fig4a");
     api_cost a, b, d;
     api_cost_eval(sol, 10000, 0, &a);
     api_cost_eval(sol, 100000, 0, &b);

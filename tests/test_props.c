@@ -552,15 +552,6 @@ static hand_props fig1c_hand(void)
     return (hand_props){ V, { 0, 0, zc }, { { ixx, 0, 0 }, { 0, ixx, 0 }, { 0, 0, izz } }, 5 + 3 * sqrt(17.0) };
 }
 
-static pde_solution *preset_solution(const char *name)
-{
-    api_model *am = preset_model(name);
-    pde_solution *sol = NULL;
-    assert_int_equal(pde_solve(api_model_get(am), &sol, NULL), PDE_OK);
-    api_model_free(am);
-    return sol;
-}
-
 /* The reference of every preset, computed once for the tests that compare with it. */
 #define MAX_PRESETS 64
 static ref_props_out ref_cache[MAX_PRESETS];
