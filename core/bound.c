@@ -49,8 +49,11 @@ static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound
                 factor_derivs(md->v, b->lo[1], order, fv);
                 mode_h_derivs(md, b->lo[2], order, h);
             }
-            for (int q = 0; q < n; q++)
-                j->d[c][q] += fu[mi_u[q]] * fv[mi_v[q]] * h[mi_w[q]];
+            for (int q = 0; q < n; q++) {
+                /* A factor that is exactly 0 makes the term 0, even beside an overflowed bound. */
+                double p = fu[mi_u[q]], r = fv[mi_v[q]], e = h[mi_w[q]];
+                j->d[c][q] += (p == 0.0 || r == 0.0 || e == 0.0) ? 0.0 : p * r * e;
+            }
         }
     }
 }
@@ -266,7 +269,8 @@ double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *
     *val = sign * m.v;
     for (int k = 0; k < 3; k++)
         at[k] = 0.5 * (b->lo[k] + b->hi[k]);
-    return sign * m.v + quad_lower(g, H, r) - cubic_rest(&m, r);
+    double lb = sign * m.v + quad_lower(g, H, r) - cubic_rest(&m, r);
+    return lb == lb ? lb : -INFINITY;   /* NaN from overflowed bounds: no bound */
 }
 
 void detj_grad_range(const pde_solution *s, const pbox *b, double lo[3], double hi[3])
@@ -345,8 +349,8 @@ int obj_split_axis(const pde_solution *s, int what, const pbox *b)
     double most = -1.0;
     for (int k = 0; k < 3; k++) {
         double c = r[k] * (fabs(m.g[k]) + spread[k]);
-        if (r[k] > 0.0 && c > most)
-            most = c, best = k;
+        if (r[k] > 0.0 && (c > most || c != c))
+            most = c == c ? c : INFINITY, best = k;
     }
     return best;
 }

@@ -61,7 +61,7 @@ typedef struct {
 /*
  * Minimises sign * f over the unit cube by branch and bound, from a known point start, until the
  * gap best - lower is at most tol or `budget` boxes have been bounded. stop() is polled every
- * 64 boxes; returns PDE_ERR_CANCELLED then.
+ * 16 boxes; returns PDE_ERR_CANCELLED then.
  */
 pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], double tol,
                        size_t budget, const pde_cancel *cancel, bb_result *out);

@@ -256,7 +256,7 @@ typedef struct {
 
 /* A zeroed options struct gives the defaults. */
 typedef struct {
-    int res;                    /* samples per axis for bounds, det J and residuals; 0: 17 */
+    int res;                    /* samples per axis of the search for extremes (the boundary residual: at least 17); 0: 9 */
     const pde_cancel *cancel;   /* polled about once per ms of work (small solids: never); NULL never stops */
 } pde_props_opts;
 

@@ -366,7 +366,8 @@ static void eigen_sym3(const double A[3][3], double val[3], double vec[3][3])
                 if (a[p][q] == 0.0)
                     continue;
                 double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-                double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                double t = fabs(theta) > 1e150 ? 0.5 / theta   /* theta^2 would overflow */
+                                               : (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
                 double c = 1.0 / sqrt(t * t + 1.0), sn = t * c;
                 for (int k = 0; k < 3; k++) {   /* a = J' a J */
                     double akp = a[k][p], akq = a[k][q];
@@ -456,8 +457,11 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     for (int i = 0; i < res; i++)
         uni[i] = (double)i / (res - 1);
     extremes e;
-    for (int c = 0; c < 3; c++)
+    for (int c = 0; c < 3; c++) {
         e.lo[c] = DBL_MAX, e.hi[c] = -DBL_MAX;
+        for (int a = 0; a < 3; a++)
+            e.lo_at[c][a] = e.hi_at[c][a] = e.jmin_at[a] = e.jmax_at[a] = 0.5;
+    }
     e.jmin = DBL_MAX;
     e.jmax = -DBL_MAX;
     pde_status st = sweep(s, uni, res, uni, res, uni, res, NULL, NULL, NULL, &pl, &e, NULL, NULL);
@@ -509,16 +513,24 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     double tol = 1e-9 * jscale;
     r.folds = best[6] < -tol && best[7] > tol;
 
-    double x0[3], vol_scale = 1.0;   /* the box's volume, the scale of the solid's */
+    /* About the centre of the extremes found (finite, where a bound may have overflowed). */
+    double x0[3], vol_scale = 1.0;
     for (int c = 0; c < 3; c++) {
-        x0[c] = 0.5 * (r.bbox_min[c] + r.bbox_max[c]);
-        vol_scale *= fmax(r.bbox_max[c] - r.bbox_min[c], 1e-3 * size);
+        x0[c] = 0.5 * (best[2 * c] + best[2 * c + 1]);
+        vol_scale *= fmax(best[2 * c + 1] - best[2 * c], 1e-3 * size);
     }
     quad_result q;
     if ((st = quad_solid(s, x0, jscale, vol_scale, cancel, &q)) != PDE_OK ||
         (st = quad_area(s, size, cancel, &r.surface_area)) != PDE_OK)
         return st;
     mass_properties(&q, x0, &r);
+    /* Integrals beyond a double: say so rather than hand back inf and NaN. */
+    double sum = r.volume + r.signed_volume + r.surface_area + r.centroid[0] + r.centroid[1] + r.centroid[2];
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            sum += r.inertia[i][k] + r.principal_axes[i][k];
+    if (!isfinite(sum))
+        return PDE_ERR_RANGE;
 
     double own[3];   /* the solution's size: attained values, not bounds (which may be loose) */
     for (int c = 0; c < 3; c++)

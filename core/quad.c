@@ -606,7 +606,8 @@ static double face_elem(const face_line *f, double t, double *sdir)
         face_point(f->s, f->axis, f->side, f->fixed, t, x, ta, tb);
     const double c[3] = { ta[1] * tb[2] - ta[2] * tb[1], ta[2] * tb[0] - ta[0] * tb[2], ta[0] * tb[1] - ta[1] * tb[0] };
     *sdir = c[0] * f->nu[0] + c[1] * f->nu[1] + c[2] * f->nu[2];
-    return sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    double m = fmax(fabs(c[0]), fmax(fabs(c[1]), fabs(c[2])));   /* scaled: no overflow in the squares */
+    return m > 0.0 ? m * sqrt((c[0] / m) * (c[0] / m) + (c[1] / m) * (c[1] / m) + (c[2] / m) * (c[2] / m)) : 0.0;
 }
 
 static double face_sign(void *arg, double t)
@@ -754,6 +755,8 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
             for (int pa = 0; pa < np[o[0]] && !c->stopped; pa++)
                 for (int pb = 0; pb < np[o[1]] && !c->stopped; pb++) {
                     const double lo[2] = { pa * h[0], pb * h[1] };
+                    if (pde_stopped(cancel))   /* a panel of a face */
+                        c->stopped = 1;
                     double a = face_panel(c, lo, h);
                     total += c->refined++ >= FACE_REFINE ? a : face_refine(c, lo, h, a, 0);
                 }

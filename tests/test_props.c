@@ -992,6 +992,38 @@ static void bounds_should_contain_a_dense_sampling_of_stress_models(void **state
     }
 }
 
+/* A bound of exp(700 u)'s derivatives overflows to inf, and inf times the exact 0 of t's second
+ * derivative made NaN, which branch and bound took for a point: det J's minimum was "certified" at
+ * -2.9e-7 while det J is -3e5 at (1, 1, 0.994). A bound may be infinite; it may not be false. */
+static void bounds_should_stay_certified_when_a_factor_bound_overflows(void **state)
+{
+    (void)state;
+    pde_bterm t[3] = { { { PDE_EXP, 700 }, { PDE_POW, 1 }, 1e-300, 0, 1e-300, 0 },
+                       { { PDE_POW, 0 }, { PDE_POW, 1 }, 1, 0, 1, 0 },
+                       { { PDE_POW, 0 }, { PDE_POW, 0 }, 0, 1, 1, 1 } };
+    pde_model m;
+    memset(&m, 0, sizeof m);
+    for (int c = 0; c < 3; c++)
+        m.comp[c] = (pde_component){ 1, 1, 1, &t[c], 1, NULL, 0 };
+    pde_solution *sol = NULL;
+    assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
+    double lo = INFINITY, hi = -INFINITY;
+    for (int k = 0; k <= 2000; k++)
+        for (int e = 0; e <= 4; e++) {
+            double xu[3], xv[3], xw[3];
+            pde_eval_d(sol, e / 4.0, 1, k / 2000.0, NULL, xu, xv, xw);
+            double dj = xu[0] * (xv[1] * xw[2] - xv[2] * xw[1]) - xu[1] * (xv[0] * xw[2] - xv[2] * xw[0]) +
+                        xu[2] * (xv[0] * xw[1] - xv[1] * xw[0]);
+            lo = fmin(lo, dj), hi = fmax(hi, dj);
+        }
+    assert_true(lo < -1e5);   /* the sample sees the dip */
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    if (!(p.detj_min <= lo && p.detj_max >= hi))
+        fail_msg("det J sampled in [%.6g, %.6g], outside the certified [%.6g, %.6g]", lo, hi, p.detj_min, p.detj_max);
+    pde_solution_free(sol);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1015,6 +1047,7 @@ int main(void)
         cmocka_unit_test(props_should_match_the_reference_quadrature_on_every_preset),
         cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_every_preset),
         cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_stress_models),
+        cmocka_unit_test(bounds_should_stay_certified_when_a_factor_bound_overflows),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
