@@ -273,20 +273,6 @@ double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *
     return lb == lb ? lb : -INFINITY;   /* NaN from overflowed bounds: no bound */
 }
 
-void detj_grad_range(const pde_solution *s, const pbox *b, double lo[3], double hi[3])
-{
-    obj_model m;
-    obj_model_at(s, OBJ_DETJ, b, &m);
-    double r[3], spread[3];
-    for (int k = 0; k < 3; k++)
-        r[k] = 0.5 * (b->hi[k] - b->lo[k]);
-    grad_spread(&m, r, spread);
-    for (int k = 0; k < 3; k++) {
-        lo[k] = m.g[k] - spread[k];
-        hi[k] = m.g[k] + spread[k];
-    }
-}
-
 /* ---- branch and bound ---- */
 
 typedef struct {

@@ -48,9 +48,6 @@ double obj_magnitude(const pde_solution *s, int what);
 /* The axis along which b's half-width contributes most to its bound, or -1 for a point. */
 int obj_split_axis(const pde_solution *s, int what, const pbox *b);
 
-/* The range of d(det J)/d(axis k) over b, for each k. */
-void detj_grad_range(const pde_solution *s, const pbox *b, double lo[3], double hi[3]);
-
 typedef struct {
     double best;      /* smallest sign * f found, at `at` */
     double at[3];

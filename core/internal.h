@@ -44,6 +44,13 @@ struct pde_solution {
 
 extern const char *const pde_comp_name[3];   /* "x", "y", "z" */
 
+/* The determinant of the matrix with rows a, b, c. */
+static inline double det3(const double a[3], const double b[3], const double c[3])
+{
+    return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
+}
+
 /* Non-zero when the caller asks the running call to stop (pde.h). */
 static inline int pde_stopped(const pde_cancel *c)
 {

@@ -53,12 +53,6 @@ static int poll_after(poller *p, size_t units)
     return p->stopped = pde_stopped(p->cancel);
 }
 
-static double det3(const double a[3], const double b[3], const double c[3])
-{
-    return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-           a[2] * (b[0] * c[1] - b[1] * c[0]);
-}
-
 static double detj_at(const pde_solution *s, const double p[3])
 {
     double xu[3], xv[3], xw[3];
@@ -125,17 +119,14 @@ static void note_point(extremes *e, const double p[3], const double x[3], double
         e->jmax = dj, e->jmax_at[0] = p[0], e->jmax_at[1] = p[1], e->jmax_at[2] = p[2];
 }
 
-/* Walks a grid over us x vs x ws, noting extremes; with weights, integrates det J. */
+/* Walks a grid over us x vs x ws, noting extremes. */
 static pde_status sweep(const pde_solution *s, const double *us, size_t nu, const double *vs,
-                        size_t nv, const double *ws, size_t nw, const double *wts_u,
-                        const double *wts_v, const double *wts_w, poller *pl, extremes *e,
-                        double *vol, double *svol)
+                        size_t nv, const double *ws, size_t nw, poller *pl, extremes *e)
 {
     pde_grid *g;
     pde_status st = pde_grid_create(s, us, nu, vs, nv, &g);
     if (st != PDE_OK)
         return st;
-    double acc = 0.0, sacc = 0.0;
     for (size_t k = 0; k < nw; k++) {
         grid_set_w(g, ws[k]);
         for (size_t j = 0; j < nv; j++) {
@@ -156,19 +147,10 @@ static pde_status sweep(const pde_solution *s, const double *us, size_t nu, cons
                 double dj = det3(a, b, c);
                 const double p[3] = { us[i], vs[j], ws[k] };
                 note_point(e, p, x, dj);
-                if (wts_u) {
-                    double wt = wts_u[i] * wts_v[j] * wts_w[k];
-                    acc += wt * fabs(dj);
-                    sacc += wt * dj;
-                }
             }
         }
     }
     pde_grid_free(g);
-    if (vol) {
-        *vol = acc;
-        *svol = sacc;
-    }
     return PDE_OK;
 }
 
@@ -464,7 +446,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     }
     e.jmin = DBL_MAX;
     e.jmax = -DBL_MAX;
-    pde_status st = sweep(s, uni, res, uni, res, uni, res, NULL, NULL, NULL, &pl, &e, NULL, NULL);
+    pde_status st = sweep(s, uni, res, uni, res, uni, res, &pl, &e);
     free(uni);
     if (st != PDE_OK)
         return st;

@@ -25,7 +25,6 @@
  * point costs one factor per mode (a polynomial, for u): lines are cheap.
  */
 #include <float.h>
-#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -58,7 +57,6 @@ typedef struct {
     size_t maxm;
     quad_result r;
     size_t modes, next_poll;
-    int cuts_min, cuts_max;      /* the fewest and most roots of the lines since they were reset */
     int stopped;
 } qctx;
 
@@ -85,12 +83,6 @@ static void gauss_legendre(int n, double *x, double *w)
         x[i] = 0.5 * (1.0 - z), x[n - 1 - i] = 0.5 * (1.0 + z);
         w[i] = w[n - 1 - i] = 0.5 * wt;
     }
-}
-
-static double det3(const double a[3], const double b[3], const double c[3])
-{
-    return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-           a[2] * (b[0] * c[1] - b[1] * c[0]);
 }
 
 static void factor_on(const pde_mode *md, int axis, double t, double *val, double *der)
@@ -210,7 +202,7 @@ static int sign_changes(double fa, double fb, double tol)
 /*
  * Where |det J| has a local minimum among the samples t0 < t1 < t2 without a sign change, det J
  * may dip through zero between them and back: golden-section search for the extreme of sign *
- * det J; if it crosses, *lo and *hi get the two brackets' inner ends.
+ * det J, from t0 to t2; returns 1 when it crosses zero, with the crossing extreme in *at, *fat.
  */
 static int line_dip(qctx *q, double t0, double t2, double sign, double *at, double *fat)
 {
@@ -268,8 +260,6 @@ static void line_integrate(qctx *q, double a, double b, double wt)
         if (fabs(f[i]) > q->jtol || fabs(f[last]) <= q->jtol)
             last = i;
     }
-    q->cuts_min = ncut < q->cuts_min ? ncut : q->cuts_min;
-    q->cuts_max = ncut > q->cuts_max ? ncut : q->cuts_max;
     if (!ncut) {
         for (int i = 0; i < n; i++)
             add_value(q, x[i + 1], f[i + 1], wt * (b - a) * q->gw[n][i]);
@@ -348,7 +338,6 @@ static void panel_lines(qctx *q, const pbox *b, int k, int definite, double acc[
     double saved[Q_N];
     memcpy(saved, q->r.acc, sizeof saved);
     memset(q->r.acc, 0, sizeof q->r.acc);
-    q->cuts_min = INT_MAX, q->cuts_max = 0;
     int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
     const int ni = q->n[i], nj = q->n[j];
     const double hi = b->hi[i] - b->lo[i], hj = b->hi[j] - b->lo[j];
