@@ -21,6 +21,7 @@ pde_status pde_fail(pde_diag *d, pde_status st, int comp, int in_force, long ter
     d->component = comp;
     d->in_force = in_force;
     d->term = term;
+    d->section = -1;
     snprintf(d->field, sizeof d->field, "%s", field);
     va_list ap;
     va_start(ap, fmt);

@@ -121,6 +121,7 @@ typedef struct {
     int component;        /* 0, 1, 2, or -1 */
     int in_force;         /* 1: term indexes fterms; 0: bterms */
     long term;            /* index of the term, or -1 */
+    int section;          /* a loft's section (pde_solve_loft), or -1 */
     char field[8];        /* "a", "b", "c", "u", "v", "w", "coef", "w0", ... or "" */
     char message[240];    /* a sentence for a person */
 } pde_diag;
@@ -178,10 +179,60 @@ typedef struct {
     pde_factor u, v;        /* normalised: k, alpha >= 0 except for exp */
     double e;               /* h'''' = e h + force: e = -(a lu + b lv) / c (eq. 8) */
     size_t nterms;
-    const pde_wterm *terms;
+    const pde_wterm *terms; /* every slab's terms, slab by slab */
+    /* h is piecewise along w: on slab s, breaks[s] <= w <= breaks[s + 1], it is the sum of
+     * terms[first[s]] .. terms[first[s + 1] - 1]. A model has one slab, [0, 1]; a loft one per pair of
+     * neighbouring sections. Every mode of a solution has the same breaks. Below 0 the first slab's
+     * terms hold, above 1 the last's; at an interior break, the slab on its right. */
+    size_t nslabs;
+    const double *breaks;   /* nslabs + 1 values, 0 first and 1 last */
+    const size_t *first;    /* nslabs + 1 offsets into terms; first[nslabs] = nterms */
 } pde_mode;
 
 const pde_mode *pde_solution_modes(const pde_solution *sol, int comp, size_t *nmodes);
+
+/*
+ * Lofts: solids through K >= 2 sections at 0 = w_0 < w_1 < ... < w_(K-1) = 1 (docs/MATH.md,
+ * "Lofts"). Between sections each component solves a x_uuuu + b x_vvvv + c x_wwww = 0 (no force).
+ * At section k every term gives x (the factor times x[k]); a section with tangent set also gives
+ * x_w (the factor times xw[k]). The conditions:
+ *   an end section with a tangent:         x and x_w given (clamped);
+ *   an end section without one:            x given and x_ww = 0 (natural);
+ *   an interior section with a tangent:    x and x_w given on both sides;
+ *   an interior section without one:       x given, x_w and x_ww continuous across it (C2).
+ * Each mode's h(w) is then one exponential polynomial per slab between neighbouring sections
+ * (pde_mode's breaks). pde_solve_loft() validates like pde_solve(); diag->section names the section
+ * at fault, and a singular slab problem names the slab and the mode in the message.
+ */
+#define PDE_MAX_SECTIONS 64
+
+typedef struct {
+    double w;
+    int tangent;            /* non-zero: x_w is given at this section */
+} pde_section;
+
+/* A term of a loft: f(u) f(v) times x[k] at section k, and times xw[k] as x_w at a section with a
+ * tangent. x has nsections values; so has xw, which may be NULL when no section has a tangent. */
+typedef struct {
+    pde_factor u, v;
+    const double *x;
+    const double *xw;
+} pde_lterm;
+
+typedef struct {
+    double a, b, c;
+    const pde_lterm *terms;
+    size_t nterms;
+} pde_lcomponent;
+
+typedef struct {
+    const pde_section *sections;
+    size_t nsections;           /* 2 .. PDE_MAX_SECTIONS */
+    pde_lcomponent comp[3];
+} pde_loft;
+
+pde_status pde_solve_loft(const pde_loft *loft, const pde_solve_opts *opts, pde_solution **out,
+                          pde_diag *diag);
 
 /* x(u, v, w). Cannot fail; any point is accepted, [0,1]^3 is the solid. */
 void pde_eval(const pde_solution *sol, double u, double v, double w, double x[3]);

@@ -339,8 +339,16 @@ static pde_status to_real(arena *mem, const ep *h, pde_mode *out)
                 B[j] += sgn * cimag(p);
         }
     }
+    static const double unit[2] = { 0.0, 1.0 };
+    size_t *first = arena_alloc(mem, 2 * sizeof *first);
+    if (!first)
+        return PDE_ERR_NOMEM;
+    first[1] = n;
     out->terms = terms;
     out->nterms = n;
+    out->nslabs = 1;
+    out->breaks = unit;
+    out->first = first;
     return PDE_OK;
 }
 
@@ -556,7 +564,7 @@ pde_status pde_solve_ex(const pde_model *model, const pde_solve_opts *opts, pde_
 {
     const pde_cancel *cancel = opts ? opts->cancel : NULL;
     if (diag)
-        memset(diag, 0, sizeof *diag), diag->component = -1, diag->term = -1;
+        memset(diag, 0, sizeof *diag), diag->component = -1, diag->term = -1, diag->section = -1;
     if (!model || !out)
         return pde_fail(diag, PDE_ERR_INVALID, -1, -1, -1, "", "no model given");
     arena mem = { 0 }, scratch = { 0 };
