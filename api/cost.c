@@ -53,8 +53,11 @@
 #define K_BOX_X    100.0  /* a coordinate's model beyond its modes */
 #define K_BOXES_X  150.0  /* boxes of a coordinate's branch and bound, typically */
 #define K_BOX_J    1500.0 /* det J's model beyond its modes: the series products */
-#define K_AREA_REFINE 4.0 /* a refined face panel's quarters and theirs, per its own work */
-#define K_REFINE   3.0    /* a refined panel's octants and theirs, per its own work */
+#define K_AREA_REFINE 8.0 /* a refined face panel's quarters and theirs, per its own work */
+#define K_REFINE   5.0    /* a refined panel's octants and theirs, per its own work */
+#define K_Q_POINT  20.0   /* a point of the integrals beyond its modes: det J, sums, roots' bookkeeping */
+#define K_Q_MODE   10.0   /* a mode of a point of the integrals: table multiply-adds, and factors off the tables */
+#define QUAD_REFINE_WORK (2.0 * PDE_PROPS_WORK)   /* core/quad.c's bound of refinement, points times (modes + 1) */
 #define K_LINE_PT  2.0    /* points per integration node: the samples are the rule, more where roots are */
 #define K_PT_F32   1.0    /* a sample written as f32 */
 #define K_FMT_F32  17.0   /* a float32 printed for grid json */
@@ -236,21 +239,23 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
     w += 6.0 * K_BOXES_X * 2.5 * (K_BOX_MODE * modes + K_BOX_X);
     w += 2.0 * 0.5 * PDE_PROPS_BOXES_J * 2.5 * (2.0 * K_BOX_MODE * modes + K_BOX_J);
     /* The integrals: lines through the panels' nodes, each node a few points (sampling, roots and
-     * the rule on each piece where det J may change sign), each a factor per mode. */
+     * the rule on each piece where det J may change sign), each a multiply-add per mode from the
+     * panel's factor tables (core/quad.c); refined panels, about K_REFINE times their own work,
+     * stop at a bounded number of points times modes (QUAD_REFINE_WORK). */
     double nodes = (double)nq[0] * (double)nq[1] * (double)nq[2];
-    /* Panels where det J may change sign are refined by octants, two levels, up to 96 of them
-     * (core/quad.c): about K_REFINE times their own work; assume every panel may be one. */
     double panels = 1.0, panel_n[3];
     for (int a = 0; a < 3; a++)
         panels *= panel_n[a] = fmax(1.0, (double)nq[a] / 12.0);
-    double refined = fmin(1.0, 96.0 / panels);
-    w += K_LINE_PT * nodes * (1.0 + K_REFINE * refined) * (pt / 3.0 + K_EV_MODE * modes);
-    /* The skin: six faces of nodes, full points, and the refinement of its first 256 panels
-     * (core/quad.c), each about K_AREA_REFINE times its own work. */
+    double base = K_LINE_PT * nodes, refined = fmin(1.0, 96.0 / panels);
+    double evals = base + fmin(K_REFINE * refined * base, QUAD_REFINE_WORK / (modes + 1.0));
+    /* The skin: six faces of nodes, and the refinement of its first 256 panels, about
+     * K_AREA_REFINE times their own work, within the same bound. */
     double face_nodes = 2.0 * ((double)nq[0] * (double)nq[1] + (double)nq[1] * (double)nq[2] +
                                (double)nq[0] * (double)nq[2]);
     double face_panels = 2.0 * (panel_n[0] * panel_n[1] + panel_n[1] * panel_n[2] + panel_n[0] * panel_n[2]);
-    w += face_nodes * (1.0 + K_AREA_REFINE * fmin(1.0, 256.0 / face_panels)) * pt;
+    double fbase = K_LINE_PT * face_nodes;
+    evals += fbase + fmin(K_AREA_REFINE * fmin(1.0, 256.0 / face_panels) * fbase, QUAD_REFINE_WORK / (modes + 1.0));
+    w += evals * (K_Q_POINT + K_Q_MODE * (modes + 1.0));
     /* Boundary residual: per component, bres^2 points at w = 0 and 1 (each a full pde_eval_d). */
     w += 3.0 * bres * bres * 2.0 * pt;
     /* PDE residual: per component, 9^3 points of x_uuuu, x_vvvv (h itself) and x_wwww. */

@@ -216,6 +216,7 @@ static const prop_row prop_rows[] = {
     PROP(NULL, "surface_area", surface_area, 1, 1),
     PROP("residuals", "boundary", bc_residual, 1, 1),
     PROP("residuals", "pde", pde_residual, 1, 1),
+    PROP("residuals", "integrals", integral_error, 1, 1),
 };
 #undef PROP
 #define PROP_ROWS (sizeof prop_rows / sizeof prop_rows[0])

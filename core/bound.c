@@ -352,17 +352,24 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
     for (int k = 0; k < 3; k++)
         r.at[k] = start[k];
 
+    /* A box per slab of a loft: a box's Taylor model holds within one slab, where h is analytic. */
     heap h = { 0 };
-    bb_node n = { { { 0, 0, 0 }, { 1, 1, 1 } }, 0 };
+    size_t nslabs;
+    const double *br = solution_breaks(s, &nslabs);
     double val, at[3];
-    n.lb = obj_lower(s, what, sign, &n.b, &val, at);
-    r.boxes++;
-    if (val < r.best)
-        r.best = val, r.at[0] = at[0], r.at[1] = at[1], r.at[2] = at[2];
+    for (size_t k = 0; k < nslabs; k++) {
+        bb_node n = { { { 0, 0, br[k] }, { 1, 1, br[k + 1] } }, 0 };
+        n.lb = obj_lower(s, what, sign, &n.b, &val, at);
+        r.boxes++;
+        if (val < r.best)
+            r.best = val, r.at[0] = at[0], r.at[1] = at[1], r.at[2] = at[2];
+        if (heap_push(&h, &n)) {
+            free(h.a);
+            return PDE_ERR_NOMEM;
+        }
+    }
     pde_status st = PDE_OK;
     unsigned iterations = 0;
-    if (heap_push(&h, &n))
-        return PDE_ERR_NOMEM;
     while (h.n) {
         if (h.a[0].lb >= r.best - tol || r.boxes >= budget)
             break;

@@ -51,6 +51,19 @@ static inline double det3(const double a[3], const double b[3], const double c[3
            a[2] * (b[0] * c[1] - b[1] * c[0]);
 }
 
+/* The slabs' breaks along w (pde_mode): every mode has the same; [0, 1] without modes. */
+static inline const double *solution_breaks(const pde_solution *s, size_t *nslabs)
+{
+    static const double unit[2] = { 0.0, 1.0 };
+    for (int c = 0; c < 3; c++)
+        if (s->comp[c].nmodes) {
+            *nslabs = s->comp[c].modes[0].nslabs;
+            return s->comp[c].modes[0].breaks;
+        }
+    *nslabs = 1;
+    return unit;
+}
+
 /* Non-zero when the caller asks the running call to stop (pde.h). */
 static inline int pde_stopped(const pde_cancel *c)
 {

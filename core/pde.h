@@ -299,7 +299,14 @@ typedef struct {
     double surface_area;     /* of the closed skin: collapsed faces add nothing, inner seams are left out */
     double bc_residual;      /* largest error of x, x_w on w = 0, 1, relative to the data and force (MATH.md) */
     double pde_residual;     /* largest a x_uuuu + b x_vvvv + c x_wwww - p, relative to its largest term */
+    double integral_error;   /* the integrals' (volume ... surface_area) estimated error, relative: about
+                              * 1e-14 unless PDE_PROPS_WORK bounded them (docs/MATH.md) */
 } pde_props;
+
+/* The integrals' work, at most: their rules' points times (modes + 1), beyond which the panels get
+ * coarser (the error is reported); and as much again for the refinement of panels where det J may
+ * change sign, and for the skin's. */
+#define PDE_PROPS_WORK (6.0 * (1u << 21))
 
 /* Boxes of one branch and bound, at most: of a coordinate's extreme, and of det J's (pde_properties). */
 #define PDE_PROPS_BOXES   2000

@@ -35,12 +35,31 @@
 #define GMAX 24        /* Gauss points per panel axis, at most */
 #define MAX_PANELS 32
 #define PANEL_PHASE 8.0       /* radians of the integrand per panel */
-#define MAX_NODES (1u << 21)  /* nodes of the rules in all: bounded work */
+#define MAX_WORK PDE_PROPS_WORK   /* nodes of the rules times (modes + 1), at most: bounded work */
+#define MAX_EDGES (MAX_PANELS + PDE_MAX_SECTIONS)   /* panels along w: MAX_PANELS, plus one per slab */
 #define FACE_DEPTH 4          /* halvings of a face's panel in its refinement, at most */
 #define FACE_REFINE 256       /* face panels refined, at most: fig. 4's, not all of fig. 3's */
 #define POLL_WORK 65536       /* factor evaluations between polls of the caller's stop() */
 #define OUTER_DEPTH 2         /* halvings of a panel in its refinement, at most */
+#define OFF_WORK MAX_WORK   /* points off the tables times (modes + 1), at most */
+#define REFINE_WORK (2 * MAX_WORK)   /* points times modes after which no panel is refined */
 #define REFINE_PANELS 96      /* panels refined, at most: fig. 4's 24 to 72, not fig. 3's 1024 */
+
+/* The panels: their edges along each axis, the points of each axis's rule, and its estimated error. */
+typedef struct {
+    int np[3], n[3];
+    double edge[3][MAX_EDGES + 1];
+    double phase[3];             /* the fastest phase over a panel of the axis */
+    double err;
+} qplan;
+
+/* Every factor of one axis at a panel's points along it: its start, its rule's n nodes and its end
+ * (n = 0: the one point lo, a face's fixed parameter). val[i * mt + o], o = off[c] + m. */
+typedef struct {
+    double t[GMAX + 2];
+    int n;
+    double *val, *der;
+} axis_tab;
 
 typedef struct {
     const pde_solution *s;
@@ -50,15 +69,28 @@ typedef struct {
     double vscale;               /* the solid's volume, roughly: for refinement's tolerance */
     double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];   /* n-point rules on [0, 1] */
     int n[3];                    /* the current panel's points per axis */
-    /* The current line: along axis k, per component and mode, the fixed factors' product P and
-     * its derivatives along the two other axes (i, j in axis order). */
+    size_t off[3], mt;           /* modes of the components before c; modes in all */
+    axis_tab tab[3];             /* the current panel's factors */
+    double *g, *dg;              /* mt: the line's own factor at a point off the tables */
+    /* The current line: along axis k, per mode, the fixed factors' product P and its derivatives
+     * along the two other axes (i, j in axis order). */
     int k, ax[2];
-    double *P, *Pi, *Pj;         /* 3 x maxmodes each */
-    size_t maxm;
+    double *P, *Pi, *Pj;         /* mt each */
     quad_result r;
     size_t modes, next_poll;
+    size_t off_evals;            /* points off the tables: roots, dips and the rules of pieces */
     int stopped;
 } qctx;
+
+/* Points off the tables cost a factor per mode each; past OFF_WORK of them (times modes), lines no
+ * longer locate det J's roots, and the result says so. */
+static int off_budget(qctx *q)
+{
+    if (q->off_evals * q->modes < OFF_WORK)
+        return 1;
+    q->r.roots_skipped = 1;
+    return 0;
+}
 
 /* Gauss-Legendre nodes and weights on [0, 1], by Newton on P_n. */
 static void gauss_legendre(int n, double *x, double *w)
@@ -95,43 +127,78 @@ static void factor_on(const pde_mode *md, int axis, double t, double *val, doubl
         mode_h(md, t, val, der);
 }
 
-/* Fixes the line along axis k through p. */
-static void line_set(qctx *q, int k, const double p[3])
+/* Fills q->tab[a] for [lo, hi] with an n-point rule (n = 0: the point lo alone). */
+static void tab_fill(qctx *q, int a, double lo, double hi, int n)
+{
+    axis_tab *tb = &q->tab[a];
+    const int np = n ? n + 2 : 1;
+    tb->n = n;
+    tb->t[0] = lo;
+    if (n) {
+        for (int i = 0; i < n; i++)
+            tb->t[i + 1] = lo + (hi - lo) * q->gx[n][i];
+        tb->t[n + 1] = hi;
+    }
+    for (int i = 0; i < np; i++)
+        for (int c = 0; c < 3; c++) {
+            const comp_solution *cs = &q->s->comp[c];
+            size_t o = (size_t)i * q->mt + q->off[c];
+            for (size_t m = 0; m < cs->nmodes; m++)
+                factor_on(&cs->modes[m], a, tb->t[i], &tb->val[o + m], &tb->der[o + m]);
+        }
+}
+
+/* Fixes the line along axis k through the tables' points idx[a] of the two other axes. */
+static void line_set(qctx *q, int k, const int idx[3])
 {
     q->k = k;
     for (int a = 0, n = 0; a < 3; a++)
         if (a != k)
             q->ax[n++] = a;
-    for (int c = 0; c < 3; c++) {
-        const comp_solution *cs = &q->s->comp[c];
-        for (size_t m = 0; m < cs->nmodes; m++) {
-            double fi, di, fj, dj;
-            factor_on(&cs->modes[m], q->ax[0], p[q->ax[0]], &fi, &di);
-            factor_on(&cs->modes[m], q->ax[1], p[q->ax[1]], &fj, &dj);
-            size_t o = c * q->maxm + m;
-            q->P[o] = fi * fj, q->Pi[o] = di * fj, q->Pj[o] = fi * dj;
-        }
-    }
+    const axis_tab *ti = &q->tab[q->ax[0]], *tj = &q->tab[q->ax[1]];
+    const double *fi = ti->val + (size_t)idx[q->ax[0]] * q->mt, *di = ti->der + (size_t)idx[q->ax[0]] * q->mt;
+    const double *fj = tj->val + (size_t)idx[q->ax[1]] * q->mt, *dj = tj->der + (size_t)idx[q->ax[1]] * q->mt;
+    for (size_t o = 0; o < q->mt; o++)
+        q->P[o] = fi[o] * fj[o], q->Pi[o] = di[o] * fj[o], q->Pj[o] = fi[o] * dj[o];
 }
 
-/* x and det J at t on the current line. */
-static double line_eval(qctx *q, double t, double x[3])
+/* x, the partials d[axis][component] and det J on the current line where its own factors are g, dg. */
+static double line_point(qctx *q, const double *g, const double *dg, double x[3], double d[3][3])
 {
-    double d[3][3];   /* d[axis][component] */
     const int k = q->k, i = q->ax[0], j = q->ax[1];
     for (int c = 0; c < 3; c++) {
-        const comp_solution *cs = &q->s->comp[c];
         double sx = 0, sk = 0, si = 0, sj = 0;
-        for (size_t m = 0; m < cs->nmodes; m++) {
-            double g, dg;
-            factor_on(&cs->modes[m], k, t, &g, &dg);
-            size_t o = c * q->maxm + m;
-            sx += q->P[o] * g, sk += q->P[o] * dg, si += q->Pi[o] * g, sj += q->Pj[o] * g;
-        }
+        for (size_t o = q->off[c], e = o + q->s->comp[c].nmodes; o < e; o++)
+            sx += q->P[o] * g[o], sk += q->P[o] * dg[o], si += q->Pi[o] * g[o], sj += q->Pj[o] * g[o];
         x[c] = sx, d[k][c] = sk, d[i][c] = si, d[j][c] = sj;
     }
     q->r.evals++;
     return det3(d[0], d[1], d[2]);
+}
+
+/* The same at the current line's table point it. */
+static double line_eval_at(qctx *q, int it, double x[3], double d[3][3])
+{
+    const axis_tab *tb = &q->tab[q->k];
+    return line_point(q, tb->val + (size_t)it * q->mt, tb->der + (size_t)it * q->mt, x, d);
+}
+
+/* The same at t, anywhere on the line. */
+static double line_eval_d(qctx *q, double t, double x[3], double d[3][3])
+{
+    q->off_evals++;
+    for (int c = 0; c < 3; c++) {
+        const comp_solution *cs = &q->s->comp[c];
+        for (size_t m = 0; m < cs->nmodes; m++)
+            factor_on(&cs->modes[m], q->k, t, &q->g[q->off[c] + m], &q->dg[q->off[c] + m]);
+    }
+    return line_point(q, q->g, q->dg, x, d);
+}
+
+static double line_eval(qctx *q, double t, double x[3])
+{
+    double d[3][3];
+    return line_eval_d(q, t, x, d);
 }
 
 static void add_value(qctx *q, const double x[3], double j, double wt)
@@ -184,9 +251,26 @@ static double line_root(qctx *q, double a, double b, double fa, double fb)
     return illinois(line_detj, q, a, b, fa, fb);
 }
 
-static void line_gauss(qctx *q, double a, double b, double wt)
+/* The current line over the whole panel, at its rule's nodes in the table. */
+static void line_gauss_tab(qctx *q, double wt)
 {
     const int n = q->n[q->k];
+    const double h = q->tab[q->k].t[n + 1] - q->tab[q->k].t[0];
+    double x[3], d[3][3];
+    for (int i = 0; i < n; i++) {
+        double j = line_eval_at(q, i + 1, x, d);
+        add_value(q, x, j, wt * h * q->gw[n][i]);
+    }
+}
+
+/* The fewest Gauss-Legendre points whose error on exp(i f t) over a panel of phase phi = f h is
+ * below 1e-14: (e phi / 8n)^(2n), the rule's asymptotic error. */
+static int rule_points(double phi);
+
+/* The current line over [a, b], a piece between roots, with a rule sized to the piece. */
+static void line_gauss(qctx *q, double a, double b, double wt)
+{
+    const int n = rule_points(q->f[q->k] * (b - a));
     double x[3], h = b - a;
     for (int i = 0; i < n; i++) {
         double j = line_eval(q, a + h * q->gx[n][i], x);
@@ -229,7 +313,7 @@ static int line_dip(qctx *q, double t0, double t2, double sign, double *at, doub
 }
 
 /*
- * The current line over [a, b]: det J at the ends and the rule's n nodes. Each sign change
+ * The current line over the panel [a, b]: det J at the ends and the rule's n nodes (the table). Each sign change
  * between neighbours (bracketed from the last value clear of zero) is located, and so is each dip
  * through zero and back between samples (line_dip). Without either, the samples are the rule;
  * else each piece between roots gets its own.
@@ -237,15 +321,13 @@ static int line_dip(qctx *q, double t0, double t2, double sign, double *at, doub
 static void line_integrate(qctx *q, double a, double b, double wt)
 {
     const int n = q->n[q->k], m = n + 1;
-    double t[GMAX + 2], f[GMAX + 2], x[GMAX + 2][3];
-    t[0] = a, t[m] = b;
-    for (int i = 0; i < n; i++)
-        t[i + 1] = a + (b - a) * q->gx[n][i];
+    const double *t = q->tab[q->k].t;   /* a, the rule's nodes, b */
+    double f[GMAX + 2], x[GMAX + 2][3], d[3][3];
     for (int i = 0; i <= m; i++)
-        f[i] = line_eval(q, t[i], x[i]);
+        f[i] = line_eval_at(q, i, x[i], d);
     double cut[2 * GMAX + 4];
     int ncut = 0, last = 0;
-    for (int i = 1; i <= m; i++) {
+    for (int i = 1; i <= m && off_budget(q); i++) {
         if (sign_changes(f[last], f[i], q->jtol))
             cut[ncut++] = line_root(q, t[last], t[i], f[last], f[i]);
         else if (i < m && fabs(f[i]) <= fabs(f[i - 1]) && fabs(f[i]) < fabs(f[i + 1]) &&
@@ -341,25 +423,22 @@ static void panel_lines(qctx *q, const pbox *b, int k, int definite, double acc[
     int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
     const int ni = q->n[i], nj = q->n[j];
     const double hi = b->hi[i] - b->lo[i], hj = b->hi[j] - b->lo[j];
-    double p[3];
+    for (int a = 0; a < 3; a++)
+        tab_fill(q, a, b->lo[a], b->hi[a], q->n[a]);
+    int idx[3] = { 0, 0, 0 };
     for (int a = 0; a < ni && !poll(q); a++)
         for (int c = 0; c < nj; c++) {
-            p[i] = b->lo[i] + hi * q->gx[ni][a];
-            p[j] = b->lo[j] + hj * q->gx[nj][c];
-            line_set(q, k, p);
+            idx[i] = a + 1, idx[j] = c + 1;
+            line_set(q, k, idx);
             double wt = hi * q->gw[ni][a] * hj * q->gw[nj][c];
             if (definite)
-                line_gauss(q, b->lo[k], b->hi[k], wt);
+                line_gauss_tab(q, wt);
             else
                 line_integrate(q, b->lo[k], b->hi[k], wt);
         }
     memcpy(acc, q->r.acc, sizeof q->r.acc);
     memcpy(q->r.acc, saved, sizeof saved);
 }
-
-/* The fewest Gauss-Legendre points whose error on exp(i f t) over a panel of phase phi = f h is
- * below 1e-14: (e phi / 8n)^(2n), the rule's asymptotic error. */
-static int rule_points(double phi);
 
 /*
  * Where det J may change sign, the line integrals are not smooth across lines that touch its zero
@@ -394,7 +473,7 @@ static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int dep
         for (int e = 0; e < Q_N; e++)
             fine[e] += part[s][e];
     }
-    if (depth + 1 >= OUTER_DEPTH || q->stopped || fabs(fine[Q_VOL] - coarse[Q_VOL]) <= 1e-12 * q->vscale) {
+    if (depth + 1 >= OUTER_DEPTH || q->stopped || q->r.evals * q->modes >= REFINE_WORK || fabs(fine[Q_VOL] - coarse[Q_VOL]) <= 1e-12 * q->vscale) {
         memcpy(out, fine, sizeof fine);
         memcpy(q->n, saved_n, sizeof saved_n);
         return;
@@ -429,11 +508,14 @@ static void panel(qctx *q, const pbox *b)
     double acc[Q_N];
     panel_lines(q, b, k, definite, acc);
     /* Refined within a budget: the first REFINE_PANELS panels where det J may change sign. */
-    if (!definite && q->r.lined <= REFINE_PANELS) {
+    if (!definite && q->r.lined <= REFINE_PANELS && q->r.evals * q->modes < REFINE_WORK) {
         double refined[Q_N];
         box_refine(q, b, acc, 0, refined);
+        q->r.refined++;
+        q->r.refine_change += fabs(refined[Q_VOL] - acc[Q_VOL]);
         memcpy(acc, refined, sizeof acc);
-    }
+    } else if (!definite)
+        q->r.unrefined++;
     for (int e = 0; e < Q_N; e++)
         q->r.acc[e] += acc[e];
 }
@@ -470,72 +552,140 @@ static int rule_points(double phi)
     return n;
 }
 
-/* Panels and points for an integrand that multiplies `factors` of the solution's factors. */
-static void panels_for(const pde_solution *s, double factors, int np[3], int n[3])
+/*
+ * Panels and points for an integrand that multiplies `factors` of the solution's factors. Along w,
+ * panels never straddle a slab's break, where h's higher derivatives jump: each slab gets panels of
+ * its own, as many as its share of the axis calls for.
+ */
+static void plan_for(const pde_solution *s, double factors, qplan *p)
 {
     double f[3];
+    size_t mt = 1, nslabs;
+    for (int c = 0; c < 3; c++)
+        mt += s->comp[c].nmodes;
+    const double *br = solution_breaks(s, &nslabs);
     frequencies(s, factors, f);
+    int want[3];
     for (int a = 0; a < 3; a++) {
-        double p = ceil(f[a] / PANEL_PHASE);   /* then 12 points per panel */
-        np[a] = p < 1 ? 1 : p > MAX_PANELS ? MAX_PANELS : (int)p;
+        double v = ceil(f[a] / PANEL_PHASE);   /* then 12 points per panel */
+        want[a] = v < 1 ? 1 : v > MAX_PANELS ? MAX_PANELS : (int)v;
     }
-    /* Bounded work: past MAX_NODES in all, the busiest axis gets fewer, wider panels, and its rule
-     * more points, up to GMAX: beyond, the integrals lose digits (docs/MATH.md). */
+    /* Bounded work: past MAX_WORK in all, the busiest axis gets fewer, wider panels, and its rule
+     * more points, up to GMAX: beyond, the integrals lose digits, which p->err estimates. */
     for (;;) {
-        for (int a = 0; a < 3; a++)
-            n[a] = rule_points(f[a] / np[a]);
-        if ((double)np[0] * n[0] * np[1] * n[1] * np[2] * n[2] <= MAX_NODES)
+        for (int a = 0; a < 3; a++) {
+            int np = want[a];
+            if (a == 2) {
+                np = 0;
+                for (size_t k = 0; k < nslabs; k++) {
+                    int m = (int)ceil(want[2] * (br[k + 1] - br[k]) - 1e-9);
+                    np += m < 1 ? 1 : m;
+                }
+            }
+            p->np[a] = np;
+        }
+        /* The edges, and each axis's rule from its widest panel. */
+        for (int a = 0; a < 3; a++) {
+            double widest = 0.0;
+            if (a < 2) {
+                for (int i = 0; i <= p->np[a]; i++)
+                    p->edge[a][i] = (double)i / p->np[a];
+            } else {
+                int e = 0;
+                for (size_t k = 0; k < nslabs; k++) {
+                    int m = (int)ceil(want[2] * (br[k + 1] - br[k]) - 1e-9);
+                    m = m < 1 ? 1 : m;
+                    for (int i = 0; i < m; i++)
+                        p->edge[2][e++] = br[k] + (br[k + 1] - br[k]) * i / m;
+                }
+                p->edge[2][e] = 1.0;
+            }
+            for (int i = 0; i < p->np[a]; i++)
+                widest = fmax(widest, p->edge[a][i + 1] - p->edge[a][i]);
+            p->n[a] = rule_points(f[a] * widest);
+            p->phase[a] = f[a] * widest;
+        }
+        if ((double)p->np[0] * p->n[0] * p->np[1] * p->n[1] * p->np[2] * p->n[2] * (double)mt <= MAX_WORK)
             break;
-        int a = np[0] * n[0] >= np[1] * n[1] && np[0] * n[0] >= np[2] * n[2] ? 0 : np[1] * n[1] >= np[2] * n[2] ? 1 : 2;
-        if (np[a] == 1)
+        int a = want[0] * p->n[0] >= want[1] * p->n[1] && want[0] * p->n[0] >= want[2] * p->n[2] ? 0
+                : want[1] * p->n[1] >= want[2] * p->n[2] ? 1 : 2;
+        if (want[a] == 1)
             break;
-        np[a] = (np[a] + 1) / 2;
+        want[a] = (want[a] + 1) / 2;
+    }
+    /* The rules' asymptotic error on the fastest exp(i f t) of a panel, relative. */
+    p->err = 0.0;
+    for (int a = 0; a < 3; a++) {
+        double e = 2 * p->n[a] * log(M_E * p->phase[a] / (8.0 * p->n[a]));
+        p->err += e < -700 ? 0.0 : fmin(1.0, exp(e));
     }
 }
 
 void quad_panels(const pde_solution *s, int np[3], int n[3])
 {
-    panels_for(s, 5.0, np, n);   /* the second moments times det J: five factors */
+    qplan p;
+    plan_for(s, 5.0, &p);   /* the second moments times det J: five factors */
+    memcpy(np, p.np, sizeof p.np);
+    memcpy(n, p.n, sizeof p.n);
+}
+
+/* A context for s with its tables (one allocation), or NULL when out of memory. */
+static qctx *qctx_new(const pde_solution *s, const pde_cancel *cancel)
+{
+    qctx *q = calloc(1, sizeof *q);
+    if (!q)
+        return NULL;
+    for (int c = 0; c < 3; c++)
+        q->off[c] = q->mt, q->mt += s->comp[c].nmodes;
+    const size_t mt = q->mt ? q->mt : 1, per = (size_t)(GMAX + 2) * mt;
+    double *buf = malloc((5 * mt + 6 * per) * sizeof *buf);
+    if (!buf) {
+        free(q);
+        return NULL;
+    }
+    q->P = buf, q->Pi = buf + mt, q->Pj = buf + 2 * mt, q->g = buf + 3 * mt, q->dg = buf + 4 * mt;
+    for (int a = 0; a < 3; a++)
+        q->tab[a].val = buf + 5 * mt + 2 * a * per, q->tab[a].der = q->tab[a].val + per;
+    q->s = s;
+    q->cancel = cancel;
+    q->modes = q->mt + 1;
+    for (int k = 1; k <= GMAX; k++)
+        gauss_legendre(k, q->gx[k], q->gw[k]);
+    return q;
+}
+
+static void qctx_free(qctx *q)
+{
+    if (q)
+        free(q->P);
+    free(q);
 }
 
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale,
                       const pde_cancel *cancel, quad_result *out)
 {
-    size_t maxm = 1;
-    for (int c = 0; c < 3; c++)
-        maxm = s->comp[c].nmodes > maxm ? s->comp[c].nmodes : maxm;
-    qctx *q = calloc(1, sizeof *q);
-    double *buf = malloc(9 * maxm * sizeof *buf);
-    if (!q || !buf) {
-        free(q);
-        free(buf);
+    qctx *q = qctx_new(s, cancel);
+    if (!q)
         return PDE_ERR_NOMEM;
-    }
-    q->s = s;
-    q->cancel = cancel;
     memcpy(q->x0, x0, sizeof q->x0);
     q->jtol = 1e-13 * jscale;
     q->vscale = vscale;
-    q->maxm = maxm;
-    q->modes = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes + 1;
-    q->P = buf, q->Pi = buf + 3 * maxm, q->Pj = buf + 6 * maxm;
-    int np[3];
-    quad_panels(s, np, q->n);
+    qplan p;
+    plan_for(s, 5.0, &p);
+    memcpy(q->n, p.n, sizeof p.n);
+    q->r.err = p.err;
     frequencies(s, 5.0, q->f);
-    for (int k = 1; k <= GMAX; k++)
-        gauss_legendre(k, q->gx[k], q->gw[k]);
-    for (int i = 0; i < np[0]; i++)
-        for (int j = 0; j < np[1]; j++)
-            for (int l = 0; l < np[2] && !q->stopped; l++) {
-                pbox b = { { (double)i / np[0], (double)j / np[1], (double)l / np[2] },
-                           { (double)(i + 1) / np[0], (double)(j + 1) / np[1], (double)(l + 1) / np[2] } };
+    for (int i = 0; i < p.np[0]; i++)
+        for (int j = 0; j < p.np[1]; j++)
+            for (int l = 0; l < p.np[2] && !q->stopped; l++) {
+                pbox b = { { p.edge[0][i], p.edge[1][j], p.edge[2][l] },
+                           { p.edge[0][i + 1], p.edge[1][j + 1], p.edge[2][l + 1] } };
                 panel(q, &b);
             }
     pde_status st = q->stopped ? PDE_ERR_CANCELLED : PDE_OK;
     if (st == PDE_OK)
         *out = q->r;
-    free(buf);
-    free(q);
+    qctx_free(q);
     return st;
 }
 
@@ -577,52 +727,70 @@ static int faces_coincide(const pde_solution *s, int axis, double size)
  * edge of the skin, where the face folds over and x_a x x_b turns through zero to the opposite
  * direction. So each panel of a face is integrated like a panel of the solid where det J may
  * change sign: along lines, with the roots of s = (x_a x x_b) . nu, nu the element's direction at
- * the panel's centre, located to rounding and a rule on each piece.
+ * the panel's centre, located to rounding and a rule on each piece. The lines are the solid's
+ * (qctx) with the face's own axis fixed at its side.
  */
 typedef struct {
-    const pde_solution *s;
+    qctx *q;
     int axis, side, la;       /* the face, and the face parameter (0, 1) the lines run along */
-    double fixed;             /* the other face parameter on the current line */
+    int o[2];                 /* the face's parameters' axes */
     double nu[3], tol;
 } face_line;
 
-static double face_elem(const face_line *f, double t, double *sdir)
+/* |x_a x x_b| from the partials d, and (x_a x x_b) . nu into *sdir. */
+static double face_elem_of(const face_line *f, double d[3][3], double *sdir)
 {
-    double x[3], ta[3], tb[3];
-    if (f->la == 0)
-        face_point(f->s, f->axis, f->side, t, f->fixed, x, ta, tb);
-    else
-        face_point(f->s, f->axis, f->side, f->fixed, t, x, ta, tb);
+    const double *ta = d[f->o[0]], *tb = d[f->o[1]];
     const double c[3] = { ta[1] * tb[2] - ta[2] * tb[1], ta[2] * tb[0] - ta[0] * tb[2], ta[0] * tb[1] - ta[1] * tb[0] };
     *sdir = c[0] * f->nu[0] + c[1] * f->nu[1] + c[2] * f->nu[2];
     double m = fmax(fabs(c[0]), fmax(fabs(c[1]), fabs(c[2])));   /* scaled: no overflow in the squares */
     return m > 0.0 ? m * sqrt((c[0] / m) * (c[0] / m) + (c[1] / m) * (c[1] / m) + (c[2] / m) * (c[2] / m)) : 0.0;
 }
 
+/* The element at t on the current line, and at its table point it. */
+static double face_elem(const face_line *f, double t, double *sdir)
+{
+    double x[3], d[3][3];
+    line_eval_d(f->q, t, x, d);
+    return face_elem_of(f, d, sdir);
+}
+
+/* flux: x . (x_a x x_b), whose integrals over the faces give the signed volume (quad_area). */
+static double face_elem_at(const face_line *f, int it, double *sdir, double *flux)
+{
+    double x[3], d[3][3];
+    line_eval_at(f->q, it, x, d);
+    const double *ta = d[f->o[0]], *tb = d[f->o[1]];
+    *flux = x[0] * (ta[1] * tb[2] - ta[2] * tb[1]) + x[1] * (ta[2] * tb[0] - ta[0] * tb[2]) +
+            x[2] * (ta[0] * tb[1] - ta[1] * tb[0]);
+    return face_elem_of(f, d, sdir);
+}
+
 static double face_sign(void *arg, double t)
 {
     double sd;
-    face_elem(arg, t, &sd);
-    return sd;
+    return face_elem(arg, t, &sd), sd;
 }
 
 static double face_root(const face_line *f, double a, double b, double fa, double fb)
 {
-    return illinois(face_sign, (void *)f, a, b, fa, fb);   /* read only */
+    return illinois(face_sign, (void *)f, a, b, fa, fb);
 }
 
-/* The integral of |x_a x x_b| along the current line over [a, b], with an n-point rule. */
-static double face_line_integral(const face_line *f, double a, double b, int n, const double *gx, const double *gw)
+/* The integral of |x_a x x_b| along the current line over the panel [a, b], with the table's n-point
+ * rule at its nodes; and the flux's (smooth: the rule alone) into *flux. */
+static double face_line_integral(const face_line *f, double a, double b, int n, const double *gw, double *flux)
 {
-    double t[GMAX + 2], v[GMAX + 2] = { 0 }, sd[GMAX + 2];
-    t[0] = a, t[n + 1] = b;
-    for (int i = 0; i < n; i++)
-        t[i + 1] = a + (b - a) * gx[i];
+    double v[GMAX + 2] = { 0 }, sd[GMAX + 2], fl[GMAX + 2];
+    const double *t = f->q->tab[f->q->k].t;
     for (int i = 0; i < n + 2; i++)
-        v[i] = face_elem(f, t[i], &sd[i]);
+        v[i] = face_elem_at(f, i, &sd[i], &fl[i]);
+    *flux = 0.0;
+    for (int i = 0; i < n; i++)
+        *flux += (b - a) * gw[i] * fl[i + 1];
     double cut[GMAX + 2], sum = 0.0;
     int ncut = 0, last = 0;
-    for (int i = 1; i < n + 2; i++) {
+    for (int i = 1; i < n + 2 && off_budget(f->q); i++) {
         if (sign_changes(sd[last], sd[i], f->tol))
             cut[ncut++] = face_root(f, t[last], t[i], sd[last], sd[i]);
         if (fabs(sd[i]) > f->tol || fabs(sd[last]) <= f->tol)
@@ -638,8 +806,8 @@ static double face_line_integral(const face_line *f, double a, double b, int n, 
         double t1 = c < ncut ? cut[c] : b;
         if (!(t1 > t0))
             continue;
-        for (int i = 0; i < n; i++)
-            sum += (t1 - t0) * gw[i] * face_elem(f, t0 + (t1 - t0) * gx[i], &dummy);
+        for (int i = 0; i < n; i++)   /* the panel's rule: the element's root is a kink of sqrt */
+            sum += (t1 - t0) * gw[i] * face_elem(f, t0 + (t1 - t0) * f->q->gx[n][i], &dummy);
         t0 = t1;
     }
     return sum;
@@ -648,7 +816,6 @@ static double face_line_integral(const face_line *f, double a, double b, int n, 
 typedef struct {
     face_line line;
     double f[2];                 /* the element's frequencies along the face's parameters */
-    double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];
     double tol;                  /* of a panel's refinement, absolute */
     const pde_cancel *cancel;
     int refined;                 /* panels refined so far */
@@ -656,12 +823,15 @@ typedef struct {
 } face_ctx;
 
 /* One panel [lo, lo + h] of the face: lines along the parameter that crosses the sign changes of
- * the element's component along its direction at the centre most often, rules sized to it. */
-static double face_panel(face_ctx *c, const double lo[2], const double h[2])
+ * the element's component along its direction at the centre most often, rules sized to it. The
+ * flux's integral goes into *flux. */
+static double face_panel(face_ctx *c, const double lo[2], const double h[2], double *flux)
 {
     face_line *f = &c->line;
+    qctx *q = f->q;
+    const pde_solution *s = q->s;
     double x[3], ta[3], tb[3], big = 0.0;
-    face_point(f->s, f->axis, f->side, lo[0] + 0.5 * h[0], lo[1] + 0.5 * h[1], x, ta, tb);
+    face_point(s, f->axis, f->side, lo[0] + 0.5 * h[0], lo[1] + 0.5 * h[1], x, ta, tb);
     f->nu[0] = ta[1] * tb[2] - ta[2] * tb[1], f->nu[1] = ta[2] * tb[0] - ta[0] * tb[2];
     f->nu[2] = ta[0] * tb[1] - ta[1] * tb[0];
     double nn = sqrt(f->nu[0] * f->nu[0] + f->nu[1] * f->nu[1] + f->nu[2] * f->nu[2]);
@@ -671,8 +841,10 @@ static double face_panel(face_ctx *c, const double lo[2], const double h[2])
     double sd[S][S];
     for (int i = 0; i < S; i++)
         for (int j = 0; j < S; j++) {
-            f->la = 0, f->fixed = lo[1] + h[1] * (j + 0.5) / S;
-            big = fmax(big, face_elem(f, lo[0] + h[0] * (i + 0.5) / S, &sd[i][j]));
+            double d[3][3], dummy[3];
+            double pa = lo[0] + h[0] * (i + 0.5) / S, pb = lo[1] + h[1] * (j + 0.5) / S;
+            face_point(s, f->axis, f->side, pa, pb, dummy, d[f->o[0]], d[f->o[1]]);
+            big = fmax(big, face_elem_of(f, d, &sd[i][j]));
         }
     f->tol = 1e-13 * big;
     int cross[2] = { 0, 0 };
@@ -683,10 +855,19 @@ static double face_panel(face_ctx *c, const double lo[2], const double h[2])
         }
     f->la = cross[1] > cross[0];
     const int lb = 1 - f->la, na = rule_points(c->f[f->la] * h[f->la]), nb = rule_points(c->f[lb] * h[lb]);
-    double total = 0.0;
+    const int ka = f->o[f->la], kb = f->o[lb];
+    tab_fill(q, f->axis, f->side, f->side, 0);
+    tab_fill(q, ka, lo[f->la], lo[f->la] + h[f->la], na);
+    tab_fill(q, kb, lo[lb], lo[lb] + h[lb], nb);
+    int idx[3];
+    idx[f->axis] = 0;
+    double total = 0.0, fl;
+    *flux = 0.0;
     for (int i = 0; i < nb; i++) {
-        f->fixed = lo[lb] + h[lb] * c->gx[nb][i];
-        total += h[lb] * c->gw[nb][i] * face_line_integral(f, lo[f->la], lo[f->la] + h[f->la], na, c->gx[na], c->gw[na]);
+        idx[kb] = i + 1;
+        line_set(q, ka, idx);
+        total += h[lb] * q->gw[nb][i] * face_line_integral(f, lo[f->la], lo[f->la] + h[f->la], na, q->gw[na], &fl);
+        *flux += h[lb] * q->gw[nb][i] * fl;
     }
     return total;
 }
@@ -699,9 +880,11 @@ static double face_refine(face_ctx *c, const double lo[2], const double h[2], do
     double q[4], ql[4][2], hh[2] = { 0.5 * h[0], 0.5 * h[1] }, fine = 0.0;
     for (int k = 0; k < 4; k++) {
         ql[k][0] = lo[0] + (k & 1) * hh[0], ql[k][1] = lo[1] + (k >> 1) * hh[1];
-        fine += q[k] = face_panel(c, ql[k], hh);
+        double fl;
+        fine += q[k] = face_panel(c, ql[k], hh, &fl);
     }
-    if (c->stopped || depth + 1 >= FACE_DEPTH || fabs(fine - coarse) <= c->tol)
+    if (c->stopped || depth + 1 >= FACE_DEPTH || c->line.q->r.evals * c->line.q->modes >= REFINE_WORK ||
+        fabs(fine - coarse) <= c->tol)
         return fine;
     double sum = 0.0;
     for (int k = 0; k < 4; k++)
@@ -716,20 +899,23 @@ static double face_refine(face_ctx *c, const double lo[2], const double h[2], do
  * 1e-13 of the solid's size squared, down to FACE_DEPTH halvings (in a small panel the lines
  * cross an edge rather than touch it), for the first FACE_REFINE panels.
  */
-pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area)
+pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area,
+                     quad_result *info)
 {
     face_ctx *c = calloc(1, sizeof *c);
-    if (!c)
+    qctx *q = qctx_new(s, cancel);
+    if (!c || !q) {
+        free(c);
+        qctx_free(q);
         return PDE_ERR_NOMEM;
-    int np[3], n[3];
-    panels_for(s, 5.0, np, n);
+    }
+    qplan p;
+    plan_for(s, 5.0, &p);
     double f[3];
     frequencies(s, 5.0, f);
-    for (int k = 1; k <= GMAX; k++)
-        gauss_legendre(k, c->gx[k], c->gw[k]);
     c->tol = 1e-13 * size * size;
     c->cancel = cancel;
-    double total = 0.0;
+    double total = 0.0, flux = 0.0;
     for (int axis = 0; axis < 3 && !c->stopped; axis++) {
         if (faces_coincide(s, axis, size))
             continue;   /* both lie inside the solid, as api/mesh.c drops them */
@@ -738,22 +924,30 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
             if (k != axis)
                 o[m++] = k;
         c->f[0] = f[o[0]], c->f[1] = f[o[1]];
-        const double h[2] = { 1.0 / np[o[0]], 1.0 / np[o[1]] };
         for (int side = 0; side < 2; side++) {
-            c->line = (face_line){ .s = s, .axis = axis, .side = side };
-            for (int pa = 0; pa < np[o[0]] && !c->stopped; pa++)
-                for (int pb = 0; pb < np[o[1]] && !c->stopped; pb++) {
-                    const double lo[2] = { pa * h[0], pb * h[1] };
+            c->line = (face_line){ .q = q, .axis = axis, .side = side, .o = { o[0], o[1] } };
+            for (int pa = 0; pa < p.np[o[0]] && !c->stopped; pa++)
+                for (int pb = 0; pb < p.np[o[1]] && !c->stopped; pb++) {
+                    const double *ea = p.edge[o[0]], *eb = p.edge[o[1]];
+                    const double lo[2] = { ea[pa], eb[pb] }, h[2] = { ea[pa + 1] - ea[pa], eb[pb + 1] - eb[pb] };
                     if (pde_stopped(cancel))   /* a panel of a face */
                         c->stopped = 1;
-                    double a = face_panel(c, lo, h);
-                    total += c->refined++ >= FACE_REFINE ? a : face_refine(c, lo, h, a, 0);
+                    double fl, a = face_panel(c, lo, h, &fl);
+                    /* Outward: side 1 along +axis; (o0, o1, axis) is odd for axis 1. */
+                    flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fl;
+                    total += c->refined++ >= FACE_REFINE || q->r.evals * q->modes >= REFINE_WORK
+                                 ? a : face_refine(c, lo, h, a, 0);
                 }
         }
     }
     pde_status st = c->stopped ? PDE_ERR_CANCELLED : PDE_OK;
     free(c);
-    if (st == PDE_OK)
+    if (st == PDE_OK) {
         *area = total;
+        q->r.err = p.err;
+        q->r.acc[Q_SIGNED] = flux / 3.0;
+        *info = q->r;
+    }
+    qctx_free(q);
     return st;
 }

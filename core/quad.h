@@ -15,6 +15,11 @@ typedef struct {
     double acc[Q_N];
     size_t evals;       /* points evaluated */
     size_t lined;       /* panels integrated along lines, where det J may change sign */
+    double err;         /* the rules' estimated error on the fastest term, relative: 1e-14 unless the
+                         * work's bound made them coarser */
+    size_t refined, unrefined;   /* lined panels refined, and left unrefined by the work's bound */
+    double refine_change;        /* the sum of what refinement changed of the refined panels' volume */
+    int roots_skipped;  /* the work's bound stopped lines locating det J's roots (or the area's) */
 } quad_result;
 
 /* jscale: the size of det J over the solid, for what counts as zero; vscale: the size of the
@@ -22,8 +27,11 @@ typedef struct {
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale,
                       const pde_cancel *cancel, quad_result *out);
 
-/* The area of the skin; size: the solid's extent, for deciding that two faces coincide. */
-pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area);
+/* The area of the skin; size: the solid's extent, for deciding that two faces coincide. Its panels
+ * are the solid's, and so is its rules' error. info->acc[Q_SIGNED] is the signed volume computed
+ * another way, from the faces: (1/3) of the flux of x through them (divergence theorem). */
+pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area,
+                     quad_result *info);
 
 /* Panels per axis and Gauss-Legendre points per panel on each axis (also for api/cost.h). */
 void quad_panels(const pde_solution *s, int np[3], int n[3]);

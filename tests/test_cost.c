@@ -405,6 +405,38 @@ static void every_preset_in_every_format_should_stay_well_under_the_budget(void 
     }
 }
 
+/*
+ * A model a designer might write: 16 cosine modes in u per component, a solid that folds. Its
+ * properties took 6.7 s and pdesolidd refused every request for it (1.06e10 units); they are now
+ * bounded by PDE_PROPS_WORK (about 0.5 s here) and fit the default budget of 1e9 with json.
+ */
+static void a_model_of_sixteen_modes_per_component_should_fit_the_default_budget(void **state)
+{
+    (void)state;
+    pde_bterm b[3][16];
+    for (int c = 0; c < 3; c++) {
+        b[c][0] = c == 2 ? (pde_bterm){ F_pow(0), F_pow(0), 0, 1, 1, 1 }
+                         : (pde_bterm){ c == 0 ? F_pow(1) : F_pow(0), c == 1 ? F_pow(1) : F_pow(0), 1, 0, 1, 0 };
+        for (int k = 1; k < 16 && c < 2; k++)
+            b[c][k] = (pde_bterm){ F_cos(k), F_sin(1 + c), 0.3 / (k * k), 0.1 / k, 0.2 / (k * k), 0 };
+    }
+    pde_model m = { { { 1, 1, -1, b[0], 16, NULL, 0 }, { 1, 1, -1, b[1], 16, NULL, 0 }, { 1, 1, -1, b[2], 1, NULL, 0 } } };
+    api_cost total = { 0, 0 }, part;
+    api_cost_solve(&m, &part);
+    api_cost_add(&total, &part);
+    pde_solution *sol;
+    assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
+    api_cost_props(sol, &part);
+    api_cost_add(&total, &part);
+    unsigned res[3];
+    assert_int_equal(api_res_parse(NULL, API_FMT_JSON, res, NULL), 0);
+    api_cost_output(sol, API_FMT_JSON, res, &part);
+    api_cost_add(&total, &part);
+    if (!(total.work < 1e9))
+        fail_msg("16 modes per component: %.3g units, over the default --max-work of 1e9", total.work);
+    pde_solution_free(sol);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -419,6 +451,7 @@ int main(void)
         cmocka_unit_test(eval_work_should_be_linear_in_the_points),
         cmocka_unit_test(heavy_requests_of_the_issue_should_exceed_the_budget),
         cmocka_unit_test(every_preset_in_every_format_should_stay_well_under_the_budget),
+        cmocka_unit_test(a_model_of_sixteen_modes_per_component_should_fit_the_default_budget),
     };
     test_filter_from_env();
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -111,6 +111,7 @@ static size_t prop_paths(pde_props *p, prop_path out[32])
         { NULL, "surface_area", "surface_area", &p->surface_area, 1 },
         { "residuals", "boundary", "residuals_boundary", &p->bc_residual, 1 },
         { "residuals", "pde", "residuals_pde", &p->pde_residual, 1 },
+        { "residuals", "integrals", "residuals_integrals", &p->integral_error, 1 },
     };
     memcpy(out, all, sizeof all);
     return sizeof all / sizeof *all;
