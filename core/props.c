@@ -421,9 +421,8 @@ static void mass_properties(const quad_result *q, const double x0[3], pde_props 
  * volume by the solid's rules against the same by the faces' (divergence theorem), which shows
  * whether the rules resolve the solid's frequencies; 1e-12, the refinement's tolerance, where det J
  * may change sign; for panels where det J may change sign left
- * unrefined by the work's bound, what refinement changed on the refined ones, on average, times the
- * square root of their number (errors of random sign; 1e-4 of the volume when none was refined: the
- * unrefined error measured on fig. 4l); at least 1e-2 when lines stopped locating roots.
+ * unrefined by the work's bound, what refinement changed on the refined ones, on average, times their
+ * number (1e-4 of the volume when none was refined: the unrefined error measured on fig. 4l); at least 1e-2 when lines stopped locating roots.
  */
 static double integral_error(const quad_result *q, const quad_result *qa)
 {
@@ -432,7 +431,7 @@ static double integral_error(const quad_result *q, const quad_result *qa)
     if (q->lined)
         e += 1e-12;   /* the refinement's tolerance where det J may change sign */
     if (q->unrefined)
-        e += q->refined ? sqrt((double)q->unrefined) * q->refine_change / q->refined / vol : 1e-4;
+        e += q->refined ? q->unrefined * q->refine_change / q->refined / vol : 1e-4;
     if (q->roots_skipped || qa->roots_skipped)
         e = fmax(e, 1e-2);
     return fmin(e, 1.0);

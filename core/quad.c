@@ -71,6 +71,8 @@ typedef struct {
     int n[3];                    /* the current panel's points per axis */
     size_t off[3], mt;           /* modes of the components before c; modes in all */
     axis_tab tab[3];             /* the current panel's factors */
+    pbox tab_box;                /* the box of the tables when tab_ok (tabs_for) */
+    int tab_n[3], tab_ok;
     double *g, *dg;              /* mt: the line's own factor at a point off the tables */
     /* The current line: along axis k, per mode, the fixed factors' product P and its derivatives
      * along the two other axes (i, j in axis order). */
@@ -146,6 +148,18 @@ static void tab_fill(qctx *q, int a, double lo, double hi, int n)
             for (size_t m = 0; m < cs->nmodes; m++)
                 factor_on(&cs->modes[m], a, tb->t[i], &tb->val[o + m], &tb->der[o + m]);
         }
+}
+
+/* The tables of box b with the current rules, unless they are already. */
+static void tabs_for(qctx *q, const pbox *b)
+{
+    if (q->tab_ok && !memcmp(&q->tab_box, b, sizeof *b) && !memcmp(q->tab_n, q->n, sizeof q->tab_n))
+        return;
+    for (int a = 0; a < 3; a++)
+        tab_fill(q, a, b->lo[a], b->hi[a], q->n[a]);
+    q->tab_box = *b;
+    memcpy(q->tab_n, q->n, sizeof q->tab_n);
+    q->tab_ok = 1;
 }
 
 /* Fixes the line along axis k through the tables' points idx[a] of the two other axes. */
@@ -385,15 +399,33 @@ static int line_axis(qctx *q, const pbox *b)
 {
     enum { S = 4 };
     double j[S][S][S];
+    tabs_for(q, b);
+    int at[3][S];   /* the table's points nearest (i + 1/2) / S of each axis */
+    for (int a = 0; a < 3; a++)
+        for (int i = 0; i < S; i++) {
+            const double want = b->lo[a] + (b->hi[a] - b->lo[a]) * (i + 0.5) / S;
+            int best = 0;
+            for (int t = 1; t < q->n[a] + 2; t++)
+                if (fabs(q->tab[a].t[t] - want) < fabs(q->tab[a].t[best] - want))
+                    best = t;
+            at[a][i] = best;
+        }
     for (int a = 0; a < S; a++)
         for (int c = 0; c < S; c++)
             for (int e = 0; e < S; e++) {
-                double p[3] = { b->lo[0] + (b->hi[0] - b->lo[0]) * (a + 0.5) / S,
-                                b->lo[1] + (b->hi[1] - b->lo[1]) * (c + 0.5) / S,
-                                b->lo[2] + (b->hi[2] - b->lo[2]) * (e + 0.5) / S };
-                double xu[3], xv[3], xw[3];
-                pde_eval_d(q->s, p[0], p[1], p[2], NULL, xu, xv, xw);
-                j[a][c][e] = det3(xu, xv, xw);
+                const size_t o0 = (size_t)at[0][a] * q->mt, o1 = (size_t)at[1][c] * q->mt, o2 = (size_t)at[2][e] * q->mt;
+                double d[3][3];
+                for (int comp = 0; comp < 3; comp++) {
+                    double su = 0, sv = 0, sw = 0;
+                    for (size_t o = q->off[comp], end = o + q->s->comp[comp].nmodes; o < end; o++) {
+                        const double U = q->tab[0].val[o0 + o], dU = q->tab[0].der[o0 + o];
+                        const double V = q->tab[1].val[o1 + o], dV = q->tab[1].der[o1 + o];
+                        const double H = q->tab[2].val[o2 + o], dH = q->tab[2].der[o2 + o];
+                        su += dU * V * H, sv += U * dV * H, sw += U * V * dH;
+                    }
+                    d[0][comp] = su, d[1][comp] = sv, d[2][comp] = sw;
+                }
+                j[a][c][e] = det3(d[0], d[1], d[2]);
             }
     double cross[3] = { 0, 0, 0 }, vary[3] = { 0, 0, 0 };
     for (int a = 0; a < S; a++)
@@ -423,8 +455,7 @@ static void panel_lines(qctx *q, const pbox *b, int k, int definite, double acc[
     int i = k == 0 ? 1 : 0, j = k == 2 ? 1 : 2;
     const int ni = q->n[i], nj = q->n[j];
     const double hi = b->hi[i] - b->lo[i], hj = b->hi[j] - b->lo[j];
-    for (int a = 0; a < 3; a++)
-        tab_fill(q, a, b->lo[a], b->hi[a], q->n[a]);
+    tabs_for(q, b);
     int idx[3] = { 0, 0, 0 };
     for (int a = 0; a < ni && !poll(q); a++)
         for (int c = 0; c < nj; c++) {
@@ -856,6 +887,7 @@ static double face_panel(face_ctx *c, const double lo[2], const double h[2], dou
     f->la = cross[1] > cross[0];
     const int lb = 1 - f->la, na = rule_points(c->f[f->la] * h[f->la]), nb = rule_points(c->f[lb] * h[lb]);
     const int ka = f->o[f->la], kb = f->o[lb];
+    q->tab_ok = 0;
     tab_fill(q, f->axis, f->side, f->side, 0);
     tab_fill(q, ka, lo[f->la], lo[f->la] + h[f->la], na);
     tab_fill(q, kb, lo[lb], lo[lb] + h[lb], nb);
