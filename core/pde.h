@@ -299,7 +299,7 @@ typedef struct {
     double surface_area;     /* of the closed skin: collapsed faces add nothing, inner seams are left out */
     double bc_residual;      /* largest error of x, x_w on w = 0, 1, relative to the data and force (MATH.md) */
     double pde_residual;     /* largest a x_uuuu + b x_vvvv + c x_wwww - p, relative to its largest term */
-    double integral_error;   /* the integrals' (volume ... surface_area) estimated error, relative: about
+    double integral_error;   /* the estimated error of volume, signed_volume, centroid, inertia, relative: about
                               * 1e-14 unless PDE_PROPS_WORK bounded them (docs/MATH.md) */
 } pde_props;
 

@@ -150,6 +150,33 @@ static void tab_fill(qctx *q, int a, double lo, double hi, int n)
         }
 }
 
+/* x's partials d[axis][component] at the tables' points idx[0], idx[1], idx[2]. */
+static void tab_partials(const qctx *q, const int idx[3], double d[3][3])
+{
+    const size_t o0 = (size_t)idx[0] * q->mt, o1 = (size_t)idx[1] * q->mt, o2 = (size_t)idx[2] * q->mt;
+    for (int c = 0; c < 3; c++) {
+        double su = 0, sv = 0, sw = 0;
+        for (size_t o = q->off[c], end = o + q->s->comp[c].nmodes; o < end; o++) {
+            const double U = q->tab[0].val[o0 + o], dU = q->tab[0].der[o0 + o];
+            const double V = q->tab[1].val[o1 + o], dV = q->tab[1].der[o1 + o];
+            const double H = q->tab[2].val[o2 + o], dH = q->tab[2].der[o2 + o];
+            su += dU * V * H, sv += U * dV * H, sw += U * V * dH;
+        }
+        d[0][c] = su, d[1][c] = sv, d[2][c] = sw;
+    }
+}
+
+/* The table's point of axis a nearest to t. */
+static int tab_nearest(const qctx *q, int a, double t)
+{
+    const axis_tab *tb = &q->tab[a];
+    int best = 0;
+    for (int i = 1; i < (tb->n ? tb->n + 2 : 1); i++)
+        if (fabs(tb->t[i] - t) < fabs(tb->t[best] - t))
+            best = i;
+    return best;
+}
+
 /* The tables of box b with the current rules, unless they are already. */
 static void tabs_for(qctx *q, const pbox *b)
 {
@@ -402,29 +429,13 @@ static int line_axis(qctx *q, const pbox *b)
     tabs_for(q, b);
     int at[3][S];   /* the table's points nearest (i + 1/2) / S of each axis */
     for (int a = 0; a < 3; a++)
-        for (int i = 0; i < S; i++) {
-            const double want = b->lo[a] + (b->hi[a] - b->lo[a]) * (i + 0.5) / S;
-            int best = 0;
-            for (int t = 1; t < q->n[a] + 2; t++)
-                if (fabs(q->tab[a].t[t] - want) < fabs(q->tab[a].t[best] - want))
-                    best = t;
-            at[a][i] = best;
-        }
+        for (int i = 0; i < S; i++)
+            at[a][i] = tab_nearest(q, a, b->lo[a] + (b->hi[a] - b->lo[a]) * (i + 0.5) / S);
     for (int a = 0; a < S; a++)
         for (int c = 0; c < S; c++)
             for (int e = 0; e < S; e++) {
-                const size_t o0 = (size_t)at[0][a] * q->mt, o1 = (size_t)at[1][c] * q->mt, o2 = (size_t)at[2][e] * q->mt;
                 double d[3][3];
-                for (int comp = 0; comp < 3; comp++) {
-                    double su = 0, sv = 0, sw = 0;
-                    for (size_t o = q->off[comp], end = o + q->s->comp[comp].nmodes; o < end; o++) {
-                        const double U = q->tab[0].val[o0 + o], dU = q->tab[0].der[o0 + o];
-                        const double V = q->tab[1].val[o1 + o], dV = q->tab[1].der[o1 + o];
-                        const double H = q->tab[2].val[o2 + o], dH = q->tab[2].der[o2 + o];
-                        su += dU * V * H, sv += U * dV * H, sw += U * V * dH;
-                    }
-                    d[0][comp] = su, d[1][comp] = sv, d[2][comp] = sw;
-                }
+                tab_partials(q, (const int[3]){ at[0][a], at[1][c], at[2][e] }, d);
                 j[a][c][e] = det3(d[0], d[1], d[2]);
             }
     double cross[3] = { 0, 0, 0 }, vary[3] = { 0, 0, 0 };
@@ -868,6 +879,8 @@ static double face_panel(face_ctx *c, const double lo[2], const double h[2], dou
     double nn = sqrt(f->nu[0] * f->nu[0] + f->nu[1] * f->nu[1] + f->nu[2] * f->nu[2]);
     for (int k = 0; k < 3; k++)
         f->nu[k] = nn > 0 ? f->nu[k] / nn : (k == 2);
+    /* Sampled evenly, not at the rules' nodes: the lines' direction decides how well a cuspidal
+     * edge is integrated (fig. 3a's area moved by 1.5e-7 when sampled at the nodes). */
     enum { S = 4 };
     double sd[S][S];
     for (int i = 0; i < S; i++)
