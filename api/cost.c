@@ -262,7 +262,9 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
     for (int i = 0; i < 3; i++)
         w += rres * rres * rres * (st[i].d4 + 2.0 * st[i].d0 + 3.0 * (st[i].fu + st[i].fv));
     c->work = w;
-    c->bytes = grid_bytes(st, res, res) + 64.0 * (PDE_PROPS_BOXES + PDE_PROPS_BOXES_J) + 64.0 * modes + 65536.0;
+    /* core/quad.c's factor tables: each axis's values and derivatives at up to 26 points per mode. */
+    c->bytes = grid_bytes(st, res, res) + 64.0 * (PDE_PROPS_BOXES + PDE_PROPS_BOXES_J) + 64.0 * modes + 65536.0 +
+               8.0 * (6.0 * 26.0 + 5.0) * (modes + 1.0);
 }
 
 /* ---- outputs ---- */
