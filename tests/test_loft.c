@@ -14,6 +14,7 @@
 
 #include <cmocka.h>
 
+#include "describe.h"
 #include "internal.h"
 #include "support.h"
 
@@ -518,6 +519,26 @@ static void sampling_and_bounds_use_the_slab_of_w(void **state)
     pde_solution_free(sol);
 }
 
+static void the_text_closed_form_shows_each_slab_of_a_loft(void **state)
+{
+    (void)state;
+    const double w[3] = { 0, 0.4, 1 };
+    const int tan[3] = { 0, 0, 0 };
+    lf_t l;
+    lf_init(&l, 3, w, tan);
+    lf_add(&l, 0, F_pow(1), F_cos(2));
+    pde_solution *sol = lf_solve(&l);
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    api_describe(f, sol, NULL);
+    fclose(f);
+    assert_non_null(strstr(text, "on 0 <= w <= 0.4:"));
+    assert_non_null(strstr(text, "on 0.4 <= w <= 1:"));
+    free(text);
+    pde_solution_free(sol);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -533,6 +554,7 @@ int main(void)
         cmocka_unit_test(every_bad_loft_is_refused_with_its_diag),
         cmocka_unit_test(a_cancelled_loft_solve_returns_cancelled),
         cmocka_unit_test(sampling_and_bounds_use_the_slab_of_w),
+        cmocka_unit_test(the_text_closed_form_shows_each_slab_of_a_loft),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
