@@ -550,8 +550,8 @@ static pde_status solve_component(arena *mem, arena *scratch, plan_list *plans, 
     const pde_lcomponent *c = &lf->comp[ci];
     comp_solution *out = &sol->comp[ci];
     const size_t K = lf->nsections, S = K - 1, nu = 4 * S;
-    lmode *modes;
-    size_t n;
+    lmode *modes = NULL;
+    size_t n = 0;
     pde_status st = collect(scratch, lf, ci, &modes, &n, diag);
     if (st != PDE_OK)
         return st;
