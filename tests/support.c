@@ -1320,6 +1320,7 @@ typedef struct {
 typedef struct {
     pde_factor u, v;
     size_t t0, nt;
+    const pde_mode *md;      /* for a loft's slabs: terms t0 + first[s] .. on slab s */
 } rp_mode;
 
 typedef struct {
@@ -1407,7 +1408,7 @@ static int rp_init(rp_eval *e, const pde_solution *s)
         size_t n;
         const pde_mode *md = pde_solution_modes(s, c, &n);
         for (size_t m = 0; m < n; m++, k++) {
-            e->modes[k] = (rp_mode){ md[m].u, md[m].v, t, md[m].nterms };
+            e->modes[k] = (rp_mode){ md[m].u, md[m].v, t, md[m].nterms, &md[m] };
             for (size_t j = 0; j < md[m].nterms; j++, t++) {
                 const pde_wterm *w = &md[m].terms[j];
                 size_t x = 0;
@@ -1438,7 +1439,17 @@ static int rp_init(rp_eval *e, const pde_solution *s)
 static void rp_h(const rp_eval *e, size_t m, double w, int cached, double *h, double *dh)
 {
     *h = 0, *dh = 0;
-    for (size_t t = e->modes[m].t0; t < e->modes[m].t0 + e->modes[m].nt; t++) {
+    size_t t0 = e->modes[m].t0, t1 = t0 + e->modes[m].nt;
+    const pde_mode *pm = e->modes[m].md;
+    if (pm->nslabs > 1) {
+        /* A loft: the slab of w, the right one at a break (pde.h). */
+        size_t sl = 0;
+        while (sl + 1 < pm->nslabs && w >= pm->breaks[sl + 1])
+            sl++;
+        t1 = t0 + pm->first[sl + 1];
+        t0 += pm->first[sl];
+    }
+    for (size_t t = t0; t < t1; t++) {
         const rp_wterm *q = &e->wt[t];
         const rp_exp *x = &e->ex[q->exp];
         double a = 0, da = 0, b = 0, db = 0;
