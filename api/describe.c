@@ -112,13 +112,23 @@ void api_describe(FILE *out, const pde_solution *sol, const pde_props *props)
             api_factor_text(fv, sizeof fv, modes[m].v, 'v');
             fprintf(out, "  %s * %s  [", fu, fv);
             regime(out, modes[m].e);
-            fputs("]\n    h(w) = ", out);
-            for (size_t k = 0; k < modes[m].nterms; k++) {
-                if (k)
-                    fputs("\n         + ", out);
-                wterm(out, &modes[m].terms[k]);
+            fputs("]\n", out);
+            /* A loft's mode is piecewise: one h(w) per slab. */
+            const pde_mode *md = &modes[m];
+            for (size_t sl = 0; sl < (md->nslabs > 1 ? md->nslabs : 1); sl++) {
+                size_t t0 = md->nslabs > 1 ? md->first[sl] : 0, t1 = md->nslabs > 1 ? md->first[sl + 1] : md->nterms;
+                if (md->nslabs > 1)
+                    fprintf(out, "    on %.10g <= w <= %.10g:\n", md->breaks[sl], md->breaks[sl + 1]);
+                fputs("    h(w) = ", out);
+                for (size_t k = t0; k < t1; k++) {
+                    if (k > t0)
+                        fputs("\n         + ", out);
+                    wterm(out, &md->terms[k]);
+                }
+                if (t0 == t1)
+                    fputs("0", out);
+                fputc('\n', out);
             }
-            fputc('\n', out);
         }
     }
     if (props)

@@ -420,17 +420,28 @@ static int json_document(api_output *o, const pde_cancel *cancel, api_error *err
             cJSON_AddItemToObject(mo, "u", api_factor_tree(md[m].u));
             cJSON_AddItemToObject(mo, "v", api_factor_tree(md[m].v));
             cJSON_AddNumberToObject(mo, "e", md[m].e);
-            if (!(terms = cJSON_AddArrayToObject(mo, "h")))
-                continue;
-            for (size_t t = 0; t < md[m].nterms; t++) {
-                const pde_wterm *w = &md[m].terms[t];
-                cJSON *to = cJSON_CreateObject();
-                cJSON_AddItemToArray(terms, to);
-                cJSON_AddNumberToObject(to, "alpha", w->alpha);
-                cJSON_AddNumberToObject(to, "beta", w->beta);
-                cJSON_AddNumberToObject(to, "shift", w->shift);
-                cJSON_AddItemToObject(to, "A", numbers(w->A, w->deg + 1));
-                cJSON_AddItemToObject(to, "B", numbers(w->B, w->deg + 1));
+            /* A loft's mode is piecewise: "slabs": [{"w": [w0, w1], "h": [...]}] instead of "h". */
+            cJSON *slabs = md[m].nslabs > 1 ? cJSON_AddArrayToObject(mo, "slabs") : NULL;
+            for (size_t sl = 0; sl < (slabs ? md[m].nslabs : 1); sl++) {
+                cJSON *holder = mo;
+                if (slabs) {
+                    holder = cJSON_CreateObject();
+                    cJSON_AddItemToArray(slabs, holder);
+                    cJSON_AddItemToObject(holder, "w", numbers(md[m].breaks + sl, 2));
+                }
+                if (!(terms = cJSON_AddArrayToObject(holder, "h")))
+                    continue;
+                size_t t0 = slabs ? md[m].first[sl] : 0, t1 = slabs ? md[m].first[sl + 1] : md[m].nterms;
+                for (size_t t = t0; t < t1; t++) {
+                    const pde_wterm *w = &md[m].terms[t];
+                    cJSON *to = cJSON_CreateObject();
+                    cJSON_AddItemToArray(terms, to);
+                    cJSON_AddNumberToObject(to, "alpha", w->alpha);
+                    cJSON_AddNumberToObject(to, "beta", w->beta);
+                    cJSON_AddNumberToObject(to, "shift", w->shift);
+                    cJSON_AddItemToObject(to, "A", numbers(w->A, w->deg + 1));
+                    cJSON_AddItemToObject(to, "B", numbers(w->B, w->deg + 1));
+                }
             }
         }
     }

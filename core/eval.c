@@ -55,7 +55,9 @@ double pde_eval_partial(const pde_solution *sol, int comp, double u, double v, d
         if (fu == 0.0 || fv == 0.0)
             continue;
         double h = 0.0;
-        for (size_t k = 0; k < md->nterms; k++)
+        size_t k0, k1;
+        mode_slab(md, w, &k0, &k1);
+        for (size_t k = k0; k < k1; k++)
             h += wterm_deriv(&md->terms[k], w, nw);
         s += h * fu * fv;
     }

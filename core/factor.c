@@ -128,7 +128,9 @@ static void horner2(const double *c, int deg, double w, double *p, double *dp)
 void mode_h(const pde_mode *m, double w, double *h, double *dh)
 {
     double hv = 0.0, hd = 0.0;
-    for (size_t k = 0; k < m->nterms; k++) {
+    size_t k0, k1;
+    mode_slab(m, w, &k0, &k1);
+    for (size_t k = k0; k < k1; k++) {
         const pde_wterm *t = &m->terms[k];
         double a, da;
         horner2(t->A, t->deg, w, &a, &da);
@@ -214,7 +216,9 @@ void mode_h_derivs(const pde_mode *m, double w, int n, double *d)
 {
     for (int k = 0; k <= n; k++)
         d[k] = 0.0;
-    for (size_t i = 0; i < m->nterms; i++) {
+    size_t i0, i1;
+    mode_slab(m, w, &i0, &i1);
+    for (size_t i = i0; i < i1; i++) {
         const pde_wterm *t = &m->terms[i];
         const double complex z = t->alpha + I * t->beta;
         double complex q[8];   /* (A - iB)^(j)(w), j <= n */
@@ -285,12 +289,13 @@ void factor_bounds(pde_factor f, double t0, double t1, int n, double *d)
         d[k] = 0.0;
 }
 
-void mode_h_bounds(const pde_mode *m, double w0, double w1, int n, double *d)
+/* Bounds over [w0, w1] of the terms i0 .. i1 - 1. */
+static void terms_bounds(const pde_mode *m, size_t i0, size_t i1, double w0, double w1, int n, double *d)
 {
     const double W = fmax(fabs(w0), fabs(w1));
     for (int k = 0; k <= n; k++)
         d[k] = 0.0;
-    for (size_t i = 0; i < m->nterms; i++) {
+    for (size_t i = i0; i < i1; i++) {
         const pde_wterm *t = &m->terms[i];
         const double az = hypot(t->alpha, t->beta);
         double q[8];   /* bounds of |(A - iB)^(j)| over the interval */
@@ -309,5 +314,27 @@ void mode_h_bounds(const pde_mode *m, double w0, double w1, int n, double *d)
             }
             d[k] += E * sum;
         }
+    }
+}
+
+void mode_h_bounds(const pde_mode *m, double w0, double w1, int n, double *d)
+{
+    if (m->nslabs <= 1) {
+        terms_bounds(m, 0, m->nterms, w0, w1, n, d);
+        return;
+    }
+    /* The max over the slabs that [w0, w1] meets, each bounded over its part (the first slab
+     * reaches down to -inf, the last up to +inf). */
+    for (int k = 0; k <= n; k++)
+        d[k] = 0.0;
+    for (size_t s = 0; s < m->nslabs; s++) {
+        double lo = s == 0 ? -INFINITY : m->breaks[s], hi = s + 1 == m->nslabs ? INFINITY : m->breaks[s + 1];
+        double a = fmax(w0, lo), b = fmin(w1, hi);
+        if (a > b)
+            continue;
+        double ds[8];
+        terms_bounds(m, m->first[s], m->first[s + 1], a, b, n, ds);
+        for (int k = 0; k <= n; k++)
+            d[k] = fmax(d[k], ds[k]);
     }
 }

@@ -35,12 +35,47 @@ typedef struct {
     /* Per mode, the particular solution's h(0), h'(0), h(1), h'(1): what the force (or a chain
      * parent) asks of the boundary fit besides the data, the scale of the boundary residual. */
     double (*drive)[4];
+    /* Lofts: per mode, its data at the sections, x[m * nsections + k] and xw (NULL without tangents),
+     * the sums over the component's terms (loft_bc_residual). NULL for a model. */
+    double *lx, *lxw;
 } comp_solution;
 
 struct pde_solution {
     arena mem;                  /* owns everything below, and the solution itself */
     comp_solution comp[3];
+    /* Lofts: the sections (0 and NULL for a model), and the worst condition estimate of a slab
+     * system with the mode it belongs to (pde_solution_condition). */
+    size_t nsections;
+    pde_section *sections;
+    double cond;
+    int cond_comp;
+    size_t cond_mode;
 };
+
+/* The terms of the slab of m that holds w: terms[*k0] .. terms[*k1 - 1] (pde.h: below 0 the first
+ * slab, above 1 the last, at an interior break the slab on its right). */
+static inline void mode_slab(const pde_mode *m, double w, size_t *k0, size_t *k1)
+{
+    if (m->nslabs <= 1) {
+        *k0 = 0;
+        *k1 = m->nterms;
+        return;
+    }
+    size_t lo = 0, hi = m->nslabs - 1;     /* the last slab whose start is <= w */
+    while (lo < hi) {
+        size_t mid = (lo + hi + 1) / 2;
+        if (m->breaks[mid] <= w)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    *k0 = m->first[lo];
+    *k1 = m->first[lo + 1];
+}
+
+/* Lofts: the largest error of the section conditions (docs/MATH.md, "Lofts"), relative to the
+ * section data's scale; 0 for a model. */
+double loft_bc_residual(const pde_solution *s);
 
 extern const char *const pde_comp_name[3];   /* "x", "y", "z" */
 

@@ -234,6 +234,11 @@ typedef struct {
 pde_status pde_solve_loft(const pde_loft *loft, const pde_solve_opts *opts, pde_solution **out,
                           pde_diag *diag);
 
+/* The worst 1-norm condition estimate among a loft's slab systems (docs/MATH.md, "Lofts"), and the
+ * component and index (into pde_solution_modes) of a mode it belongs to; comp and mode may be NULL.
+ * 1 for a model, with *comp = -1. A loft with condition above 1e12 is refused as singular. */
+double pde_solution_condition(const pde_solution *sol, int *comp, size_t *mode);
+
 /* x(u, v, w). Cannot fail; any point is accepted, [0,1]^3 is the solid. */
 void pde_eval(const pde_solution *sol, double u, double v, double w, double x[3]);
 

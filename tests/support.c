@@ -259,6 +259,137 @@ void indep_free(indep_solution *s)
     free(s);
 }
 
+/* ---- the loft problem: multiple shooting over the slabs ---- */
+
+struct indep_loft {
+    indep_solution sys;   /* one mode: n = 4, A and the state scale */
+    size_t K;
+    double *w;            /* K sections */
+    size_t *node0;        /* first node of slab s; slab s has nodes node0[s] .. node0[s + 1] - 1 */
+    double *t;            /* node positions */
+    double *Y;            /* 4 per node */
+};
+
+indep_loft *indep_loft_solve(double e, size_t K, const double *w, const int *tangent, const double *x,
+                             const double *xw)
+{
+    indep_loft *L = calloc(1, sizeof *L);
+    indep_solution *s = &L->sys;
+    s->p.M = 1;
+    s->n = 4;
+    double big = fmax(1.0, pow(fabs(e), 0.25));
+    s->s = big;
+    s->A = calloc(16, sizeof *s->A);
+    for (int j = 0; j < 3; j++)
+        s->A[j * 4 + j + 1] = big;
+    s->A[3 * 4] = e / (big * big * big);
+    L->K = K;
+    L->w = malloc(K * sizeof *L->w);
+    memcpy(L->w, w, K * sizeof *L->w);
+    size_t S = K - 1, nodes = 0;
+    L->node0 = malloc((S + 1) * sizeof *L->node0);
+    size_t *ns = malloc(S * sizeof *ns);
+    for (size_t k = 0; k < S; k++) {
+        ns[k] = (size_t)ceil((w[k + 1] - w[k]) * 2.0 * big * 4.0);   /* intervals: |A tau| <= 1/8 */
+        if (ns[k] < 2)
+            ns[k] = 2;
+        L->node0[k] = nodes;
+        nodes += ns[k] + 1;
+    }
+    L->node0[S] = nodes;
+    L->t = malloc(nodes * sizeof *L->t);
+    for (size_t k = 0; k < S; k++)
+        for (size_t i = 0; i <= ns[k]; i++)
+            L->t[L->node0[k] + i] = i == ns[k] ? w[k + 1] : w[k] + (w[k + 1] - w[k]) * (double)i / (double)ns[k];
+    int N = (int)(4 * nodes);
+    band b = { N, 8, 8, 0, NULL };
+    b.w = 2 * b.kl + b.ku + 1;
+    b.a = calloc((size_t)N * b.w, sizeof *b.a);
+    double *rhs = calloc((size_t)N, sizeof *rhs), E[16];
+    int row = 0;
+    for (size_t k = 0; k < K; k++) {
+        /* The section's conditions on the states of its neighbouring nodes. */
+        int left = k > 0 ? (int)(4 * (L->node0[k] - 1)) : -1, right = k < S ? (int)(4 * L->node0[k]) : -1;
+        double sd = big;   /* y_1 = h' / big, y_2 = h'' / big^2 */
+        if (left < 0 || right < 0) {
+            int c = left < 0 ? right : left;
+            *bat(&b, row, c) = 1.0;
+            rhs[row++] = x[k];
+            if (tangent[k]) {
+                *bat(&b, row, c + 1) = 1.0;
+                rhs[row++] = xw[k] / sd;
+            } else {
+                *bat(&b, row, c + 2) = 1.0;
+                rhs[row++] = 0.0;
+            }
+        } else if (tangent[k]) {
+            const int cs[2] = { left, right };
+            for (int i = 0; i < 2; i++) {
+                *bat(&b, row, cs[i]) = 1.0;
+                rhs[row++] = x[k];
+                *bat(&b, row, cs[i] + 1) = 1.0;
+                rhs[row++] = xw[k] / sd;
+            }
+        } else {
+            *bat(&b, row, left) = 1.0;
+            rhs[row++] = x[k];
+            *bat(&b, row, right) = 1.0;
+            rhs[row++] = x[k];
+            for (int d = 1; d <= 2; d++) {
+                *bat(&b, row, left + d) = 1.0;
+                *bat(&b, row, right + d) = -1.0;
+                rhs[row++] = 0.0;
+            }
+        }
+        if (k == S)
+            break;
+        /* Continuity along slab k. */
+        for (size_t i = L->node0[k]; i + 1 < L->node0[k + 1]; i++) {
+            expm(s, L->t[i + 1] - L->t[i], E);
+            for (int r = 0; r < 4; r++, row++) {
+                for (int j = 0; j < 4; j++)
+                    *bat(&b, row, (int)(4 * i) + j) = E[r * 4 + j];
+                *bat(&b, row, (int)(4 * (i + 1)) + r) = -1.0;
+                rhs[row] = 0.0;
+            }
+        }
+    }
+    free(ns);
+    int ok = row == N && band_solve(&b, rhs) == 0;
+    free(b.a);
+    L->Y = rhs;
+    if (!ok) {
+        indep_loft_free(L);
+        return NULL;
+    }
+    return L;
+}
+
+double indep_loft_eval(const indep_loft *L, int d, double w, int left)
+{
+    size_t S = L->K - 1, s = 0;
+    while (s + 1 < S && (left ? w > L->w[s + 1] : w >= L->w[s + 1]))
+        s++;
+    size_t i = L->node0[s];
+    while (i + 2 < L->node0[s + 1] && w >= L->t[i + 1])
+        i++;
+    double y[4];
+    propagate(&L->sys, L->t[i], w - L->t[i], L->Y + 4 * i, y);
+    return y[d] * pow(L->sys.s, d);
+}
+
+void indep_loft_free(indep_loft *L)
+{
+    if (!L)
+        return;
+    free(L->sys.A);
+    free(L->w);
+    free(L->node0);
+    free(L->t);
+    free(L->Y);
+    free(L);
+}
+
 int close_rel(double a, double b, double tol, double floor)
 {
     return fabs(a - b) <= tol * fmax(fmax(fabs(a), fabs(b)), floor);
@@ -1189,6 +1320,7 @@ typedef struct {
 typedef struct {
     pde_factor u, v;
     size_t t0, nt;
+    const pde_mode *md;      /* for a loft's slabs: terms t0 + first[s] .. on slab s */
 } rp_mode;
 
 typedef struct {
@@ -1276,7 +1408,7 @@ static int rp_init(rp_eval *e, const pde_solution *s)
         size_t n;
         const pde_mode *md = pde_solution_modes(s, c, &n);
         for (size_t m = 0; m < n; m++, k++) {
-            e->modes[k] = (rp_mode){ md[m].u, md[m].v, t, md[m].nterms };
+            e->modes[k] = (rp_mode){ md[m].u, md[m].v, t, md[m].nterms, &md[m] };
             for (size_t j = 0; j < md[m].nterms; j++, t++) {
                 const pde_wterm *w = &md[m].terms[j];
                 size_t x = 0;
@@ -1307,7 +1439,17 @@ static int rp_init(rp_eval *e, const pde_solution *s)
 static void rp_h(const rp_eval *e, size_t m, double w, int cached, double *h, double *dh)
 {
     *h = 0, *dh = 0;
-    for (size_t t = e->modes[m].t0; t < e->modes[m].t0 + e->modes[m].nt; t++) {
+    size_t t0 = e->modes[m].t0, t1 = t0 + e->modes[m].nt;
+    const pde_mode *pm = e->modes[m].md;
+    if (pm->nslabs > 1) {
+        /* A loft: the slab of w, the right one at a break (pde.h). */
+        size_t sl = 0;
+        while (sl + 1 < pm->nslabs && w >= pm->breaks[sl + 1])
+            sl++;
+        t1 = t0 + pm->first[sl + 1];
+        t0 += pm->first[sl];
+    }
+    for (size_t t = t0; t < t1; t++) {
         const rp_wterm *q = &e->wt[t];
         const rp_exp *x = &e->ex[q->exp];
         double a = 0, da = 0, b = 0, db = 0;

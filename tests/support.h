@@ -38,6 +38,20 @@ indep_solution *indep_solve(const indep_problem *p);
 double indep_eval(const indep_solution *s, int m, int d, double w);
 void indep_free(indep_solution *s);
 
+/*
+ * The loft problem of one mode (pde.h, "Lofts"), solved the same way: h'''' = e h on each slab
+ * between K sections at w[0] = 0 < ... < w[K-1] = 1, with x[k] given at every section, x_w = xw[k]
+ * where tangent[k] (clamped), else x_ww = 0 at an end (natural) and continuous x_w, x_ww at an
+ * interior section (C2). NULL if the shooting system is singular.
+ */
+typedef struct indep_loft indep_loft;
+
+indep_loft *indep_loft_solve(double e, size_t K, const double *w, const int *tangent, const double *x,
+                             const double *xw);
+/* h^(d)(w), d = 0..3; at an interior section, the slab on the left when left is non-zero. */
+double indep_loft_eval(const indep_loft *s, int d, double w, int left);
+void indep_loft_free(indep_loft *s);
+
 /* |a - b| <= tol * max(|a|, |b|, floor): a relative test with an absolute floor. */
 int close_rel(double a, double b, double tol, double floor);
 
