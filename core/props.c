@@ -172,6 +172,10 @@ static pde_status sweep(const pde_solution *s, const double *us, size_t nu, cons
 static pde_status bc_residual(const pde_solution *s, int res, const double own_size[3], poller *pl,
                               double *out)
 {
+    if (s->nsections) {   /* a loft: its conditions at every section (core/loft.c) */
+        *out = loft_bc_residual(s);
+        return PDE_OK;
+    }
     const size_t n = (size_t)res;
     const size_t nb = s->comp[0].nbterms + s->comp[1].nbterms + s->comp[2].nbterms;
     double *uni = malloc((n + 2 * nb * n + 12 * n) * sizeof *uni);
@@ -287,7 +291,9 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
                 fv[m * n + i] = factor_deriv(md->v, t, 0);
                 fv4[m * n + i] = factor_deriv(md->v, t, 4);
                 double h0 = 0.0, hw = 0.0;
-                for (size_t k = 0; k < md->nterms; k++) {
+                size_t k0, k1;
+                mode_slab(md, t, &k0, &k1);   /* a loft's slab of t */
+                for (size_t k = k0; k < k1; k++) {
                     h0 += wterm_deriv(&md->terms[k], t, 0);
                     hw += wterm_deriv(&md->terms[k], t, 4);
                 }
