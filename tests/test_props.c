@@ -1065,6 +1065,38 @@ static void bounds_should_contain_a_dense_sampling_of_stress_models(void **state
 /* A bound of exp(700 u)'s derivatives overflows to inf, and inf times the exact 0 of t's second
  * derivative made NaN, which branch and bound took for a point: det J's minimum was "certified" at
  * -2.9e-7 while det J is -3e5 at (1, 1, 0.994). A bound may be infinite; it may not be false. */
+/*
+ * A loft (pde_solve_loft): a circle, an ellipse with a fourth harmonic, a circle, up the z axis, at
+ * w = 0, 0.4, 1, clamped at the bottom. Its properties hold as a model's: the certificate near
+ * rounding (the section conditions, the PDE on each slab), the integrals against the reference
+ * quadrature (which evaluates the closed form on the slab of w), the bounds around a dense sample.
+ */
+static void a_lofts_properties_should_match_the_reference_and_its_certificate_be_near_rounding(void **state)
+{
+    (void)state;
+    static const pde_section sec[3] = { { 0, 1 }, { 0.4, 0 }, { 1, 0 } };
+    static const double xc2[3] = { 1, 1.5, 1 }, xc4[3] = { 0, 0.2, 0 }, ys2[3] = { 1, 0.7, 1 };
+    static const double zc[3] = { 0, 0.8, 2 }, zw[3] = { 2, 0, 0 }, none[3] = { 0, 0, 0 };
+    const pde_lterm tx[2] = { { F_pow(1), F_cos(2), xc2, none }, { F_pow(1), F_cos(4), xc4, none } };
+    const pde_lterm ty[1] = { { F_pow(1), F_sin(2), ys2, none } };
+    const pde_lterm tz[1] = { { F_pow(0), F_pow(0), zc, zw } };
+    const pde_loft loft = { sec, 3, { { 1, 1, 1, tx, 2 }, { 1, 1, 1, ty, 1 }, { 1, 1, 1, tz, 1 } } };
+    pde_solution *sol = NULL;
+    pde_diag d;
+    if (pde_solve_loft(&loft, NULL, &sol, &d) != PDE_OK)
+        fail_msg("the loft does not solve: %s", d.message);
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    if (!(p.bc_residual <= 1e-12 && p.pde_residual <= 1e-12))
+        fail_msg("loft: certificate bc %.3g pde %.3g", p.bc_residual, p.pde_residual);
+    ref_props_out r;
+    assert_int_equal(ref_props(sol, &r), 0);
+    assert_true(r.converged);
+    expect_props_match_reference("loft", &p, &r);
+    expect_bounds_contain_samples("loft", sol, 41, 81, 101, 100000);
+    pde_solution_free(sol);
+}
+
 static void bounds_should_stay_certified_when_a_factor_bound_overflows(void **state)
 {
     (void)state;
@@ -1119,6 +1151,7 @@ int main(void)
         cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_every_preset),
         cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_stress_models),
         cmocka_unit_test(bounds_should_stay_certified_when_a_factor_bound_overflows),
+        cmocka_unit_test(a_lofts_properties_should_match_the_reference_and_its_certificate_be_near_rounding),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
