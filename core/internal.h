@@ -10,6 +10,7 @@
 
 #include <complex.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "pde.h"
 
@@ -103,6 +104,13 @@ static inline const double *solution_breaks(const pde_solution *s, size_t *nslab
 static inline int pde_stopped(const pde_cancel *c)
 {
     return c && c->stop && c->stop(c->arg);
+}
+
+/* Clears d (if not NULL): nothing at fault yet. */
+static inline void pde_diag_clear(pde_diag *d)
+{
+    if (d)
+        memset(d, 0, sizeof *d), d->component = -1, d->term = -1, d->section = -1;
 }
 
 /* Fills d (if not NULL) and returns st. */

@@ -649,8 +649,7 @@ pde_status pde_solve_loft(const pde_loft *loft, const pde_solve_opts *opts, pde_
                           pde_diag *diag)
 {
     const pde_cancel *cancel = opts ? opts->cancel : NULL;
-    if (diag)
-        memset(diag, 0, sizeof *diag), diag->component = -1, diag->term = -1, diag->section = -1;
+    pde_diag_clear(diag);
     if (!loft || !out)
         return pde_fail(diag, PDE_ERR_INVALID, -1, 0, -1, "", "no loft given");
     pde_status st = validate(loft, diag);

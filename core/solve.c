@@ -563,8 +563,7 @@ pde_status pde_solve_ex(const pde_model *model, const pde_solve_opts *opts, pde_
                         pde_diag *diag)
 {
     const pde_cancel *cancel = opts ? opts->cancel : NULL;
-    if (diag)
-        memset(diag, 0, sizeof *diag), diag->component = -1, diag->term = -1, diag->section = -1;
+    pde_diag_clear(diag);
     if (!model || !out)
         return pde_fail(diag, PDE_ERR_INVALID, -1, -1, -1, "", "no model given");
     arena mem = { 0 }, scratch = { 0 };

@@ -1188,6 +1188,17 @@ api_model *preset_model(const char *name)
     return m;
 }
 
+void sixteen_mode_model(pde_bterm b[3][16], pde_model *m)
+{
+    for (int c = 0; c < 3; c++) {
+        b[c][0] = c == 2 ? (pde_bterm){ F_pow(0), F_pow(0), 0, 1, 1, 1 }
+                         : (pde_bterm){ c == 0 ? F_pow(1) : F_pow(0), c == 1 ? F_pow(1) : F_pow(0), 1, 0, 1, 0 };
+        for (int k = 1; k < 16 && c < 2; k++)
+            b[c][k] = (pde_bterm){ F_cos(k), F_sin(1 + c), 0.3 / (k * k), 0.1 / k, 0.2 / (k * k), 0 };
+    }
+    *m = (pde_model){ { { 1, 1, -1, b[0], 16, NULL, 0 }, { 1, 1, -1, b[1], 16, NULL, 0 }, { 1, 1, -1, b[2], 1, NULL, 0 } } };
+}
+
 pde_solution *preset_solution(const char *name)
 {
     api_model *m = preset_model(name);

@@ -86,6 +86,10 @@ void paper_figure_model(size_t i, pde_model *m);
 
 /* A preset's model with its default parameters (api_model_free it); fails the test if there is none. */
 struct api_model *preset_model(const char *name);
+
+/* 16 cosine modes in u per component (x, y; z = w), folding: a model past the properties' work bound
+ * (tests/test_cost.c, test_props.c). b holds its terms, which *m points into. */
+void sixteen_mode_model(pde_bterm b[3][16], pde_model *m);
 /* The solution of a preset (a test failure if it does not solve); free with pde_solution_free(). */
 struct pde_solution *preset_solution(const char *name);
 

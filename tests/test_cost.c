@@ -414,13 +414,8 @@ static void a_model_of_sixteen_modes_per_component_should_fit_the_default_budget
 {
     (void)state;
     pde_bterm b[3][16];
-    for (int c = 0; c < 3; c++) {
-        b[c][0] = c == 2 ? (pde_bterm){ F_pow(0), F_pow(0), 0, 1, 1, 1 }
-                         : (pde_bterm){ c == 0 ? F_pow(1) : F_pow(0), c == 1 ? F_pow(1) : F_pow(0), 1, 0, 1, 0 };
-        for (int k = 1; k < 16 && c < 2; k++)
-            b[c][k] = (pde_bterm){ F_cos(k), F_sin(1 + c), 0.3 / (k * k), 0.1 / k, 0.2 / (k * k), 0 };
-    }
-    pde_model m = { { { 1, 1, -1, b[0], 16, NULL, 0 }, { 1, 1, -1, b[1], 16, NULL, 0 }, { 1, 1, -1, b[2], 1, NULL, 0 } } };
+    pde_model m;
+    sixteen_mode_model(b, &m);
     api_cost total = { 0, 0 }, part;
     api_cost_solve(&m, &part);
     api_cost_add(&total, &part);

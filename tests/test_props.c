@@ -787,13 +787,8 @@ static void props_beyond_the_work_bound_should_report_an_error_that_covers_what_
 {
     (void)state;
     pde_bterm b[3][16];
-    for (int c = 0; c < 3; c++) {
-        b[c][0] = c == 2 ? (pde_bterm){ F_pow(0), F_pow(0), 0, 1, 1, 1 }
-                         : (pde_bterm){ c == 0 ? F_pow(1) : F_pow(0), c == 1 ? F_pow(1) : F_pow(0), 1, 0, 1, 0 };
-        for (int k = 1; k < 16 && c < 2; k++)
-            b[c][k] = (pde_bterm){ F_cos(k), F_sin(1 + c), 0.3 / (k * k), 0.1 / k, 0.2 / (k * k), 0 };
-    }
-    pde_model m = { { { 1, 1, -1, b[0], 16, NULL, 0 }, { 1, 1, -1, b[1], 16, NULL, 0 }, { 1, 1, -1, b[2], 1, NULL, 0 } } };
+    pde_model m;
+    sixteen_mode_model(b, &m);
     pde_solution *sol;
     assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
     pde_props p;
