@@ -384,6 +384,25 @@ static double lambda(pde_factor f)
     return w * w * w * w;
 }
 
+/* A loft's solve (core/loft.c): per mode, its slab system's banded solve (shared by equal e) and
+ * the real form of its slabs' terms; per term, the sums at the sections. */
+void api_cost_loft(const pde_loft *l, api_cost *c)
+{
+    double modes = 0.0, terms = 0.0, K = (double)l->nsections;
+    for (int ci = 0; ci < 3; ci++)
+        modes += (double)l->comp[ci].nterms, terms += (double)l->comp[ci].nterms;
+    c->work = (K_S_MODE + K_S_PLAN) * modes * (K - 1.0) + K_S_TERM * terms * K;
+    c->bytes = 1600.0 * modes * (K - 1.0) + 64.0 * K * K * 16.0;
+}
+
+void api_cost_model(const api_model *m, api_cost *c)
+{
+    if (api_model_loft(m))
+        api_cost_loft(api_model_loft(m), c);
+    else
+        api_cost_solve(api_model_get(m), c);
+}
+
 void api_cost_solve(const pde_model *m, api_cost *c)
 {
     double w = 0.0, bytes = 0.0;

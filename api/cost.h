@@ -30,6 +30,7 @@
 
 #include <stddef.h>
 
+#include "model.h"
 #include "output.h"
 #include "pde.h"
 
@@ -42,6 +43,10 @@ typedef struct {
 void api_cost_parse(size_t len, api_cost *c);
 /* pde_solve() of the model, from its terms (the model need not be valid). */
 void api_cost_solve(const pde_model *m, api_cost *c);
+/* pde_solve_loft() of a loft. */
+void api_cost_loft(const pde_loft *l, api_cost *c);
+/* What api_model_parse() read: a model's solve, or a loft's. */
+void api_cost_model(const api_model *m, api_cost *c);
 /* pde_properties() with the default options. */
 void api_cost_props(const pde_solution *sol, api_cost *c);
 /* api_output_open() and reading the whole output, excluding the properties (api_cost_props). */

@@ -9,6 +9,7 @@
 #include <nettle/sha2.h>
 
 #include "id.h"
+#include "model.h"
 
 static void put_u64(struct sha256_ctx *h, uint64_t v)
 {
@@ -29,6 +30,19 @@ static void put_factor(struct sha256_ctx *h, pde_factor f)
 {
     put_u64(h, (uint64_t)f.kind);
     put_f64(h, f.p);
+}
+
+/* The hex digits of a digest's first API_ID_LEN / 2 bytes. */
+static void hex_id(struct sha256_ctx *h, char id[API_ID_LEN + 1])
+{
+    uint8_t digest[SHA256_DIGEST_SIZE];
+    sha256_digest(h, sizeof digest, digest);
+    static const char hex[] = "0123456789abcdef";
+    for (int i = 0; i < API_ID_LEN / 2; i++) {
+        id[2 * i] = hex[digest[i] >> 4];
+        id[2 * i + 1] = hex[digest[i] & 15];
+    }
+    id[API_ID_LEN] = '\0';
 }
 
 pde_status api_model_id(const pde_model *m, char id[API_ID_LEN + 1], pde_diag *diag)
@@ -66,15 +80,45 @@ pde_status api_model_id(const pde_model *m, char id[API_ID_LEN + 1], pde_diag *d
         }
     }
     pde_model_canonical_free(&c);
-    uint8_t digest[SHA256_DIGEST_SIZE];
-    sha256_digest(&h, sizeof digest, digest);
-    static const char hex[] = "0123456789abcdef";
-    for (int i = 0; i < API_ID_LEN / 2; i++) {
-        id[2 * i] = hex[digest[i] >> 4];
-        id[2 * i + 1] = hex[digest[i] & 15];
-    }
-    id[API_ID_LEN] = '\0';
+    hex_id(&h, id);
     return PDE_OK;
+}
+
+/* api/loft.c builds a loft's terms merged and sorted, numbers without -0: its bytes are canonical. */
+pde_status api_loft_id(const pde_loft *l, char id[API_ID_LEN + 1])
+{
+    struct sha256_ctx h;
+    sha256_init(&h);
+    static const char tag[] = "pdesolid loft v1";
+    sha256_update(&h, sizeof tag, (const uint8_t *)tag);
+    const size_t K = l->nsections;
+    put_u64(&h, K);
+    for (size_t k = 0; k < K; k++) {
+        put_f64(&h, l->sections[k].w + 0.0);
+        put_u64(&h, l->sections[k].tangent != 0);
+    }
+    for (int i = 0; i < 3; i++) {
+        const pde_lcomponent *c = &l->comp[i];
+        put_f64(&h, c->a + 0.0);
+        put_f64(&h, c->b + 0.0);
+        put_f64(&h, c->c + 0.0);
+        put_u64(&h, c->nterms);
+        for (size_t j = 0; j < c->nterms; j++) {
+            put_factor(&h, c->terms[j].u);
+            put_factor(&h, c->terms[j].v);
+            for (size_t k = 0; k < K; k++) {
+                put_f64(&h, c->terms[j].x[k] + 0.0);
+                put_f64(&h, l->sections[k].tangent && c->terms[j].xw ? c->terms[j].xw[k] + 0.0 : 0.0);
+            }
+        }
+    }
+    hex_id(&h, id);
+    return PDE_OK;
+}
+
+pde_status api_request_id(const api_model *m, char id[API_ID_LEN + 1], pde_diag *diag)
+{
+    return api_model_loft(m) ? api_loft_id(api_model_loft(m), id) : api_model_id(api_model_get(m), id, diag);
 }
 
 int api_id_valid(const char *s)

@@ -13,6 +13,11 @@
 
 /* Writes the id and a NUL into id[API_ID_LEN + 1]. Returns PDE_OK or the model's error. */
 pde_status api_model_id(const pde_model *m, char id[API_ID_LEN + 1], pde_diag *diag);
+/* A loft's id (its terms as api/loft.c builds them: merged, sorted, no -0). */
+pde_status api_loft_id(const pde_loft *l, char id[API_ID_LEN + 1]);
+/* The id of what api_model_parse() read: a model's, or a loft's. */
+struct api_model;
+pde_status api_request_id(const struct api_model *m, char id[API_ID_LEN + 1], pde_diag *diag);
 /* 1 if s is the form of an id: API_ID_LEN lowercase hex digits and nothing else. */
 int api_id_valid(const char *s);
 

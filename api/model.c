@@ -14,11 +14,14 @@
 #include <cJSON.h>
 
 #include "model.h"
+#include "jsonparse.h"
+#include "loft.h"
 #include "strict.h"
 #include "template.h"
 
 struct api_model {
     pde_model m;
+    api_loft *loft;     /* a loft document (loft.h): m is then empty */
     pde_bterm *b[3];
     pde_fterm *f[3];
     int from_params;    /* expanded from a preset or template: errors point into /params */
@@ -47,7 +50,7 @@ int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
 }
 
 /* ptr + "/" + key as RFC 6901 writes a key: ~ as ~0 and / as ~1. */
-static void child_ptr(char *out, size_t n, const char *ptr, const char *key)
+void api_json_child(char *out, size_t n, const char *ptr, const char *key)
 {
     size_t w = (size_t)snprintf(out, n, "%s/", ptr);
     for (; *key && w + 2 < n; key++) {
@@ -69,7 +72,7 @@ static const char *quoted(char out[64], const char *s)
     return out;
 }
 
-static const char *type_name(const cJSON *j)
+const char *api_json_type(const cJSON *j)
 {
     if (cJSON_IsNumber(j)) return "a number";
     if (cJSON_IsString(j)) return "a string";
@@ -84,11 +87,11 @@ static const char *type_name(const cJSON *j)
  * Checks that obj is an object whose keys are all in keys[] (NULL-ended) and
  * appear once; found[i] gets the child for keys[i] or NULL.
  */
-static int check_object(const cJSON *obj, const char *ptr, const char *const *keys,
+int api_json_object(const cJSON *obj, const char *ptr, const char *const *keys,
                         const cJSON **found, api_error *err)
 {
     if (!cJSON_IsObject(obj))
-        return api_fail(err, ptr, "must be an object, not %s", type_name(obj));
+        return api_fail(err, ptr, "must be an object, not %s", api_json_type(obj));
     size_t nk = 0;
     while (keys[nk])
         found[nk++] = NULL;
@@ -102,11 +105,11 @@ static int check_object(const cJSON *obj, const char *ptr, const char *const *ke
             for (size_t k = 0; k < nk; k++)
                 snprintf(allowed + strlen(allowed), sizeof allowed - strlen(allowed), "%s\"%s\"",
                          k ? ", " : "", keys[k]);
-            child_ptr(at, sizeof at, ptr, c->string);
+            api_json_child(at, sizeof at, ptr, c->string);
             return api_fail(err, at, "unknown key \"%s\"; the keys here are %s", quoted(q, c->string), allowed);
         }
         if (found[i]) {
-            child_ptr(at, sizeof at, ptr, keys[i]);
+            api_json_child(at, sizeof at, ptr, keys[i]);
             return api_fail(err, at, "the key \"%s\" appears twice", keys[i]);
         }
         found[i] = c;
@@ -115,21 +118,21 @@ static int check_object(const cJSON *obj, const char *ptr, const char *const *ke
 }
 
 /* A finite number, or 0 when absent. */
-static int get_number(const cJSON *j, const char *ptr, double *out, api_error *err)
+int api_json_number(const cJSON *j, const char *ptr, double *out, api_error *err)
 {
     if (!j) {
         *out = 0.0;
         return 0;
     }
     if (!cJSON_IsNumber(j))
-        return api_fail(err, ptr, "must be a number, not %s", type_name(j));
+        return api_fail(err, ptr, "must be a number, not %s", api_json_type(j));
     if (!isfinite(j->valuedouble))
         return api_fail(err, ptr, "must be a finite number; this one overflows a double");
     *out = j->valuedouble;
     return 0;
 }
 
-static int get_factor(const cJSON *j, const char *ptr, pde_factor *f, api_error *err)
+int api_json_factor(const cJSON *j, const char *ptr, pde_factor *f, api_error *err)
 {
     static const char *const kinds[] = { "pow", "sin", "cos", "exp", "sinh", "cosh", NULL };
     f->kind = PDE_POW;
@@ -137,7 +140,7 @@ static int get_factor(const cJSON *j, const char *ptr, pde_factor *f, api_error 
     if (!j)
         return 0;
     const cJSON *found[6];
-    if (check_object(j, ptr, kinds, found, err))
+    if (api_json_object(j, ptr, kinds, found, err))
         return -1;
     int which = -1;
     for (int k = 0; k < 6; k++)
@@ -150,8 +153,8 @@ static int get_factor(const cJSON *j, const char *ptr, pde_factor *f, api_error 
     if (which < 0)
         return api_fail(err, ptr, "a factor needs one of \"pow\", \"sin\", \"cos\", \"exp\", \"sinh\", \"cosh\"");
     char p[200];
-    child_ptr(p, sizeof p, ptr, kinds[which]);
-    if (get_number(found[which], p, &f->p, err))
+    api_json_child(p, sizeof p, ptr, kinds[which]);
+    if (api_json_number(found[which], p, &f->p, err))
         return -1;
     f->kind = (pde_factor_kind)which;
     if (which == PDE_POW && (f->p != floor(f->p) || f->p < 0 || f->p > PDE_MAX_POW))
@@ -164,7 +167,7 @@ static int get_factor(const cJSON *j, const char *ptr, pde_factor *f, api_error 
     return 0;
 }
 
-static int get_vector3(const cJSON *j, const char *ptr, double out[3], api_error *err)
+int api_json_vector3(const cJSON *j, const char *ptr, double out[3], api_error *err)
 {
     if (!j)
         return api_fail(err, ptr, "is required: an array of three numbers, one for each of x, y, z");
@@ -174,7 +177,7 @@ static int get_vector3(const cJSON *j, const char *ptr, double out[3], api_error
     for (const cJSON *c = j->child; c; c = c->next, i++) {
         char p[200];
         snprintf(p, sizeof p, "%s/%d", ptr, i);
-        if (!c || get_number(c, p, &out[i], err))
+        if (!c || api_json_number(c, p, &out[i], err))
             return -1;
     }
     return 0;
@@ -184,7 +187,7 @@ static int get_vector3(const cJSON *j, const char *ptr, double out[3], api_error
 static int term_array(const cJSON *j, const char *ptr, size_t *n, api_error *err)
 {
     if (!cJSON_IsArray(j))
-        return api_fail(err, ptr, "must be an array of terms, not %s", type_name(j));
+        return api_fail(err, ptr, "must be an array of terms, not %s", api_json_type(j));
     size_t k = 0;
     for (const cJSON *c = j->child; c; c = c->next)
         if (++k > API_MAX_TERMS) {
@@ -211,17 +214,17 @@ static int parse_bterms(const cJSON *j, const char *ptr, api_model *m, int ci, a
         snprintf(p, sizeof p, "%s/%zu", ptr, i);
         const cJSON *f[6];
         pde_bterm *t = &m->b[ci][i];
-        if (check_object(c, p, keys, f, err))
+        if (api_json_object(c, p, keys, f, err))
             return -1;
         double *num[4] = { &t->w0, &t->dw0, &t->w1, &t->dw1 };
         for (int k = 0; k < 2; k++) {
-            child_ptr(q, sizeof q, p, keys[k]);
-            if (get_factor(f[k], q, k ? &t->v : &t->u, err))
+            api_json_child(q, sizeof q, p, keys[k]);
+            if (api_json_factor(f[k], q, k ? &t->v : &t->u, err))
                 return -1;
         }
         for (int k = 0; k < 4; k++) {
-            child_ptr(q, sizeof q, p, keys[k + 2]);
-            if (get_number(f[k + 2], q, num[k], err))
+            api_json_child(q, sizeof q, p, keys[k + 2]);
+            if (api_json_number(f[k + 2], q, num[k], err))
                 return -1;
         }
     }
@@ -245,15 +248,15 @@ static int parse_fterms(const cJSON *j, const char *ptr, api_model *m, int ci, a
         snprintf(p, sizeof p, "%s/%zu", ptr, i);
         const cJSON *f[4];
         pde_fterm *t = &m->f[ci][i];
-        if (check_object(c, p, keys, f, err))
+        if (api_json_object(c, p, keys, f, err))
             return -1;
-        child_ptr(q, sizeof q, p, "coef");
-        if (get_number(f[0], q, &t->coef, err))
+        api_json_child(q, sizeof q, p, "coef");
+        if (api_json_number(f[0], q, &t->coef, err))
             return -1;
         pde_factor *fac[3] = { &t->u, &t->v, &t->w };
         for (int k = 0; k < 3; k++) {
-            child_ptr(q, sizeof q, p, keys[k + 1]);
-            if (get_factor(f[k + 1], q, fac[k], err))
+            api_json_child(q, sizeof q, p, keys[k + 1]);
+            if (api_json_factor(f[k + 1], q, fac[k], err))
                 return -1;
         }
     }
@@ -268,17 +271,17 @@ static int parse_model(const cJSON *root, api_model *m, api_error *err)
     static const char *const abc[] = { "a", "b", "c", NULL };
     static const char *const xyz[] = { "x", "y", "z", NULL };
     const cJSON *t[3], *p[3], *comps[3];
-    if (check_object(root, "", top, t, err))
+    if (api_json_object(root, "", top, t, err))
         return -1;
     if (!t[0])
         return api_fail(err, "/pde", "is required: {\"a\": [..], \"b\": [..], \"c\": [..]}, the PDE's coefficients");
-    if (check_object(t[0], "/pde", abc, p, err))
+    if (api_json_object(t[0], "/pde", abc, p, err))
         return -1;
     double v[3][3];
     for (int k = 0; k < 3; k++) {
         char q[32];
         snprintf(q, sizeof q, "/pde/%s", abc[k]);
-        if (get_vector3(p[k], q, v[k], err))
+        if (api_json_vector3(p[k], q, v[k], err))
             return -1;
     }
     for (int ci = 0; ci < 3; ci++) {
@@ -292,7 +295,7 @@ static int parse_model(const cJSON *root, api_model *m, api_error *err)
         const char *name = top[sect];
         char q[32];
         snprintf(q, sizeof q, "/%s", name);
-        if (check_object(t[sect], q, xyz, comps, err))
+        if (api_json_object(t[sect], q, xyz, comps, err))
             return -1;
         for (int ci = 0; ci < 3; ci++) {
             if (!comps[ci])
@@ -311,7 +314,7 @@ static api_model *parse_request(const cJSON *root, api_error *err)
 {
     static const char *const keys[] = { "preset", "template", "params", NULL };
     const cJSON *k[3];
-    if (check_object(root, "", keys, k, err))
+    if (api_json_object(root, "", keys, k, err))
         return NULL;
     if (k[0] && k[1]) {
         api_fail(err, "", "give either \"preset\" or \"template\", not both");
@@ -320,7 +323,7 @@ static api_model *parse_request(const cJSON *root, api_error *err)
     const cJSON *name = k[0] ? k[0] : k[1];
     const char *ptr = k[0] ? "/preset" : "/template";
     if (!cJSON_IsString(name)) {
-        api_fail(err, ptr, "must be a string, not %s", type_name(name));
+        api_fail(err, ptr, "must be a string, not %s", api_json_type(name));
         return NULL;
     }
     const api_template *t;
@@ -345,12 +348,12 @@ static api_model *parse_request(const cJSON *root, api_error *err)
     }
     if (k[2]) {
         if (!cJSON_IsObject(k[2])) {
-            api_fail(err, "/params", "must be an object of parameter values, not %s", type_name(k[2]));
+            api_fail(err, "/params", "must be an object of parameter values, not %s", api_json_type(k[2]));
             return NULL;
         }
         for (const cJSON *c = k[2]->child; c; c = c->next) {
             char q[200];
-            child_ptr(q, sizeof q, "/params", c->string);
+            api_json_child(q, sizeof q, "/params", c->string);
             for (const cJSON *d = k[2]->child; d != c; d = d->next)
                 if (strcmp(d->string, c->string) == 0) {
                     api_fail(err, q, "the key \"%s\" appears twice", quoted(q0, c->string));
@@ -364,14 +367,14 @@ static api_model *parse_request(const cJSON *root, api_error *err)
                 for (const cJSON *x = c->child; x; x = x->next) {
                     char qi[220];
                     snprintf(qi, sizeof qi, "%s/%d", q, n);
-                    if (get_number(x, qi, &v[n++], err))
+                    if (api_json_number(x, qi, &v[n++], err))
                         return NULL;
                 }
             } else {
-                api_fail(err, q, "must be a number, or an array of three for a, b and c; not %s", type_name(c));
+                api_fail(err, q, "must be a number, or an array of three for a, b and c; not %s", api_json_type(c));
                 return NULL;
             }
-            if (n == 1 && get_number(c, q, &v[0], err))
+            if (n == 1 && api_json_number(c, q, &v[0], err))
                 return NULL;
             if (api_params_set(t, &p, c->string, v, n, err)) {
                 /* template.c writes the key as it is; a pointer escapes ~ and / */
@@ -415,6 +418,15 @@ api_model *api_model_parse(const char *text, size_t len, api_error *err)
     if (cJSON_IsObject(root) && (cJSON_GetObjectItemCaseSensitive(root, "preset") ||
                                  cJSON_GetObjectItemCaseSensitive(root, "template"))) {
         m = parse_request(root, err);
+    } else if (cJSON_IsObject(root) && cJSON_GetObjectItemCaseSensitive(root, "loft")) {
+        static const char *const keys[] = { "loft", NULL };
+        const cJSON *f[1];
+        if (!api_json_object(root, "", keys, f, err) && (m = calloc(1, sizeof *m)) == NULL)
+            api_fail(err, "", "out of memory");
+        if (m && !(m->loft = api_loft_parse(f[0], "/loft", err))) {
+            api_model_free(m);
+            m = NULL;
+        }
     } else if (!(m = calloc(1, sizeof *m))) {
         api_fail(err, "", "out of memory");
     } else if (parse_model(root, m, err)) {
@@ -461,12 +473,18 @@ void api_model_free(api_model *m)
         free(m->b[i]);
         free(m->f[i]);
     }
+    api_loft_free(m->loft);
     free(m);
 }
 
 const pde_model *api_model_get(const api_model *m)
 {
     return &m->m;
+}
+
+const pde_loft *api_model_loft(const api_model *m)
+{
+    return m->loft ? api_loft_get(m->loft) : NULL;
 }
 
 int api_solve(const api_model *m, pde_solution **out, api_error *err)
@@ -476,6 +494,8 @@ int api_solve(const api_model *m, pde_solution **out, api_error *err)
 
 int api_solve_ex(const api_model *m, const pde_cancel *cancel, pde_solution **out, api_error *err)
 {
+    if (m->loft)
+        return api_loft_solve(m->loft, "/loft", cancel, out, err);
     pde_diag d;
     pde_solve_opts o = { .cancel = cancel };
     pde_status st = pde_solve_ex(&m->m, &o, out, &d);
@@ -502,7 +522,7 @@ int api_solve_ex(const api_model *m, const pde_cancel *cancel, pde_solution **ou
 static int points_from(const cJSON *arr, const char *ptr, size_t max, double **out, size_t *count, api_error *err)
 {
     if (!cJSON_IsArray(arr))
-        return api_fail(err, ptr, "must be an array of [u, v, w] points, not %s", type_name(arr));
+        return api_fail(err, ptr, "must be an array of [u, v, w] points, not %s", api_json_type(arr));
     size_t k = 0;
     for (const cJSON *c = arr->child; c; c = c->next)
         if (++k > max) {
@@ -525,7 +545,7 @@ static int points_from(const cJSON *arr, const char *ptr, size_t max, double **o
         for (const cJSON *x = c->child; x; x = x->next, q++) {
             char pq[80];
             snprintf(pq, sizeof pq, "%s/%d", p, q);
-            if (get_number(x, pq, &pts[3 * i + q], err)) {
+            if (api_json_number(x, pq, &pts[3 * i + q], err)) {
                 free(pts);
                 return -1;
             }
@@ -554,11 +574,11 @@ int api_eval_parse(const char *text, size_t len, size_t max_points, double **out
     if (!root)
         return -1;
     const cJSON *k[2];
-    int rc = check_object(root, "", keys, k, err);
+    int rc = api_json_object(root, "", keys, k, err);
     if (!rc && !k[0])
         rc = api_fail(err, "/points", "is required: an array of [u, v, w] points");
     if (!rc && k[1] && !cJSON_IsBool(k[1]))
-        rc = api_fail(err, "/derivatives", "must be true or false, not %s", type_name(k[1]));
+        rc = api_fail(err, "/derivatives", "must be true or false, not %s", api_json_type(k[1]));
     if (!rc)
         rc = points_from(k[0], "/points", max_points, out, n, err);
     if (!rc)

@@ -56,8 +56,9 @@ typedef struct {
 typedef struct api_model api_model;
 
 /*
- * Parses a request of len bytes (no NUL needed): a model, or
- * {"preset": NAME, "params": {...}} or {"template": NAME, "params": {...}},
+ * Parses a request of len bytes (no NUL needed): a model, a loft document
+ * {"loft": {...}} (loft.h), or {"preset": NAME, "params": {...}} or
+ * {"template": NAME, "params": {...}},
  * where params override the preset's or the template's values (template.h).
  * Returns NULL and fills err on failure.
  */
@@ -70,7 +71,10 @@ api_model *api_model_parse(const char *text, size_t len, api_error *err);
  */
 api_model *api_model_build(const pde_model *m, int from_params, api_error *err);
 void api_model_free(api_model *m);
+/* The model; for a loft document ({"loft": ...}, loft.h) an empty one: see api_model_loft(). */
 const pde_model *api_model_get(const api_model *m);
+/* The loft of a loft document, or NULL for a model. */
+const pde_loft *api_model_loft(const api_model *m);
 
 /* pde_solve() with the core's diagnosis turned into a JSON pointer. Returns 0 or the pde_status. */
 int api_solve(const api_model *m, pde_solution **out, api_error *err);

@@ -231,7 +231,7 @@ static void post_solve(srv_req *r)
     }
     char id[API_ID_LEN + 1];
     pde_diag d;
-    if (api_model_id(api_model_get(m), id, &d) != PDE_OK) {
+    if (api_request_id(m, id, &d) != PDE_OK) {
         /* Invalid in a way the solve reports with a pointer. */
         pde_solution *sol = NULL;
         api_solve(m, &sol, &err);
@@ -240,7 +240,7 @@ static void post_solve(srv_req *r)
         srv_problem_api(r, &err);
         return;
     }
-    api_cost_solve(api_model_get(m), &part);
+    api_cost_model(m, &part);
     if (over_budget(r, &part)) {
         api_model_free(m);
         return;

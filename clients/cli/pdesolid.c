@@ -164,7 +164,7 @@ static int load(const options *o, const char *path, pde_solution **sol, char *id
         return report(what, &err);
     int st = api_solve(m, sol, &err);
     if (!st && id)
-        api_model_id(api_model_get(m), id, NULL);
+        api_request_id(m, id, NULL);
     api_model_free(m);
     if (st == PDE_ERR_NOMEM) {
         fprintf(stderr, "pdesolid: out of memory\n");

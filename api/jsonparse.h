@@ -1,0 +1,28 @@
+/*
+ * jsonparse.h: the pieces of api/'s strict JSON reading that model.c and loft.c share (internal to
+ * api/). Each check fills err with a JSON pointer and a sentence (api_fail, status 422) and returns
+ * -1 on failure, 0 on success.
+ */
+#ifndef API_JSONPARSE_H
+#define API_JSONPARSE_H
+
+#include <stddef.h>
+
+#include <cJSON.h>
+
+#include "model.h"
+
+/* ptr + "/" + key as RFC 6901 writes a key: ~ as ~0 and / as ~1. */
+void api_json_child(char *out, size_t n, const char *ptr, const char *key);
+/* "a number", "an array", ... for messages. */
+const char *api_json_type(const cJSON *j);
+/* obj is an object whose keys are all in keys[] (NULL-ended), each once; found[i] gets keys[i]'s child or NULL. */
+int api_json_object(const cJSON *obj, const char *ptr, const char *const *keys, const cJSON **found, api_error *err);
+/* A finite number into *out, or 0 when j is NULL. */
+int api_json_number(const cJSON *j, const char *ptr, double *out, api_error *err);
+/* A factor {"pow": n}, {"sin": k}, ... into *f, or the constant 1 when j is NULL. */
+int api_json_factor(const cJSON *j, const char *ptr, pde_factor *f, api_error *err);
+/* An array of three finite numbers (required). */
+int api_json_vector3(const cJSON *j, const char *ptr, double out[3], api_error *err);
+
+#endif
