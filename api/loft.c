@@ -133,12 +133,10 @@ static int fit_curve(records *rs, int k, int tangent, const double (*pts)[3], in
             in[j] = pts[j][c];
         fftw_execute_dft_r2c(fwd, in, out);
         const pde_factor one = { PDE_POW, 0 }, u = { PDE_POW, 1 };
-        double x0 = C, x1 = mean[c] - C;
-        if (fabs(x1) < cut)
-            x1 = 0.0;
+        double x0 = fabs(C) < cut ? 0.0 : C, x1 = fabs(mean[c] - C) < cut ? 0.0 : mean[c] - C;
+        out[0][0] = (x0 + x1) * n, out[0][1] = 0.0;   /* the kept mean, for the fit error */
         rc |= push(rs, c, one, one, k, tangent ? 0 : x0, tangent ? x0 : 0);
         rc |= push(rs, c, u, one, k, tangent ? 0 : x1, tangent ? x1 : 0);
-        out[0][0] = mean[c] * n, out[0][1] = 0.0;
         for (int m = 1; m < nh; m++) {
             const int top = 2 * m == n;   /* even n: the Nyquist term, a cosine alone */
             double a = (top ? 1.0 : 2.0) * out[m][0] / n, b = top ? 0.0 : -2.0 * out[m][1] / n;
