@@ -428,7 +428,9 @@ static void mass_properties(const quad_result *q, const double x0[3], pde_props 
  * whether the rules resolve the solid's frequencies; 1e-12, the refinement's tolerance, where det J
  * may change sign; for panels where det J may change sign left
  * unrefined by the work's bound, what refinement changed on the refined ones, on average, times their
- * number (1e-4 of the volume when none was refined: the unrefined error measured on fig. 4l); at least 1e-2 when lines stopped locating roots.
+ * number (1e-4 of the volume when none was refined: the unrefined error measured on fig. 4l); at least
+ * 1e-2 when lines stopped locating roots; at least the rules' a-priori error when the work's bound made
+ * them coarser than the solid's frequencies.
  */
 static double integral_error(const quad_result *q, const quad_result *qa)
 {
@@ -440,7 +442,12 @@ static double integral_error(const quad_result *q, const quad_result *qa)
         e += q->refined ? q->unrefined * q->refine_change / q->refined / vol : 1e-4;
     if (q->roots_skipped || qa->roots_skipped)
         e = fmax(e, 1e-2);
-    return fmin(e, 1.0);
+    /* The signed volume multiplies three factors, the second moments five: where the work's bound
+     * made the rules coarser than the fastest of those, their a-priori error stands (pessimistic). */
+    const double rules = fmax(q->err, qa->err);
+    if (rules > 1e-10)
+        e = fmax(e, rules);
+    return e == e ? fmin(e, 1.0) : 1.0;
 }
 
 pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde_props *out)
