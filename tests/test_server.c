@@ -530,6 +530,49 @@ static int dial(int port)
     return fd;
 }
 
+/* A loft document through POST /solve: solved, cached under its id, outputs; a bad one named. */
+static void a_loft_should_solve_and_a_bad_one_get_its_pointer(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    const char *loft = "{\"loft\": {\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], \"c\": [2, 2, 2]}, \"sections\": ["
+                       "{\"w\": 0, \"profile\": [[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]]},"
+                       "{\"w\": 0.5, \"profile\": [[1.5, 0, 1], [0, 0.8, 1], [-1.5, 0, 1], [0, -0.8, 1]]},"
+                       "{\"w\": 1, \"profile\": [[1, 0, 2], [0, 1, 2], [-1, 0, 2], [0, -1, 2]]}]}}";
+    reply r = post(&d, "/solve", loft);
+    assert_int_equal(r.status, 200);
+    cJSON *j = cJSON_Parse(r.body);
+    assert_non_null(j);
+    const char *id = cJSON_GetStringValue(cJSON_GetObjectItem(j, "id"));
+    assert_non_null(id);
+    /* The section at w = 0.5 through the server's eval: u = 1, v = 1/4 is the point (0, 0.8, 1). */
+    char path[128];
+    snprintf(path, sizeof path, "/solids/%s/eval", id);
+    reply e = post(&d, path, "{\"points\": [[1, 0.25, 0.5]]}");
+    assert_int_equal(e.status, 200);
+    cJSON *ej = cJSON_Parse(e.body), *p0 = cJSON_GetArrayItem(cJSON_GetObjectItem(ej, "values"), 0);
+    assert_non_null(p0);
+    assert_true(fabs(cJSON_GetArrayItem(p0, 1)->valuedouble - 0.8) < 1e-12);
+    assert_true(fabs(cJSON_GetArrayItem(p0, 2)->valuedouble - 1) < 1e-12);
+    snprintf(path, sizeof path, "/solids/%s?format=glb", id);
+    reply g = http(&d, "GET", path, NULL, 0, NULL);
+    assert_int_equal(g.status, 200);
+    cJSON_Delete(j);
+    cJSON_Delete(ej);
+    free(r.body);
+    free(e.body);
+    free(g.body);
+    r = post(&d, "/solve", "{\"loft\": {\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], \"c\": [2, 2, 2]}, \"sections\": ["
+                           "{\"w\": 0, \"profile\": [[1, 0, 0], [0, 1, 0]]}, {\"w\": 1, \"profile\": [[1, 0, 1], [0, 1, 1], [0, 0, 1]]}]}}");
+    expect_problem(&r, 422, "/loft/sections/0/profile", "at least 3");
+    free(r.body);
+    r = http(&d, "GET", "/livez", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    free(r.body);
+    stop(&d);
+}
+
 static void two_content_lengths_and_stalled_clients_should_be_refused(void **state)
 {
     (void)state;
@@ -736,6 +779,7 @@ int main(void)
         cmocka_unit_test(sixty_four_concurrent_clients_should_all_get_correct_answers),
         cmocka_unit_test(a_full_queue_should_give_503_with_retry_after),
         cmocka_unit_test(bad_requests_should_get_problems_and_the_daemon_should_keep_serving),
+        cmocka_unit_test(a_loft_should_solve_and_a_bad_one_get_its_pointer),
         cmocka_unit_test(two_content_lengths_and_stalled_clients_should_be_refused),
         cmocka_unit_test(sigterm_should_let_a_request_in_flight_complete),
         cmocka_unit_test(presets_version_health_metrics_and_cors_should_answer),
