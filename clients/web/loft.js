@@ -126,11 +126,14 @@ export function stateOf(doc) {
   if (!l || !Array.isArray(l.sections)) throw new Error('not a loft document: {"loft": {"sections": [...]}} expected');
   const st = defaultLoft();
   for (const k of ['a', 'b', 'c']) if (Array.isArray(l.pde?.[k])) st[k] = l.pde[k].slice(0, 3).map(Number);
-  st.height = 1;
   st.sections = l.sections.map((s) => ({
     shape: 'uploaded', raw: Array.isArray(s.profile) ? s.profile : [], points: Array.isArray(s.profile) ? s.profile.length : 0,
     params: {}, size: 1, rotation: 0, x: 0, y: 0, w: s.w, tangent: s.tangent, centre: s.centre,
   }));
+  // A section switched to a generator sits at z = w height: the height the upload's last section has.
+  const last = st.sections[st.sections.length - 1]?.raw;
+  const z = last?.length ? mean(last.map((p) => [0, 0, Number(p?.[2]) || 0]))[2] : 0;
+  st.height = z > 0 ? z : 1;
   return st;
 }
 
@@ -215,7 +218,9 @@ export function mountLoftEditor(gui, { onChange, onActivate }) {
         const c = p === 'digits' ? add(s.params, p).name('NACA digits') : add(s.params, p, ...paramRange(p));
         c.domElement.dataset.loft = `${k}.${p}`;
       }
-      const pts = s.shape === 'uploaded' ? f.add(s, 'points').disable() : add(s, 'points', 3, 256, 1);
+      // An uploaded profile's count is shown, not edited (and not disabled: its error must stay legible).
+      const pts = s.shape === 'uploaded' ? f.add(s, 'points').onFinishChange(() => { s.points = s.raw.length; pts.updateDisplay(); })
+        : add(s, 'points', 3, 256, 1);
       pts.domElement.dataset.loft = `${k}.points`;
       controllers[`/sections/${k}/profile`] = pts;
       controllers[`/sections/${k}`] = shape;

@@ -1,7 +1,7 @@
 // The loft editor's shape generators (clients/web/loft.js): each one's points lie on its curve,
 // checked against the curve's equation written here.   node tests/node/shapes.mjs
 // Prints one line per check; exits 1 if any fails.
-import { SHAPES, nacaThickness, loftDocument, defaultLoft } from '../../clients/web/loft.js';
+import { SHAPES, nacaThickness, loftDocument, defaultLoft, stateOf } from '../../clients/web/loft.js';
 
 let failed = 0, step = 0;
 function check(name, worst, tol) {
@@ -67,6 +67,9 @@ check('star: r = 1 - 0.35 (1 - cos 5t) / 2 at each point\'s own angle',
   const t0 = doc.sections[0].tangent, t2 = doc.sections[2].tangent;
   check('end tangents are (0, 0, 2.5) at every point, none inside',
     maxOf([...t0, ...t2].map((v) => Math.hypot(v[0], v[1], v[2] - 2.5))) + (doc.sections[1].tangent ? 1 : 0), 1e-14);
+  const again = loftDocument(stateOf(loftDocument(st))).loft;
+  check('an uploaded document fills the editor, which sends it back unchanged',
+    JSON.stringify(again) === JSON.stringify(doc) ? 0 : 1, 0);
   check('section z is w times the height', maxOf(doc.sections.flatMap((s) => s.profile.map((p) => Math.abs(p[2] - 2 * s.w)))), 0);
 }
 
