@@ -171,6 +171,7 @@ export function mountLoftEditor(gui, { onChange, onActivate }) {
       rebuild(); changed();
     },
     upload: () => fileInput.click(),
+    fresh: () => { fill(defaultLoft()); changed(); },
   };
   fileInput.addEventListener('change', async () => {
     const f = fileInput.files[0];
@@ -193,7 +194,7 @@ export function mountLoftEditor(gui, { onChange, onActivate }) {
   tan.domElement.dataset.loft = 'tangents';
   tanLen.domElement.dataset.loft = 'tangentLength';
   fixed.$children.appendChild(note);
-  for (const [k, name] of [['add', 'add a section'], ['remove', 'remove a section'], ['upload', 'upload a loft document…'], ['solve', 'solve this loft']]) {
+  for (const [k, name] of [['fresh', 'new loft (circle, star, ellipse)'], ['add', 'add a section'], ['remove', 'remove a section'], ['upload', 'upload a loft document…'], ['solve', 'solve this loft']]) {
     const c = folder.add(acts, k).name(name);
     c.domElement.dataset.loft = k;
   }
@@ -238,14 +239,14 @@ export function mountLoftEditor(gui, { onChange, onActivate }) {
     });
   }
 
-  function load(doc) {
-    Object.assign(st, stateOf(doc));
+  function fill(next) {
+    Object.assign(st, next);
     for (const k of ['a', 'b', 'c']) ['x', 'y', 'z'].forEach((axis, i) => { pdeProxy[`${k}${axis}`] = st[k][i]; });
     for (const c of fixed.controllersRecursive()) c.updateDisplay();
     rebuild();
     folder.open();
-    changed();
   }
+  function load(doc) { fill(stateOf(doc)); changed(); }
   rebuild();
   return {
     document: () => loftDocument(st),

@@ -173,9 +173,9 @@ if (loftProbe.status !== 200) {
   console.log(`skip the loft editor's checks: this daemon does not solve lofts (${loftProbe.status}: ${loftProbe.body.slice(0, 160)})`);
 } else {
   await check('the loft editor builds a three-section loft and it draws', async () => {
-    await page.locator('.lil-title', { hasText: 'Loft editor' }).click();
+    if (!(await page.locator('[data-loft="fresh"] button').isVisible())) await page.locator('.lil-title', { hasText: 'Loft editor' }).click();
     const n = (await state()).solves;
-    await page.locator('[data-loft="solve"] button').click();
+    await page.locator('[data-loft="fresh"] button').click();
     await solved(n);
     const s = await state();
     if (s.mode !== 'loft') throw new Error(`mode ${s.mode}`);
