@@ -18,6 +18,7 @@ static const struct {
     { "/", "index.html", "text/html; charset=utf-8" },
     { "/index.html", "index.html", "text/html; charset=utf-8" },
     { "/app.js", "app.js", JS },
+    { "/loft.js", "loft.js", JS },
     { "/style.css", "style.css", "text/css; charset=utf-8" },
     { "/openapi.yaml", NULL, "application/yaml; charset=utf-8" },
     { "/vendor/three/three.module.js", "node_modules/three/build/three.module.js", JS },

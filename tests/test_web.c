@@ -5,7 +5,10 @@
  * draws fig4a; the gallery loads every preset; a control re-solves and changes
  * the picture; an invalid value shows the server's error beside its field;
  * the panel shows the centroid, surface area, moments and inertia the server
- * computed.
+ * computed; the loft editor builds, uploads and solves lofts and shows a bad
+ * section's error beside it, and the loft presets draw (while the daemon
+ * refuses lofts, browser.mjs says so and skips those). The loft editor's shape
+ * generators are checked in node against their curves (tests/node/shapes.mjs).
  * Screenshots go to build/artifacts/web/.
  */
 #include <setjmp.h>
@@ -43,9 +46,24 @@ static void the_front_end_should_work_in_a_real_browser(void **state)
     assert_int_equal(tmpdir_remove(dir), 0);
 }
 
+static void the_loft_shape_generators_should_lie_on_their_curves(void **state)
+{
+    (void)state;
+    char out[1 << 12] = "";
+    FILE *p = popen("node tests/node/shapes.mjs 2>&1", "r");
+    assert_non_null(p);
+    size_t n = fread(out, 1, sizeof out - 1, p);
+    out[n] = '\0';
+    int st = pclose(p);
+    printf("%s", out);
+    assert_int_equal(st, 0);
+    assert_non_null(strstr(out, "all 16 checks passed"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(the_loft_shape_generators_should_lie_on_their_curves),
         cmocka_unit_test(the_front_end_should_work_in_a_real_browser),
     };
     test_filter_from_env();

@@ -1,11 +1,13 @@
 // pdesolid's browser front-end: design a solid of the fourth-order PDE with
 // the paper's templates, see it re-solved as the controls move, and download it.
+// The loft editor (loft.js) solves {"loft": {...}} documents through the same path.
 // Everything comes from pdesolidd: GET /presets, POST /solve?format=glb,
 // GET /solids/{id}?format=..., and three.js and lil-gui from its /vendor/.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import GUI from 'lil-gui';
+import { mountLoftEditor } from './loft.js';
 
 const RES_CHOICES = [16, 24, 32, 48, 64, 96, 128];
 const DEBOUNCE_MS = 120;
@@ -52,10 +54,10 @@ function frame(box) {
 
 // ---- the state the panel edits ----
 const state = {
-  preset: 'fig4a', template: '', params: {}, res: 48,
+  mode: 'template', preset: 'fig4a', template: '', params: {}, res: 48,
   skin: true, lines: false, slices: false, id: '', solves: 0, phase: 'loading', error: null,
 };
-const ui = { info: {}, templates: {}, presets: [], gui: null, paramFolder: null, controllers: {} };
+const ui = { info: {}, templates: {}, presets: [], gui: null, paramFolder: null, controllers: {}, loft: null };
 const el = (id) => document.getElementById(id);
 
 function setStatus(text) { el('status').textContent = text; }
@@ -104,7 +106,7 @@ function showProps(p, times) {
 
 // ---- errors beside the field they name ----
 function clearFieldErrors() {
-  for (const c of Object.values(ui.controllers)) {
+  for (const c of [...Object.values(ui.controllers), ...(ui.loft?.controllers() || [])]) {
     c.domElement.classList.remove('has-error');
     c.domElement.querySelector('.field-error')?.remove();
   }
@@ -117,14 +119,15 @@ function showProblem(problem) {
   // /params/NAME or /params/NAME/i: the controller of that parameter (component i of a vector).
   const m = /^\/params\/([^/]+)(?:\/(\d))?$/.exec(problem.pointer || '');
   const key = m ? (m[2] !== undefined ? `${m[1]}.${'xyz'[+m[2]]}` : m[1]) : null;
-  const c = key && (ui.controllers[key] || ui.controllers[`${key}.x`]);
+  const c = state.mode === 'loft' ? ui.loft.controllerFor(problem.pointer)
+    : key && (ui.controllers[key] || ui.controllers[`${key}.x`]);
   if (c) {
     c.domElement.classList.add('has-error');
     const note = document.createElement('div');
     note.className = 'field-error';
-    note.textContent = detail.replace(/^\/params\/\S+: /, '');
+    note.textContent = detail.replace(/^\/(params|loft)\/\S+: /, '');
     c.domElement.appendChild(note);
-    c.parent.open();
+    for (let f = c.parent; f; f = f.parent) f.open();
   } else {
     el('error').textContent = detail;
     el('error').hidden = false;
@@ -135,7 +138,9 @@ function showProblem(problem) {
 let pending = null, timer = 0;
 const loader = new GLTFLoader();
 
-function requestBody() { return JSON.stringify({ template: state.template, params: state.params }); }
+function requestBody() {
+  return JSON.stringify(state.mode === 'loft' ? ui.loft.document() : { template: state.template, params: state.params });
+}
 
 function schedule() {
   clearTimeout(timer);
@@ -201,6 +206,7 @@ function show(gltf, timing, roundTrip) {
   mesh.geometry.computeBoundingBox();
   if (!framed) { frame(mesh.geometry.boundingBox); framed = true; }
   if (extras.properties) showProps(extras.properties, serverTimes(timing, roundTrip));
+  if (state.mode === 'loft') ui.loft.warn(extras.properties);
   updateDownloads();
   state.solves++;
   state.phase = 'ready';
@@ -262,7 +268,7 @@ function download(format, res) {
   if (!state.id) return;
   const a = document.createElement('a');
   a.href = `/solids/${state.id}?format=${format}&res=${res}`;
-  a.download = `${state.preset || state.template}-${state.id.slice(0, 8)}${{ grid: '.grid.json' }[format] || '.' + format}`;
+  a.download = `${state.preset || state.template || 'loft'}-${state.id.slice(0, 8)}${{ grid: '.grid.json' }[format] || '.' + format}`;
   document.body.appendChild(a);
   a.click();
   a.remove();
@@ -306,12 +312,24 @@ async function loadPreset(name) {
   const resp = await fetch(`/presets/${name}`);
   if (!resp.ok) return fail(await resp.json());
   const p = await resp.json();
+  for (const b of document.querySelectorAll('#gallery button')) b.setAttribute('aria-pressed', String(b.dataset.preset === name));
+  el('caption').textContent = p.caption;
+  framed = false;
+  if (p.loft) {
+    // A loft preset fills the loft editor, which solves it.
+    ui.paramFolder?.destroy();
+    ui.paramFolder = null;
+    ui.controllers = {};
+    state.mode = 'loft';
+    state.preset = name;
+    ui.loft.load(p);
+    return;
+  }
+  state.mode = 'template';
   state.preset = name;
+  ui.loft.warn(null);
   state.template = p.template;
   state.params = p.params;
-  el('caption').textContent = p.caption;
-  for (const b of document.querySelectorAll('#gallery button')) b.setAttribute('aria-pressed', String(b.dataset.preset === name));
-  framed = false;
   buildParamControls();
   await solve();
 }
@@ -348,13 +366,27 @@ async function main() {
   for (const [fmt, name] of [['glb', '.glb'], ['gltf', '.gltf'], ['stl', '.stl'], ['vts', '.vts (volume, det J)'], ['grid', 'grid (JSON)']])
     downloads[fmt] = dl.add(acts, fmt).name(name);
   dl.close();
+  ui.loft = mountLoftEditor(ui.gui, {
+    // Editing the loft makes it the solid shown; a problem found before solving shows as the server's would.
+    onActivate: () => {
+      if (state.mode === 'loft') return;
+      Object.assign(state, { mode: 'loft', preset: '', template: '' });
+      ui.paramFolder?.destroy();
+      ui.paramFolder = null;
+      ui.controllers = {};
+      el('caption').textContent = 'your loft';
+      framed = false;
+      for (const b of document.querySelectorAll('#gallery button')) if (b.dataset.preset !== state.preset) b.setAttribute('aria-pressed', 'false');
+    },
+    onChange: (problem) => (problem ? fail(problem) : schedule()),
+  });
   await loadPreset(new URLSearchParams(location.search).get('preset') || state.preset);
 }
 
 // For people at the console and for the browser tests: the state, and how much of the
 // canvas's middle is drawn (a blank picture has none).
 window.pdesolid = {
-  get state() { return { phase: state.phase, solves: state.solves, id: state.id, preset: state.preset, error: state.error }; },
+  get state() { return { mode: state.mode, phase: state.phase, solves: state.solves, id: state.id, preset: state.preset, error: state.error }; },
   snapshot() {
     render();
     const src = renderer.domElement, w = 64, h = 64;
