@@ -1,12 +1,15 @@
 /*
  * catalog.c: presets and templates as JSON (catalog.h).
  */
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <cJSON.h>
 
 #include "catalog.h"
 #include "id.h"
+#include "loft.h"
 
 char *api_presets_json(void)
 {
@@ -18,6 +21,14 @@ char *api_presets_json(void)
         cJSON_AddStringToObject(o, "name", p->name);
         cJSON_AddStringToObject(o, "template", p->template);
         cJSON_AddStringToObject(o, "caption", p->caption);
+    }
+    for (size_t i = 0; list && i < api_loft_preset_count(); i++) {
+        const char *caption, *name = api_loft_preset_name(i, &caption);
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddItemToArray(list, o);
+        cJSON_AddStringToObject(o, "name", name);
+        cJSON_AddStringToObject(o, "template", "loft");
+        cJSON_AddStringToObject(o, "caption", caption);
     }
     cJSON *tl = cJSON_AddArrayToObject(root, "templates");
     for (size_t i = 0; tl && i < api_template_count(); i++) {
@@ -68,6 +79,55 @@ char *api_preset_json(const api_preset *ps)
     }
     cJSON_AddItemToObject(root, "params", params);
     cJSON_AddItemToObject(root, "model", model ? model : cJSON_CreateNull());
+    char *s = cJSON_PrintUnformatted(root);
+    cJSON_Delete(root);
+    return s;
+}
+
+/* Every number under j as 17 digits: cJSON prints 15 where they read back within an epsilon, and a
+ * document that does not read back exactly would get another id. */
+static void exact_numbers(cJSON *j)
+{
+    for (cJSON *c = j->child, *next; c; c = next) {
+        next = c->next;
+        if (cJSON_IsNumber(c)) {
+            char b[32];
+            snprintf(b, sizeof b, "%.17g", c->valuedouble + 0.0);
+            cJSON *raw = cJSON_CreateRaw(b);
+            if (raw && c->string)
+                cJSON_ReplaceItemInObjectCaseSensitive(j, c->string, raw);   /* keeps the key */
+            else if (raw)
+                cJSON_ReplaceItemViaPointer(j, c, raw);
+        } else
+            exact_numbers(c);
+    }
+}
+
+char *api_loft_preset_json(const char *name)
+{
+    cJSON *doc = api_loft_preset_tree(name);
+    if (!doc)
+        return NULL;
+    const char *caption = "";
+    for (size_t i = 0; i < api_loft_preset_count(); i++)
+        if (!strcmp(api_loft_preset_name(i, &caption), name))
+            break;
+    char id[API_ID_LEN + 1] = "";
+    api_error err;
+    api_loft *l = api_loft_parse(cJSON_GetObjectItemCaseSensitive(doc, "loft"), "/loft", &err);
+    if (l)
+        api_loft_id(api_loft_get(l), id);
+    api_loft_free(l);
+    cJSON *loft = cJSON_DetachItemFromObjectCaseSensitive(doc, "loft");
+    cJSON_Delete(doc);
+    if (loft)
+        exact_numbers(loft);
+    cJSON *root = cJSON_CreateObject();
+    cJSON_AddStringToObject(root, "name", name);
+    cJSON_AddStringToObject(root, "template", "loft");
+    cJSON_AddStringToObject(root, "caption", caption);
+    cJSON_AddStringToObject(root, "id", id);
+    cJSON_AddItemToObject(root, "loft", loft);
     char *s = cJSON_PrintUnformatted(root);
     cJSON_Delete(root);
     return s;

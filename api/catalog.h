@@ -12,4 +12,8 @@ char *api_presets_json(void);
 /* {"name", "template", "caption", "id", "params": {...}, "model": {...}}; malloc'd, NULL if out of memory. */
 char *api_preset_json(const api_preset *ps);
 
+/* A loft preset (loft.h) as {"name", "template": "loft", "caption", "id", "loft": {...}}: its document, which
+ * POST /solve takes as {"loft": ...}; NULL if no loft preset has the name. The list above has them too. */
+char *api_loft_preset_json(const char *name);
+
 #endif

@@ -44,4 +44,11 @@ double api_loft_fit_error(const api_loft *l);
 int api_loft_solve(const api_loft *l, const char *ptr, const pde_cancel *cancel, pde_solution **out,
                    api_error *err);
 
+/* The gallery's lofts (loft_presets.c): vase, tower, blade, bottle. The name of the i-th (and its
+ * caption into *caption, unless NULL), or NULL past the last. */
+size_t api_loft_preset_count(void);
+const char *api_loft_preset_name(size_t i, const char **caption);
+/* The document {"loft": {...}} of the loft preset name (cJSON_Delete it), or NULL if none has it. */
+cJSON *api_loft_preset_tree(const char *name);
+
 #endif

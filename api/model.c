@@ -329,6 +329,23 @@ static api_model *parse_request(const cJSON *root, api_error *err)
     const api_template *t;
     api_params p;
     char q0[64];
+    if (k[0] && !api_preset_find(name->valuestring)) {
+        cJSON *doc = api_loft_preset_tree(name->valuestring);   /* a loft of the gallery */
+        if (doc) {
+            api_model *m = NULL;
+            if (k[2])
+                api_fail(err, "/params", "the loft preset \"%s\" takes no params; POST its document (GET /presets/%s) "
+                         "with your changes", name->valuestring, name->valuestring);
+            else if (!(m = calloc(1, sizeof *m)))
+                api_fail(err, "", "out of memory");
+            else if (!(m->loft = api_loft_parse(cJSON_GetObjectItemCaseSensitive(doc, "loft"), "/loft", err))) {
+                free(m);
+                m = NULL;
+            }
+            cJSON_Delete(doc);
+            return m;
+        }
+    }
     if (k[0]) {
         const api_preset *ps = api_preset_find(name->valuestring);
         if (!ps) {

@@ -80,10 +80,13 @@ static void get_presets(srv_req *r)
 static void get_preset(srv_req *r)
 {
     const api_preset *ps = api_preset_find(r->arg);
-    if (!ps)
-        srv_problem(r, 404, NULL, "no preset \"%s\"; GET /presets lists them", r->arg);
-    else
+    char *loft = ps ? NULL : api_loft_preset_json(r->arg);
+    if (ps)
         srv_set_text(r, 200, "application/json", api_preset_json(ps));
+    else if (loft)
+        srv_set_text(r, 200, "application/json", loft);
+    else
+        srv_problem(r, 404, NULL, "no preset \"%s\"; GET /presets lists them", r->arg);
 }
 
 /* ---- the solver threads' jobs ---- */

@@ -15,6 +15,9 @@
 
 #include <cmocka.h>
 
+#include <cJSON.h>
+
+#include "catalog.h"
 #include "id.h"
 #include "loft.h"
 #include "model.h"
@@ -256,6 +259,50 @@ static void equal_lofts_should_share_an_id_and_a_changed_one_should_not(void **s
     free(cc.s);
 }
 
+/* ---- the gallery's lofts ---- */
+
+static void every_loft_preset_should_solve_soundly_and_its_document_give_the_same_id(void **state)
+{
+    (void)state;
+    assert_true(api_loft_preset_count() >= 4);
+    for (size_t i = 0; i < api_loft_preset_count(); i++) {
+        const char *caption, *name = api_loft_preset_name(i, &caption);
+        char req[96];
+        snprintf(req, sizeof req, "{\"preset\": \"%s\"}", name);
+        api_model *m = parse_ok(req);
+        pde_solution *s = solve_ok(m);
+        pde_props p;
+        assert_int_equal(pde_properties(s, NULL, &p), PDE_OK);
+        if (!(p.bc_residual < 1e-12 && p.pde_residual < 1e-12 && !p.folds && p.volume > 0.1))
+            fail_msg("%s: bc %.3g pde %.3g folds %d volume %.3g", name, p.bc_residual, p.pde_residual, p.folds, p.volume);
+        /* GET /presets/NAME's document, POSTed back as {"loft": ...}, is the same solid. */
+        char *doc = api_loft_preset_json(name);
+        assert_non_null(doc);
+        cJSON *j = cJSON_Parse(doc);
+        assert_string_equal(cJSON_GetStringValue(cJSON_GetObjectItem(j, "caption")), caption);
+        const char *at = strstr(doc, "\"loft\":");   /* the last key: the text as a client gets it */
+        assert_non_null(at);
+        sbuf body = { 0 };
+        put(&body, "{%s", at);
+        api_model *back = parse_ok(body.s);
+        char id1[API_ID_LEN + 1], id2[API_ID_LEN + 1];
+        assert_int_equal(api_request_id(m, id1, NULL), PDE_OK);
+        assert_int_equal(api_request_id(back, id2, NULL), PDE_OK);
+        assert_string_equal(id1, id2);
+        assert_string_equal(cJSON_GetStringValue(cJSON_GetObjectItem(j, "id")), id1);
+        free(body.s);
+        cJSON_Delete(j);
+        free(doc);
+        api_model_free(back);
+        pde_solution_free(s);
+        api_model_free(m);
+    }
+    api_error err;
+    const char *bad = "{\"preset\": \"vase\", \"params\": {\"c\": [1, 1, 1]}}";
+    assert_null(api_model_parse(bad, strlen(bad), &err));
+    assert_string_equal(err.pointer, "/params");
+}
+
 /* ---- bad input ---- */
 
 static void expect_bad(const char *doc, const char *pointer, int status)
@@ -331,6 +378,7 @@ int main(void)
         cmocka_unit_test(the_tolerance_should_drop_the_harmonics_of_noise),
         cmocka_unit_test(equal_lofts_should_share_an_id_and_a_changed_one_should_not),
         cmocka_unit_test(every_bad_loft_should_name_its_field),
+        cmocka_unit_test(every_loft_preset_should_solve_soundly_and_its_document_give_the_same_id),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

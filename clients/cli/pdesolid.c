@@ -10,6 +10,7 @@
 
 #include "describe.h"
 #include "id.h"
+#include "loft.h"
 #include "model.h"
 #include "output.h"
 #include "remote.h"
@@ -107,6 +108,17 @@ static int report(const char *what, const api_error *err)
 static api_model *preset_model(const options *o, api_error *err)
 {
     const api_preset *ps = api_preset_find(o->preset);
+    cJSON *loft = ps ? NULL : api_loft_preset_tree(o->preset);
+    if (loft) {   /* a loft of the gallery: its document */
+        cJSON_Delete(loft);
+        if (o->nparams) {
+            api_fail(err, "/params", "the loft preset \"%s\" takes no --param; `pdesolid presets` shows its document", o->preset);
+            return NULL;
+        }
+        char body[128];
+        int n = snprintf(body, sizeof body, "{\"preset\": \"%.60s\"}", o->preset);
+        return api_model_parse(body, (size_t)n, err);
+    }
     if (!ps) {
         api_fail(err, "/preset", "no preset \"%s\"; `pdesolid presets` lists them", o->preset);
         return NULL;
@@ -344,6 +356,10 @@ static int cmd_presets(void)
     for (size_t i = 0; i < api_preset_count(); i++) {
         const api_preset *p = api_preset_at(i);
         printf("%-6s %-9s %s\n", p->name, p->template, p->caption);
+    }
+    for (size_t i = 0; i < api_loft_preset_count(); i++) {
+        const char *caption, *name = api_loft_preset_name(i, &caption);
+        printf("%-6s %-9s %s\n", name, "loft", caption);
     }
     return 0;
 }
