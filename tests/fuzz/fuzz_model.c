@@ -139,7 +139,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     }
     api_cost cost;
-    api_cost_solve(api_model_get(m), &cost);
+    api_cost_model(m, &cost);
     check_cost(&cost, "the solve");
     pde_solution *sol = NULL;
     memset(&err, 'X', sizeof err);
@@ -152,7 +152,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FUZZ_CHECK(sol, "api_solve gave 0 and no solution");
     char id[API_ID_LEN + 1];
     pde_diag diag;
-    FUZZ_CHECK(api_model_id(api_model_get(m), id, &diag) == PDE_OK, "a solved model has no id");
+    FUZZ_CHECK(api_request_id(m, id, &diag) == PDE_OK, "a solved model has no id");
     FUZZ_CHECK(api_id_valid(id), "id \"%s\"", id);
     size_t modes = 0;
     for (int c = 0; c < 3; c++) {
