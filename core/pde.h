@@ -304,6 +304,8 @@ typedef struct {
     double surface_area;     /* of the closed skin: collapsed faces add nothing, inner seams are left out */
     double bc_residual;      /* largest error of x, x_w on w = 0, 1, relative to the data and force (MATH.md) */
     double pde_residual;     /* largest a x_uuuu + b x_vvvv + c x_wwww - p, relative to its largest term */
+    double condition;        /* a loft's worst slab system's condition estimate (1 for a model) */
+    double condition_harmonic;   /* its mode's harmonic m in v (cos, sin 2 pi m v), 0 if none */
     double integral_error;   /* the estimated error of volume, signed_volume, centroid, inertia, relative: about
                               * 1e-14 unless PDE_PROPS_WORK bounded them (docs/MATH.md) */
 } pde_props;

@@ -541,6 +541,13 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         return st;
     mass_properties(&q, x0, &r);
     r.integral_error = integral_error(&q, &qa);
+    int cc;
+    size_t cm;
+    r.condition = pde_solution_condition(s, &cc, &cm);
+    if (cc >= 0) {
+        const pde_factor v = s->comp[cc].modes[cm].v;
+        r.condition_harmonic = v.kind == PDE_SIN || v.kind == PDE_COS ? 0.5 * v.p : 0.0;
+    }
     /* Integrals beyond a double: say so rather than hand back inf and NaN. */
     double sum = r.volume + r.signed_volume + r.surface_area + r.centroid[0] + r.centroid[1] + r.centroid[2];
     for (int i = 0; i < 3; i++)

@@ -303,6 +303,29 @@ static void every_loft_preset_should_solve_soundly_and_its_document_give_the_sam
     assert_string_equal(err.pointer, "/params");
 }
 
+/* Near a clamped eigenvalue (b = 1, c = -10, harmonic 4: t = 14.13, near 14.137) the loft swells, rightly;
+ * the properties name the harmonic and its condition, which the editor warns about above 1e3. */
+static void a_near_resonant_loft_should_report_its_harmonic_and_condition(void **state)
+{
+    (void)state;
+    const char *doc = "{\"loft\":{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[-10,-10,-10]},\"sections\":[{\"w\":0,\"terms\":{\"x\":[{\"u\":{\"pow\":1},\"v\":{\"cos\":8},\"c\":1},{\"u\":{\"pow\":1},\"v\":{\"cos\":2},\"c\":1}],\"y\":[{\"u\":{\"pow\":1},\"v\":{\"sin\":2},\"c\":1}],\"z\":[{\"c\":0}]}},{\"w\":0.5,\"terms\":{\"x\":[{\"u\":{\"pow\":1},\"v\":{\"cos\":2},\"c\":1}],\"y\":[{\"u\":{\"pow\":1},\"v\":{\"sin\":2},\"c\":1}],\"z\":[{\"c\":1}]}},{\"w\":1,\"terms\":{\"x\":[{\"u\":{\"pow\":1},\"v\":{\"cos\":8},\"c\":1},{\"u\":{\"pow\":1},\"v\":{\"cos\":2},\"c\":1}],\"y\":[{\"u\":{\"pow\":1},\"v\":{\"sin\":2},\"c\":1}],\"z\":[{\"c\":2}]}}]}}";
+    api_model *m = parse_ok(doc);
+    pde_solution *s = solve_ok(m);
+    pde_props p;
+    assert_int_equal(pde_properties(s, NULL, &p), PDE_OK);
+    if (!(p.condition > 1e3 && p.condition_harmonic == 4 && p.bbox_max[0] > 100))
+        fail_msg("condition %.3g at harmonic %g, x up to %.3g", p.condition, p.condition_harmonic, p.bbox_max[0]);
+    pde_solution_free(s);
+    api_model_free(m);
+    /* The gallery's vase, with a, b, c > 0, is well conditioned. */
+    m = parse_ok("{\"preset\": \"vase\"}");
+    s = solve_ok(m);
+    assert_int_equal(pde_properties(s, NULL, &p), PDE_OK);
+    assert_true(p.condition >= 1 && p.condition < 1e3);
+    pde_solution_free(s);
+    api_model_free(m);
+}
+
 /* ---- bad input ---- */
 
 static void expect_bad(const char *doc, const char *pointer, int status)
@@ -379,6 +402,7 @@ int main(void)
         cmocka_unit_test(equal_lofts_should_share_an_id_and_a_changed_one_should_not),
         cmocka_unit_test(every_bad_loft_should_name_its_field),
         cmocka_unit_test(every_loft_preset_should_solve_soundly_and_its_document_give_the_same_id),
+        cmocka_unit_test(a_near_resonant_loft_should_report_its_harmonic_and_condition),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

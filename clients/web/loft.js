@@ -276,7 +276,7 @@ function paramRange(p) {
 }
 
 // CONDITION_LIMIT: beyond this condition number a harmonic's slab problem is called poorly conditioned.
-export const CONDITION_LIMIT = 1e8;
+export const CONDITION_LIMIT = 1e3;
 // The worst harmonic the properties report as poorly conditioned, or null. Reads
 // properties.conditioning (the loft's certificate, docs/API.md): either an object with the
 // worst harmonic, or a list of {harmonic|mode, condition|cond, poor?}.
