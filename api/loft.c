@@ -80,26 +80,44 @@ static struct {
 } plans[PLAN_CACHE];
 static int nplans;
 
-/* The plan for a real transform of n points (inverse: complex to real), or NULL if FFTW fails. */
-static fftw_plan plan_for(int n, int inverse)
+enum { R2C, C2R, DCT1 };   /* real to complex, its inverse, and the DCT-I (FFTW's REDFT00) */
+
+/* The plan of a transform of n points of this kind, or NULL if FFTW fails. Past PLAN_CACHE sizes
+ * the plan is made for this call alone (*owned set): give it back with plan_done(). */
+static fftw_plan plan_for(int n, int kind, int *owned)
 {
     pthread_mutex_lock(&plan_lock);
     fftw_plan p = NULL;
+    *owned = 0;
     for (int i = 0; i < nplans && !p; i++)
-        if (plans[i].n == n && plans[i].inverse == inverse)
+        if (plans[i].n == n && plans[i].inverse == kind)
             p = plans[i].p;
-    if (!p && nplans < PLAN_CACHE) {
-        double *r = fftw_alloc_real((size_t)n);
+    if (!p) {
+        double *r = fftw_alloc_real((size_t)n), *r2 = fftw_alloc_real((size_t)n);
         fftw_complex *c = fftw_alloc_complex((size_t)n / 2 + 1);
-        if (r && c)
-            p = inverse ? fftw_plan_dft_c2r_1d(n, c, r, FFTW_ESTIMATE) : fftw_plan_dft_r2c_1d(n, r, c, FFTW_ESTIMATE);
+        if (r && r2 && c)
+            p = kind == C2R   ? fftw_plan_dft_c2r_1d(n, c, r, FFTW_ESTIMATE)
+                : kind == R2C ? fftw_plan_dft_r2c_1d(n, r, c, FFTW_ESTIMATE)
+                              : fftw_plan_r2r_1d(n, r, r2, FFTW_REDFT00, FFTW_ESTIMATE);
         fftw_free(r);
+        fftw_free(r2);
         fftw_free(c);
-        if (p)
-            plans[nplans].n = n, plans[nplans].inverse = inverse, plans[nplans++].p = p;
+        if (p && nplans < PLAN_CACHE)
+            plans[nplans].n = n, plans[nplans].inverse = kind, plans[nplans++].p = p;
+        else if (p)
+            *owned = 1;
     }
     pthread_mutex_unlock(&plan_lock);
     return p;
+}
+
+static void plan_done(fftw_plan p, int owned)
+{
+    if (!owned || !p)
+        return;
+    pthread_mutex_lock(&plan_lock);   /* FFTW's planner state is shared: destroying is not thread-safe */
+    fftw_destroy_plan(p);
+    pthread_mutex_unlock(&plan_lock);
 }
 
 /*
@@ -112,7 +130,8 @@ static int fit_curve(records *rs, int k, int tangent, const double (*pts)[3], in
                      double tol, double *fit)
 {
     const int nh = n / 2 + 1;
-    fftw_plan fwd = plan_for(n, 0), inv = plan_for(n, 1);
+    int own_f, own_i;
+    fftw_plan fwd = plan_for(n, R2C, &own_f), inv = plan_for(n, C2R, &own_i);
     double *in = fftw_alloc_real((size_t)n);
     fftw_complex *out = fftw_alloc_complex((size_t)nh);
     int rc = fwd && inv && in && out ? 0 : -1;
@@ -155,6 +174,88 @@ static int fit_curve(records *rs, int k, int tangent, const double (*pts)[3], in
     }
     fftw_free(in);
     fftw_free(out);
+    plan_done(fwd, own_f);
+    plan_done(inv, own_i);
+    return rc;
+}
+
+/* The cosine (or, periodic, Fourier) coefficients of n samples in place, by DCT-I (REDFT00) at t = i/(n-1)
+ * or the real DFT at t = i/n: x[k] of cos(k pi t) (k < n); periodic, x[2m-1] of cos(2 pi m t), x[2m] of sin. */
+static int coefficients(double *x, int n, int periodic)
+{
+    int own;
+    fftw_plan p = plan_for(n, periodic ? R2C : DCT1, &own);
+    double *in = fftw_alloc_real((size_t)n), *out = fftw_alloc_real((size_t)n);
+    fftw_complex *c = fftw_alloc_complex((size_t)n / 2 + 1);
+    int rc = p && in && out && c ? 0 : -1;
+    if (!rc) {
+        memcpy(in, x, (size_t)n * sizeof *x);
+        if (periodic) {
+            fftw_execute_dft_r2c(p, in, c);
+            x[0] = c[0][0] / n;
+            for (int m = 1; 2 * m <= n; m++) {   /* even n: the Nyquist term, a cosine alone */
+                const int top = 2 * m == n;
+                x[2 * m - 1] = (top ? 1.0 : 2.0) * c[m][0] / n;
+                if (!top)
+                    x[2 * m] = -2.0 * c[m][1] / n;
+            }
+        } else {
+            fftw_execute_r2r(p, in, out);
+            for (int k = 0; k < n; k++)
+                x[k] = out[k] / (n - 1) * (k == 0 || k == n - 1 ? 0.5 : 1.0);
+        }
+    }
+    fftw_free(in);
+    fftw_free(out);
+    fftw_free(c);
+    plan_done(p, own);
+    return rc;
+}
+
+/* The factor of coefficient k of coefficients(): cos(k pi t), or periodic cos / sin(2 pi m t); 1 for k = 0. */
+static pde_factor coefficient_factor(int k, int periodic)
+{
+    if (k == 0)
+        return (pde_factor){ PDE_POW, 0 };
+    if (!periodic)
+        return (pde_factor){ PDE_COS, k };
+    return k % 2 ? (pde_factor){ PDE_COS, k + 1.0 } : (pde_factor){ PDE_SIN, k };   /* 2 pi m t: k pi t, k = 2m */
+}
+
+/*
+ * A sampled surface: nv rows of nu points, p[j * nu + i] at u = i/(nu - 1), v = j/(nv - 1) (periodic:
+ * j/nv), fitted by cosine series in u and in v (Fourier in a periodic v): eigenfunctions of d4, so each
+ * product is a mode. Coefficients below tol of the surface's size are dropped.
+ */
+static int fit_grid(records *rs, int k, const double (*p)[3], int nu, int nv, int periodic, double tol)
+{
+    double *a = malloc((size_t)nu * nv * sizeof *a), *col = malloc((size_t)(nu > nv ? nu : nv) * sizeof *col);
+    int rc = a && col ? 0 : -1;
+    double mean[3] = { 0, 0, 0 }, size = 0.0;
+    for (int q = 0; q < nu * nv; q++)
+        for (int c = 0; c < 3; c++)
+            mean[c] += p[q][c] / (nu * nv);
+    for (int q = 0; q < nu * nv; q++)
+        for (int c = 0; c < 3; c++)
+            size = fmax(size, fabs(p[q][c] - mean[c]));
+    for (int c = 0; c < 3 && !rc; c++) {
+        for (int j = 0; j < nv && !rc; j++) {   /* along u, each row */
+            for (int i = 0; i < nu; i++)
+                a[j * nu + i] = p[j * nu + i][c];
+            rc = coefficients(a + (size_t)j * nu, nu, 0);
+        }
+        for (int i = 0; i < nu && !rc; i++) {   /* then along v, each column */
+            for (int j = 0; j < nv; j++)
+                col[j] = a[j * nu + i];
+            if ((rc = coefficients(col, nv, periodic)))
+                break;
+            for (int j = 0; j < nv && !rc; j++)
+                if (fabs(col[j]) >= tol * size && col[j] != 0.0)
+                    rc = push(rs, c, coefficient_factor(i, 0), coefficient_factor(j, periodic), k, col[j], 0);
+        }
+    }
+    free(a);
+    free(col);
     return rc;
 }
 
@@ -233,10 +334,50 @@ static int parse_terms(const cJSON *j, const char *ptr, records *rs, int k, int 
     return 0;
 }
 
+/* "grid": nv rows of nu points [x, y, z] each, nu, nv >= 2 (periodic: nv >= 3); "periodic": v wraps. */
+static int parse_grid(const cJSON *g, const cJSON *per, const char *ptr, int k, double tol, records *rs, api_error *err)
+{
+    if (per && !cJSON_IsBool(per))
+        return api_fail(err, ptr, "\"periodic\" must be true or false");
+    const int periodic = per && cJSON_IsTrue(per);
+    if (!cJSON_IsArray(g) || cJSON_GetArraySize(g) < (periodic ? 3 : 2))
+        return api_fail(err, ptr, "must be an array of at least %d rows (one per v) of points [x, y, z]", periodic ? 3 : 2);
+    const int nv = cJSON_GetArraySize(g), nu = cJSON_IsArray(g->child) ? cJSON_GetArraySize(g->child) : 0;
+    if (nu < 2)
+        return api_fail(err, ptr, "each row must be an array of at least 2 points [x, y, z] (one per u)");
+    if ((long)nu * nv > API_LOFT_MAX_GRID) {
+        api_fail(err, ptr, "has %d x %d points, over the limit of %d", nv, nu, API_LOFT_MAX_GRID);
+        err->status = 413;
+        return -1;
+    }
+    double(*p)[3] = malloc((size_t)nu * nv * sizeof *p);
+    if (!p)
+        return api_fail(err, ptr, "out of memory");
+    int j = 0, rc = 0;
+    for (const cJSON *row = g->child; row && !rc; row = row->next, j++) {
+        char r[220];
+        snprintf(r, sizeof r, "%s/%d", ptr, j);
+        if (!cJSON_IsArray(row) || cJSON_GetArraySize(row) != nu) {
+            rc = api_fail(err, r, "must be an array of %d points, as the first row", nu);
+            break;
+        }
+        int i = 0;
+        for (const cJSON *c = row->child; c && !rc; c = c->next, i++) {
+            char t[240];
+            snprintf(t, sizeof t, "%s/%d", r, i);
+            rc = api_json_vector3(c, t, p[j * nu + i], err);
+        }
+    }
+    if (!rc && fit_grid(rs, k, (const double(*)[3])p, nu, nv, periodic, tol))
+        rc = api_fail(err, ptr, "out of memory");
+    free(p);
+    return rc;
+}
+
 static int parse_section(const cJSON *j, const char *ptr, int k, double tol, api_loft *l, records *rs, api_error *err)
 {
-    static const char *const keys[] = { "w", "profile", "tangent", "centre", "terms", NULL };
-    const cJSON *f[5];
+    static const char *const keys[] = { "w", "profile", "tangent", "centre", "terms", "grid", "periodic", NULL };
+    const cJSON *f[7];
     char q[200];
     if (api_json_object(j, ptr, keys, f, err))
         return -1;
@@ -245,8 +386,17 @@ static int parse_section(const cJSON *j, const char *ptr, int k, double tol, api
         return api_fail(err, q, "is required: the section's place along w, from 0 to 1");
     if (api_json_number(f[0], q, &l->sec[k].w, err))
         return -1;
-    if (!!f[1] == !!f[4])
-        return api_fail(err, ptr, "a section needs either \"profile\" (points) or \"terms\" (closed form), and not both");
+    if (!!f[1] + !!f[4] + !!f[5] != 1)
+        return api_fail(err, ptr, "a section needs one of \"profile\" (points of a curve), \"grid\" (a sampled surface) "
+                        "or \"terms\" (closed form)");
+    if (f[6] && !f[5])
+        return api_fail(err, ptr, "\"periodic\" goes with \"grid\"");
+    if (f[5]) {
+        if (f[2] || f[3])
+            return api_fail(err, ptr, "\"tangent\" and \"centre\" go with \"profile\"");
+        api_json_child(q, sizeof q, ptr, "grid");
+        return parse_grid(f[5], f[6], q, k, tol, rs, err);
+    }
     if (f[4]) {
         if (f[2] || f[3])
             return api_fail(err, ptr, "\"tangent\" and \"centre\" go with \"profile\"; in \"terms\", give x_w as \"dw\"");

@@ -11,7 +11,8 @@
  *   api_loft_free(l);
  *
  * A section is a profile (N >= 3 points [x, y, z] of a closed curve at v = j/N, with optional
- * tangents and centre), or separable terms already in closed form. A profile's points are
+ * tangents and centre), a sampled surface (a grid fitted by cosine series in u and v, DCT-I), or
+ * separable terms already in closed form. A profile's points are
  * interpolated by their trigonometric polynomial, computed with FFTW's real DFT, and the section is
  * x(u, v) = C + u (P(v) - C): terms u^0 (C), u^1 (the mean minus C), u cos(2 pi m v), u sin(2 pi m v).
  * Harmonics below tol (default API_LOFT_TOL) of the section's size are dropped. Errors follow
@@ -29,6 +30,7 @@
 #include "pde.h"
 
 #define API_LOFT_MAX_POINTS 4096   /* points of one profile */
+#define API_LOFT_MAX_GRID 65536    /* points of one grid section */
 #define API_LOFT_TOL 1e-12         /* harmonics below this of the section's size are dropped */
 
 typedef struct api_loft api_loft;

@@ -259,6 +259,55 @@ static void equal_lofts_should_share_an_id_and_a_changed_one_should_not(void **s
     free(cc.s);
 }
 
+/* A surface band-limited in cosines of u and Fourier in v: r(u) = 1 + 0.3 cos(pi u), z with cos(2 pi u). */
+static void grid_surface(double u, double v, double z, double p[3])
+{
+    double r = 1 + 0.3 * cos(M_PI * u);
+    p[0] = r * cos(2 * M_PI * v), p[1] = r * sin(2 * M_PI * v), p[2] = z + 0.1 * cos(2 * M_PI * u);
+}
+
+static void a_grid_section_should_be_reproduced_at_its_samples_and_everywhere_when_band_limited(void **state)
+{
+    (void)state;
+    const int nu = 5, nv = 8;
+    sbuf b = { 0 };
+    put(&b, "{\"loft\": {\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], \"c\": [2, 2, 2]}, \"sections\": [");
+    for (int k = 0; k < 2; k++) {   /* w = 0: periodic in v; w = 1: not (v = j/(nv - 1)) */
+        put(&b, "%s{\"w\": %d, \"periodic\": %s, \"grid\": [", k ? ", " : "", k, k ? "false" : "true");
+        for (int j = 0; j < nv; j++) {
+            put(&b, "%s[", j ? ", " : "");
+            for (int i = 0; i < nu; i++) {
+                double p[3];
+                grid_surface((double)i / (nu - 1), k ? (double)j / (nv - 1) : (double)j / nv, 2 * k, p);
+                put(&b, "%s[%.17g, %.17g, %.17g]", i ? ", " : "", p[0], p[1], p[2]);
+            }
+            put(&b, "]");
+        }
+        put(&b, "]}");
+    }
+    put(&b, "]}}");
+    api_model *m = parse_ok(b.s);
+    pde_solution *s = solve_ok(m);
+    for (int k = 0; k < 2; k++)
+        for (int j = 0; j <= 4 * nv; j++)
+            for (int i = 0; i <= 4 * (nu - 1); i++) {
+                double u = i / (4.0 * (nu - 1)), v = j / (4.0 * nv), x[3], want[3];
+                if (k == 1) {   /* not band-limited in cosines of v: at the samples only */
+                    if (i % 4 || j % 4 || j / 4 >= nv)
+                        continue;
+                    v = (j / 4) / (double)(nv - 1);
+                }
+                grid_surface(u, v, 2 * k, want);
+                pde_eval(s, u, v, k, x);
+                for (int c = 0; c < 3; c++)
+                    if (fabs(x[c] - want[c]) > 1e-12)
+                        fail_msg("section %d, u %.3f v %.3f, %c: %.17g, the surface %.17g", k, u, v, "xyz"[c], x[c], want[c]);
+            }
+    pde_solution_free(s);
+    api_model_free(m);
+    free(b.s);
+}
+
 /* ---- the gallery's lofts ---- */
 
 static void every_loft_preset_should_solve_soundly_and_its_document_give_the_same_id(void **state)
@@ -375,6 +424,10 @@ static void every_bad_loft_should_name_its_field(void **state)
                "}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
                "/loft/pde/c/1", 422);
     expect_bad("{\"loft\": {" PDE3 "}, \"boundary\": {}}", "/boundary", 422);
+    expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"grid\": [[[0, 0, 0], [1, 0, 0]], [[0, 1, 0]]]}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
+               "/loft/sections/0/grid/1", 422);
+    expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"periodic\": true, \"profile\": " TRI(0) "}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
+               "/loft/sections/0", 422);
     /* Limits: sections and points. */
     sbuf b = { 0 };
     put(&b, "{\"loft\": {" PDE3 ", \"sections\": [");
@@ -398,6 +451,7 @@ int main(void)
         cmocka_unit_test(a_section_should_be_its_centre_plus_u_times_the_profile_minus_the_centre),
         cmocka_unit_test(a_tangent_should_be_the_sections_x_w),
         cmocka_unit_test(a_terms_section_should_be_its_closed_form),
+        cmocka_unit_test(a_grid_section_should_be_reproduced_at_its_samples_and_everywhere_when_band_limited),
         cmocka_unit_test(the_tolerance_should_drop_the_harmonics_of_noise),
         cmocka_unit_test(equal_lofts_should_share_an_id_and_a_changed_one_should_not),
         cmocka_unit_test(every_bad_loft_should_name_its_field),
