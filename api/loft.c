@@ -227,7 +227,7 @@ static pde_factor coefficient_factor(int k, int periodic)
  * j/nv), fitted by cosine series in u and in v (Fourier in a periodic v): eigenfunctions of d4, so each
  * product is a mode. Coefficients below tol of the surface's size are dropped.
  */
-static int fit_grid(records *rs, int k, const double (*p)[3], int nu, int nv, int periodic, double tol)
+static int fit_grid(records *rs, int k, const double (*p)[3], int nu, int nv, int periodic, double tol, double *fit)
 {
     double *a = malloc((size_t)nu * nv * sizeof *a), *col = malloc((size_t)(nu > nv ? nu : nv) * sizeof *col);
     int rc = a && col ? 0 : -1;
@@ -239,6 +239,7 @@ static int fit_grid(records *rs, int k, const double (*p)[3], int nu, int nv, in
         for (int c = 0; c < 3; c++)
             size = fmax(size, fabs(p[q][c] - mean[c]));
     for (int c = 0; c < 3 && !rc; c++) {
+        double dropped = 0.0;   /* each basis function is at most 1 in size: a bound of the fit's error */
         for (int j = 0; j < nv && !rc; j++) {   /* along u, each row */
             for (int i = 0; i < nu; i++)
                 a[j * nu + i] = p[j * nu + i][c];
@@ -252,7 +253,10 @@ static int fit_grid(records *rs, int k, const double (*p)[3], int nu, int nv, in
             for (int j = 0; j < nv && !rc; j++)
                 if (fabs(col[j]) >= tol * size && col[j] != 0.0)
                     rc = push(rs, c, coefficient_factor(i, 0), coefficient_factor(j, periodic), k, col[j], 0);
+                else
+                    dropped += fabs(col[j]);
         }
+        *fit = fmax(*fit, dropped);
     }
     free(a);
     free(col);
@@ -335,7 +339,8 @@ static int parse_terms(const cJSON *j, const char *ptr, records *rs, int k, int 
 }
 
 /* "grid": nv rows of nu points [x, y, z] each, nu, nv >= 2 (periodic: nv >= 3); "periodic": v wraps. */
-static int parse_grid(const cJSON *g, const cJSON *per, const char *ptr, int k, double tol, records *rs, api_error *err)
+static int parse_grid(const cJSON *g, const cJSON *per, const char *ptr, int k, double tol, records *rs, double *fit,
+                      api_error *err)
 {
     if (per && !cJSON_IsBool(per))
         return api_fail(err, ptr, "\"periodic\" must be true or false");
@@ -368,7 +373,7 @@ static int parse_grid(const cJSON *g, const cJSON *per, const char *ptr, int k, 
             rc = api_json_vector3(c, t, p[j * nu + i], err);
         }
     }
-    if (!rc && fit_grid(rs, k, (const double(*)[3])p, nu, nv, periodic, tol))
+    if (!rc && fit_grid(rs, k, (const double(*)[3])p, nu, nv, periodic, tol, fit))
         rc = api_fail(err, ptr, "out of memory");
     free(p);
     return rc;
@@ -395,7 +400,7 @@ static int parse_section(const cJSON *j, const char *ptr, int k, double tol, api
         if (f[2] || f[3])
             return api_fail(err, ptr, "\"tangent\" and \"centre\" go with \"profile\"");
         api_json_child(q, sizeof q, ptr, "grid");
-        return parse_grid(f[5], f[6], q, k, tol, rs, err);
+        return parse_grid(f[5], f[6], q, k, tol, rs, &l->fit_error, err);
     }
     if (f[4]) {
         if (f[2] || f[3])
@@ -518,6 +523,7 @@ api_loft *api_loft_parse(const cJSON *j, const char *ptr, api_error *err)
     if (!rc) {
         l->loft.sections = l->sec;
         l->loft.nsections = (size_t)ns;
+        l->loft.fit_error = l->fit_error;
         rc = build_terms(l, &rs, err);
     }
     free(rs.r);

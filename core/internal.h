@@ -49,6 +49,7 @@ struct pde_solution {
     size_t nsections;
     pde_section *sections;
     double cond;
+    double fit_error;           /* pde_loft.fit_error */
     int cond_comp;
     size_t cond_mode;
 };

@@ -661,6 +661,7 @@ pde_status pde_solve_loft(const pde_loft *loft, const pde_solve_opts *opts, pde_
     st = sol ? PDE_OK : PDE_ERR_NOMEM;
     if (sol) {
         sol->nsections = loft->nsections;
+        sol->fit_error = isfinite(loft->fit_error) ? fabs(loft->fit_error) : 0.0;
         sol->sections = arena_alloc(&mem, loft->nsections * sizeof *sol->sections);
         if (!sol->sections)
             st = PDE_ERR_NOMEM;

@@ -229,6 +229,8 @@ typedef struct {
     const pde_section *sections;
     size_t nsections;           /* 2 .. PDE_MAX_SECTIONS */
     pde_lcomponent comp[3];
+    double fit_error;           /* how far the caller's data lies from these terms (a fit's error); the
+                                 * solution keeps it and pde_properties() reports it; 0 if exact */
 } pde_loft;
 
 pde_status pde_solve_loft(const pde_loft *loft, const pde_solve_opts *opts, pde_solution **out,
@@ -304,6 +306,7 @@ typedef struct {
     double surface_area;     /* of the closed skin: collapsed faces add nothing, inner seams are left out */
     double bc_residual;      /* largest error of x, x_w on w = 0, 1, relative to the data and force (MATH.md) */
     double pde_residual;     /* largest a x_uuuu + b x_vvvv + c x_wwww - p, relative to its largest term */
+    double fit_error;        /* a loft's pde_loft.fit_error: its data against its terms (0 for a model) */
     double condition;        /* a loft's worst slab system's condition estimate (1 for a model) */
     double condition_harmonic;   /* its mode's harmonic m in v (cos, sin 2 pi m v), 0 if none */
     double integral_error;   /* the estimated error of volume, signed_volume, centroid, inertia, relative: about

@@ -544,6 +544,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     int cc;
     size_t cm;
     r.condition = pde_solution_condition(s, &cc, &cm);
+    r.fit_error = s->fit_error;
     if (cc >= 0) {
         const pde_factor v = s->comp[cc].modes[cm].v;
         r.condition_harmonic = v.kind == PDE_SIN || v.kind == PDE_COS ? 0.5 * v.p : 0.0;

@@ -224,6 +224,18 @@ static void the_tolerance_should_drop_the_harmonics_of_noise(void **state)
     api_model *dflt = parse_ok(b[0].s), *none = parse_ok(b[1].s);
     assert_true(loft_terms(dflt) == 3);     /* x: u cos, y: u sin, z: its constant and nothing else */
     assert_true(loft_terms(none) > 20);
+    /* The fit's error, reported in the properties: the noise left out, or rounding when all is kept. */
+    double fit[2];
+    api_model *both[2] = { dflt, none };
+    for (int t = 0; t < 2; t++) {
+        pde_solution *s = solve_ok(both[t]);
+        pde_props p;
+        assert_int_equal(pde_properties(s, NULL, &p), PDE_OK);
+        fit[t] = p.fit_error;
+        pde_solution_free(s);
+    }
+    if (!(fit[0] > 5e-15 && fit[0] < 1e-12 && fit[1] < 5e-15))
+        fail_msg("fit error %.3g with the default tolerance, %.3g with none", fit[0], fit[1]);
     api_error err;
     api_loft *l = api_loft_parse(NULL, "/loft", &err);   /* (not an object) */
     assert_null(l);
