@@ -69,6 +69,21 @@ static int cmp_record(const void *pa, const void *pb)
     return c ? c : (a->section > b->section) - (a->section < b->section);
 }
 
+/* c as three finite numbers into out, quickly: 0, or -1 without a word (the caller then asks
+ * api_json_vector3() for the error, so that a pointer is only written for a bad point). */
+static int quick_vector3(const cJSON *c, double out[3])
+{
+    if (!cJSON_IsArray(c))
+        return -1;
+    int i = 0;
+    for (const cJSON *e = c->child; e; e = e->next, i++)
+        if (i > 2 || !cJSON_IsNumber(e) || !isfinite(e->valuedouble))
+            return -1;
+        else
+            out[i] = e->valuedouble;
+    return i == 3 ? 0 : -1;
+}
+
 /* ---- FFTW: plans once per size and direction, under a lock ---- */
 
 #define PLAN_CACHE 64
@@ -283,6 +298,8 @@ static int get_points(const cJSON *j, const char *ptr, int want, double (**out)[
         return api_fail(err, ptr, "out of memory");
     int i = 0;
     for (const cJSON *c = j->child; c; c = c->next, i++) {
+        if (!quick_vector3(c, p[i]))
+            continue;
         char q[200];
         snprintf(q, sizeof q, "%s/%d", ptr, i);
         if (api_json_vector3(c, q, p[i], err)) {
@@ -368,6 +385,8 @@ static int parse_grid(const cJSON *g, const cJSON *per, const char *ptr, int k, 
         }
         int i = 0;
         for (const cJSON *c = row->child; c && !rc; c = c->next, i++) {
+            if (!quick_vector3(c, p[j * nu + i]))
+                continue;
             char t[240];
             snprintf(t, sizeof t, "%s/%d", r, i);
             rc = api_json_vector3(c, t, p[j * nu + i], err);
