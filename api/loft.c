@@ -569,11 +569,6 @@ const pde_loft *api_loft_get(const api_loft *l)
     return &l->loft;
 }
 
-double api_loft_fit_error(const api_loft *l)
-{
-    return l->fit_error;
-}
-
 int api_loft_solve(const api_loft *l, const char *ptr, const pde_cancel *cancel, pde_solution **out, api_error *err)
 {
     pde_diag d;
@@ -581,11 +576,8 @@ int api_loft_solve(const api_loft *l, const char *ptr, const pde_cancel *cancel,
     pde_status st = pde_solve_loft(&l->loft, &o, out, &d);
     if (st == PDE_OK)
         return 0;
-    if (st == PDE_ERR_CANCELLED) {
-        api_fail(err, "", "cancelled");
-        err->status = API_STATUS_CANCELLED;
-        return (int)st;
-    }
+    if (st == PDE_ERR_CANCELLED)
+        return api_fail_cancelled(err);
     char p[200];
     if (d.section >= 0)
         snprintf(p, sizeof p, "%s/sections/%d%s", ptr, d.section, strcmp(d.field, "w") ? "" : "/w");

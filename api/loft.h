@@ -39,8 +39,6 @@ typedef struct api_loft api_loft;
 api_loft *api_loft_parse(const cJSON *j, const char *ptr, api_error *err);
 void api_loft_free(api_loft *l);
 const pde_loft *api_loft_get(const api_loft *l);
-/* The largest distance between a fitted profile and its points, over the loft's sections. */
-double api_loft_fit_error(const api_loft *l);
 
 /* pde_solve_loft() with the core's diagnosis turned into a pointer under ptr; 0 or the status. */
 int api_loft_solve(const api_loft *l, const char *ptr, const pde_cancel *cancel, pde_solution **out,

@@ -49,6 +49,14 @@ int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
     return -1;
 }
 
+int api_fail_cancelled(api_error *err)
+{
+    api_fail(err, "", "cancelled");
+    if (err)
+        err->status = API_STATUS_CANCELLED;
+    return (int)PDE_ERR_CANCELLED;
+}
+
 /* ptr + "/" + key as RFC 6901 writes a key: ~ as ~0 and / as ~1. */
 void api_json_child(char *out, size_t n, const char *ptr, const char *key)
 {
@@ -518,11 +526,8 @@ int api_solve_ex(const api_model *m, const pde_cancel *cancel, pde_solution **ou
     pde_status st = pde_solve_ex(&m->m, &o, out, &d);
     if (st == PDE_OK)
         return 0;
-    if (st == PDE_ERR_CANCELLED) {
-        api_fail(err, "", "cancelled");
-        err->status = API_STATUS_CANCELLED;
-        return (int)st;
-    }
+    if (st == PDE_ERR_CANCELLED)
+        return api_fail_cancelled(err);
     char ptr[160] = "";
     if (m->from_params)
         snprintf(ptr, sizeof ptr, d.term < 0 && d.field[0] ? "/params/%s/%d" : "/params", d.field, d.component);

@@ -106,4 +106,8 @@ struct cJSON *api_factor_tree(pde_factor f);
 int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
+/* Sets err to the "cancelled" problem (status API_STATUS_CANCELLED) and returns PDE_ERR_CANCELLED: a
+ * solve that its pde_cancel stopped. */
+int api_fail_cancelled(api_error *err);
+
 #endif
