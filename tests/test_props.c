@@ -1075,7 +1075,7 @@ static void a_lofts_properties_should_match_the_reference_and_its_certificate_be
     const pde_lterm tx[2] = { { F_pow(1), F_cos(2), xc2, none }, { F_pow(1), F_cos(4), xc4, none } };
     const pde_lterm ty[1] = { { F_pow(1), F_sin(2), ys2, none } };
     const pde_lterm tz[1] = { { F_pow(0), F_pow(0), zc, zw } };
-    const pde_loft loft = { sec, 3, { { 1, 1, 1, tx, 2 }, { 1, 1, 1, ty, 1 }, { 1, 1, 1, tz, 1 } } };
+    const pde_loft loft = { sec, 3, { { 1, 1, 1, tx, 2 }, { 1, 1, 1, ty, 1 }, { 1, 1, 1, tz, 1 } }, 0 };
     pde_solution *sol = NULL;
     pde_diag d;
     if (pde_solve_loft(&loft, NULL, &sol, &d) != PDE_OK)
