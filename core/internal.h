@@ -114,6 +114,9 @@ static inline void pde_diag_clear(pde_diag *d)
         memset(d, 0, sizeof *d), d->component = -1, d->term = -1, d->section = -1;
 }
 
+/* A solve that failed with st: its message, if none was written, and its memory freed; returns st. */
+pde_status pde_solve_abandon(arena *mem, pde_status st, pde_diag *d);
+
 /* Fills d (if not NULL) and returns st. */
 pde_status pde_fail(pde_diag *d, pde_status st, int comp, int in_force, long term, const char *field,
                     const char *fmt, ...) __attribute__((format(printf, 7, 8)));

@@ -680,12 +680,8 @@ pde_status pde_solve_loft(const pde_loft *loft, const pde_solve_opts *opts, pde_
         plan_free(&plans.p[i]);
     free(plans.p);
     arena_free(&scratch);
-    if (st != PDE_OK) {
-        if ((st == PDE_ERR_NOMEM || st == PDE_ERR_CANCELLED) && diag && !diag->message[0])
-            snprintf(diag->message, sizeof diag->message, "%s", pde_strerror(st));
-        arena_free(&mem);
-        return st;
-    }
+    if (st != PDE_OK)
+        return pde_solve_abandon(&mem, st, diag);
     if (sol->cond_comp < 0)
         sol->cond = 1.0;
     sol->mem = mem;

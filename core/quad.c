@@ -21,8 +21,11 @@
  *    figures (fig. 4a: 8.15592346144658 against 8.15592346144647 computed
  *    with 160 digits).
  *
- * Along a line the two fixed factors of every mode are evaluated once, so a
- * point costs one factor per mode (a polynomial, for u): lines are cheap.
+ * Each panel tabulates every mode's factor of each axis at its rules' points
+ * once (axis_tab), so a point on a line is four multiply-adds per mode; only
+ * roots, dips and the rules of pieces between roots evaluate factors afresh.
+ * The work is bounded (PDE_PROPS_WORK), and the result says what it cost in
+ * accuracy (props.c's integral_error).
  */
 #include <float.h>
 #include <math.h>

@@ -554,6 +554,14 @@ static pde_status solve_component(arena *mem, arena *s, plan_cache *plans, const
     return PDE_OK;
 }
 
+pde_status pde_solve_abandon(arena *mem, pde_status st, pde_diag *d)
+{
+    if ((st == PDE_ERR_NOMEM || st == PDE_ERR_CANCELLED) && d && !d->message[0])
+        snprintf(d->message, sizeof d->message, "%s", pde_strerror(st));
+    arena_free(mem);
+    return st;
+}
+
 pde_status pde_solve(const pde_model *model, pde_solution **out, pde_diag *diag)
 {
     return pde_solve_ex(model, NULL, out, diag);
@@ -573,12 +581,8 @@ pde_status pde_solve_ex(const pde_model *model, const pde_solve_opts *opts, pde_
     for (int ci = 0; ci < 3 && st == PDE_OK; ci++)
         st = solve_component(&mem, &scratch, &plans, model, ci, cancel, &sol->comp[ci], diag);
     arena_free(&scratch);
-    if (st != PDE_OK) {
-        if ((st == PDE_ERR_NOMEM || st == PDE_ERR_CANCELLED) && diag && !diag->message[0])
-            snprintf(diag->message, sizeof diag->message, "%s", pde_strerror(st));
-        arena_free(&mem);
-        return st;
-    }
+    if (st != PDE_OK)
+        return pde_solve_abandon(&mem, st, diag);
     sol->mem = mem;
     *out = sol;
     return PDE_OK;
