@@ -236,7 +236,9 @@ static double cubic_rest(const obj_model *m, const double r[3])
     return t / 6.0;
 }
 
-double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *val, double at[3])
+/* obj_lower, leaving the final box's model in *mp. */
+static double lower_model(const pde_solution *s, int what, double sign, pbox *b, double *val, double at[3],
+                          obj_model *mp)
 {
     obj_model m;
     double r[3], spread[3];
@@ -270,7 +272,14 @@ double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *
     for (int k = 0; k < 3; k++)
         at[k] = 0.5 * (b->lo[k] + b->hi[k]);
     double lb = sign * m.v + quad_lower(g, H, r) - cubic_rest(&m, r);
+    *mp = m;
     return lb == lb ? lb : -INFINITY;   /* NaN from overflowed bounds: no bound */
+}
+
+double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *val, double at[3])
+{
+    obj_model m;
+    return lower_model(s, what, sign, b, val, at, &m);
 }
 
 /* ---- branch and bound ---- */
@@ -278,6 +287,7 @@ double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *
 typedef struct {
     pbox b;
     double lb;
+    int axis;   /* split_axis of b's model, -1 for a point */
 } bb_node;
 
 typedef struct {
@@ -323,18 +333,17 @@ static bb_node heap_pop(heap *h)
     return top;
 }
 
-int obj_split_axis(const pde_solution *s, int what, const pbox *b)
+/* The axis along which b's half-width contributes most to its model m's bound, or -1 for a point. */
+static int split_axis(const obj_model *m, const pbox *b)
 {
-    obj_model m;
-    obj_model_at(s, what, b, &m);
     double r[3], spread[3];
     for (int k = 0; k < 3; k++)
         r[k] = 0.5 * (b->hi[k] - b->lo[k]);
-    grad_spread(&m, r, spread);
+    grad_spread(m, r, spread);
     int best = -1;
     double most = -1.0;
     for (int k = 0; k < 3; k++) {
-        double c = r[k] * (fabs(m.g[k]) + spread[k]);
+        double c = r[k] * (fabs(m->g[k]) + spread[k]);
         if (r[k] > 0.0 && (c > most || c != c))
             most = c == c ? c : INFINITY, best = k;
     }
@@ -358,8 +367,10 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
     const double *br = solution_breaks(s, &nslabs);
     double val, at[3];
     for (size_t k = 0; k < nslabs; k++) {
-        bb_node n = { { { 0, 0, br[k] }, { 1, 1, br[k + 1] } }, 0 };
-        n.lb = obj_lower(s, what, sign, &n.b, &val, at);
+        bb_node n = { { { 0, 0, br[k] }, { 1, 1, br[k + 1] } }, 0, -1 };
+        obj_model m;
+        n.lb = lower_model(s, what, sign, &n.b, &val, at, &m);
+        n.axis = split_axis(&m, &n.b);
         r.boxes++;
         if (val < r.best)
             r.best = val, r.at[0] = at[0], r.at[1] = at[1], r.at[2] = at[2];
@@ -378,7 +389,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
             break;
         }
         bb_node top = heap_pop(&h);
-        int k = obj_split_axis(s, what, &top.b);
+        const int k = top.axis;
         if (k < 0) {   /* a point: its bound is its value */
             r.lower = fmin(r.lower, top.lb);
             continue;
@@ -390,7 +401,9 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
                 c.b.lo[k] = mid;
             else
                 c.b.hi[k] = mid;
-            c.lb = obj_lower(s, what, sign, &c.b, &val, at);
+            obj_model m;
+            c.lb = lower_model(s, what, sign, &c.b, &val, at, &m);
+            c.axis = split_axis(&m, &c.b);
             r.boxes++;
             if (val < r.best)
                 r.best = val, r.at[0] = at[0], r.at[1] = at[1], r.at[2] = at[2];

@@ -45,9 +45,6 @@ double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *
  * rounding error of its evaluation, which a certified bound must allow for. */
 double obj_magnitude(const pde_solution *s, int what);
 
-/* The axis along which b's half-width contributes most to its bound, or -1 for a point. */
-int obj_split_axis(const pde_solution *s, int what, const pbox *b);
-
 typedef struct {
     double best;      /* smallest sign * f found, at `at` */
     double at[3];

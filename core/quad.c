@@ -961,7 +961,7 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
     plan_for(s, 5.0, &p);
     double f[3];
     frequencies(s, 5.0, f);
-    c->tol = 1e-13 * size * size;
+    c->tol = 1e-11 * size * size;
     c->cancel = cancel;
     double total = 0.0, flux = 0.0;
     for (int axis = 0; axis < 3 && !c->stopped; axis++) {
