@@ -2,19 +2,32 @@
  * mesh.c: the closed skin of a solid (mesh.h).
  *
  * DESIGN
- * 1. Each face is sampled on its own grid and triangulated, wound so that
- *    its normal points out of the parameter cube.
- * 2. Positions closer than 1e-6 of the solid's extent are welded (a spatial
- *    hash, searched over neighbouring cells): seams, shared edges and
- *    collapsed rows become one position each.
- * 3. Triangles with a repeated position, or no area, are dropped: that removes
- *    faces that collapse to a line or a point. Pairs of triangles over the
- *    same three positions with opposite orientations cancel: that removes
- *    faces that coincide, which lie inside the solid.
+ * The skin is the image of the parameter cube's boundary, sampled on the
+ * lattice i/(n-1) of each axis, so its topology is known before any position
+ * is: no position is hashed or searched for.
+ * 1. Each face is sampled on its own grid with the closed form's first
+ *    derivatives (pde_grid), and triangulated, wound so that its normal points
+ *    out of the parameter cube.
+ * 2. Samples are joined (union-find) where they are one point:
+ *    - a face's edge row is its neighbour's (the cube's 12 edges): by the
+ *      lattice alone;
+ *    - adjacent samples of a face's line that the map makes one, within 1e-6
+ *      of the solid's extent: a collapsed row (u = 0 of the circular examples);
+ *    - the same sample on opposite faces that the map makes one: a closed
+ *      loop's seam (v = 0 and v = 1).
+ * 3. Triangles with a repeated point, or no area, are dropped: faces that
+ *    collapse to a line or a point go. A cell of opposite faces whose
+ *    triangles join the same points lies inside the solid: both go (faces that
+ *    coincide).
  * 4. If the enclosed volume comes out negative (the parametrisation reverses
  *    orientation, as x = u sin 2pi v, y = u cos 2pi v does), every triangle
  *    is flipped.
- * 5. Vertices are (position, face) pairs, with area-weighted normals.
+ * 5. Vertices are (point, face) pairs. A vertex's normal is the face's
+ *    x_a x x_b from the closed form, and its det J is det(x_u, x_v, x_w);
+ *    where a vertex joins several samples of its face, or x_a x x_b vanishes
+ *    (a collapsed row's point), the normal is the area-weighted mean of its
+ *    triangles' instead.
+ * Every pass is linear in the samples.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -22,62 +35,11 @@
 
 #include "mesh.h"
 
-/* ---- a small open-addressing map from 64-bit keys to 32-bit values ---- */
-
-typedef struct {
-    uint64_t *keys;
-    uint32_t *vals;
-    size_t cap;    /* a power of two */
-} u64map;
-
-#define EMPTY UINT64_MAX
-
-static int map_init(u64map *m, size_t n)
-{
-    m->cap = 16;
-    while (m->cap < 2 * n)
-        m->cap *= 2;
-    m->keys = malloc(m->cap * sizeof *m->keys);
-    m->vals = malloc(m->cap * sizeof *m->vals);
-    if (!m->keys || !m->vals)
-        return -1;
-    memset(m->keys, 0xff, m->cap * sizeof *m->keys);
-    return 0;
-}
-
-static void map_free(u64map *m)
-{
-    free(m->keys);
-    free(m->vals);
-}
-
-static size_t slot(const u64map *m, uint64_t key)
-{
-    uint64_t h = key * 0x9e3779b97f4a7c15ull;
-    size_t i = (size_t)(h >> 20) & (m->cap - 1);
-    while (m->keys[i] != EMPTY && m->keys[i] != key)
-        i = (i + 1) & (m->cap - 1);
-    return i;
-}
-
-/* The value of key, or the given one stored now; *found tells which. */
-static uint32_t map_get_or_put(u64map *m, uint64_t key, uint32_t val, int *found)
-{
-    size_t i = slot(m, key);
-    *found = m->keys[i] == key;
-    if (!*found) {
-        m->keys[i] = key;
-        m->vals[i] = val;
-    }
-    return m->vals[i];
-}
-
-/* ---- sampling the faces ---- */
-
 typedef struct {
     int axis, side;       /* the face axis = side */
-    size_t na, nb;        /* samples along its fast and slow parameters */
+    size_t na, nb;        /* samples along its fast and slow parameters: (v, w), (u, w) or (u, v) */
     int reverse;          /* wind the other way to face outward */
+    size_t base;          /* its first sample's index */
 } face;
 
 static double sample(size_t i, size_t n)
@@ -90,14 +52,43 @@ static int stopped(const pde_cancel *c)
     return c && c->stop && c->stop(c->arg);
 }
 
-/* Positions of a face, na x nb, fast index first, into out (3 na nb floats); 1 when cancelled. */
-static int sample_face(const pde_solution *sol, const face *f, const unsigned res[3], const pde_cancel *cancel,
-                       float *out)
+/* The fast and slow parameters' axes of a face. */
+static void face_axes(const face *f, int o[2])
 {
-    size_t nu = res[0], nv = res[1], nw = res[2];
+    o[0] = f->axis == 0 ? 1 : 0;
+    o[1] = f->axis == 2 ? 1 : 2;
+}
+
+/* The sample of face f at lattice point ijk, which must lie on f. */
+static size_t face_sample(const face *f, const size_t ijk[3])
+{
+    int o[2];
+    face_axes(f, o);
+    return f->base + ijk[o[1]] * f->na + ijk[o[0]];
+}
+
+/* The raw samples: positions, the face's x_a x x_b, and det J. */
+typedef struct {
+    float *pos, *nrm, *detj;
+} samples;
+
+/*
+ * Face f's samples, na x nb, fast index first, from the closed form with its derivatives. The
+ * grid is made per face: a plane of u = side is a row of (v) per w, and so on. 1 when cancelled,
+ * -1 out of memory.
+ */
+static int sample_face(const pde_solution *sol, const face *f, const unsigned res[3], const pde_cancel *cancel,
+                       samples *out)
+{
+    size_t nu = res[0], nv = res[1];
+    size_t nmax = nu > nv ? nu : nv;
     double *us = malloc((nu + nv) * sizeof *us), *vs = us ? us + nu : NULL;
-    if (!us)
+    float *d = malloc(9 * nmax * sizeof *d);
+    if (!us || !d) {
+        free(us);
+        free(d);
         return -1;
+    }
     for (size_t i = 0; i < nu; i++)
         us[i] = sample(i, nu);
     for (size_t j = 0; j < nv; j++)
@@ -112,28 +103,61 @@ static int sample_face(const pde_solution *sol, const face *f, const unsigned re
     else
         st = pde_grid_create(sol, us, nu, vs, nv, &g);           /* (u, v) */
     free(us);
-    if (st != PDE_OK)
+    if (st != PDE_OK) {
+        free(d);
         return -1;
-    int rc = 0;
-    if (f->axis == 2) {
-        for (size_t j = 0; j < nv && !rc; j++)       /* a row at a time, to poll between rows */
-            if (!(rc = stopped(cancel)))
-                pde_grid_rows(g, fixed, j, j + 1, out + 3 * j * nu, NULL, NULL, NULL);
-    } else {
-        for (size_t k = 0; k < nw && !rc; k++)
-            if (!(rc = stopped(cancel)))
-                pde_grid_plane(g, sample(k, nw), out + 3 * k * f->na);
+    }
+    int o[2], rc = 0;
+    face_axes(f, o);
+    float *xd[3] = { d, d + 3 * nmax, d + 6 * nmax };   /* x_u, x_v, x_w along a row */
+    for (size_t b = 0; b < f->nb && !rc; b++) {       /* a row at a time, to poll between rows */
+        if ((rc = stopped(cancel)))
+            break;
+        const size_t s0 = f->base + b * f->na;
+        if (f->axis == 2)
+            pde_grid_rows(g, fixed, b, b + 1, out->pos + 3 * s0, xd[0], xd[1], xd[2]);
+        else
+            pde_grid_plane_d(g, sample(b, res[2]), out->pos + 3 * s0, xd[0], xd[1], xd[2]);
+        for (size_t a = 0; a < f->na; a++) {
+            const float *ta = xd[o[0]] + 3 * a, *tb = xd[o[1]] + 3 * a, *tc = xd[f->axis] + 3 * a;
+            double n[3] = { (double)ta[1] * tb[2] - (double)ta[2] * tb[1], (double)ta[2] * tb[0] - (double)ta[0] * tb[2],
+                            (double)ta[0] * tb[1] - (double)ta[1] * tb[0] };
+            /* det(x_u, x_v, x_w) = (x_a x x_b) . x_axis, times the sign of (a, b, axis)'s order */
+            double det = n[0] * tc[0] + n[1] * tc[1] + n[2] * tc[2];
+            float *nr = out->nrm + 3 * (s0 + a);
+            for (int k = 0; k < 3; k++)
+                nr[k] = (float)n[k];
+            out->detj[s0 + a] = (float)(f->axis == 1 ? -det : det);
+        }
     }
     pde_grid_free(g);
+    free(d);
     return rc;
 }
 
-#define DEAD 0xff    /* rface mark of a dropped triangle */
+/* ---- union-find over the samples; a set's root is its least sample ---- */
 
-/* A cell's key: 21 bits of each coordinate (cells wrap around far apart, which only costs a probe). */
-static uint64_t cell_key(int64_t x, int64_t y, int64_t z)
+static uint32_t find(uint32_t *up, uint32_t i)
 {
-    return ((uint64_t)(x & 0x1fffff) << 42) | ((uint64_t)(y & 0x1fffff) << 21) | (uint64_t)(z & 0x1fffff);
+    while (up[i] != i) {
+        up[i] = up[up[i]];
+        i = up[i];
+    }
+    return i;
+}
+
+static void join(uint32_t *up, uint32_t a, uint32_t b)
+{
+    a = find(up, a), b = find(up, b);
+    if (a < b)
+        up[b] = a;
+    else if (b < a)
+        up[a] = b;
+}
+
+static int near(const float *p, const float *q, double eps)
+{
+    return fabs((double)p[0] - q[0]) <= eps && fabs((double)p[1] - q[1]) <= eps && fabs((double)p[2] - q[2]) <= eps;
 }
 
 /* The triple in increasing order; returns the parity of the sorting permutation. */
@@ -146,19 +170,6 @@ static int sorted(const uint32_t t[3], uint32_t s[3])
     if (s[1] > s[2]) x = s[1], s[1] = s[2], s[2] = x, parity ^= 1;
     if (s[0] > s[1]) x = s[0], s[0] = s[1], s[1] = x, parity ^= 1;
     return parity;
-}
-
-/* A 64-bit hash of a sorted triple (splitmix64 steps). */
-static uint64_t mix3(const uint32_t s[3])
-{
-    uint64_t h = 0;
-    for (int i = 0; i < 3; i++) {
-        h += s[i] + 0x9e3779b97f4a7c15ull;
-        h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
-        h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
-        h ^= h >> 31;
-    }
-    return h == EMPTY ? 0 : h;
 }
 
 static void cross(const double a[3], const double b[3], double c[3])
@@ -179,23 +190,45 @@ static void tri_normal(const float *p, const float *q, const float *r, double n[
     cross(a, b, n);
 }
 
+/* Six times the signed volume of the tetrahedron (0, p, q, r), for samples p, q, r. */
+static double tri_volume(const float *pos, uint32_t p, uint32_t q, uint32_t r)
+{
+    const float *a = pos + 3 * p, *b = pos + 3 * q, *c = pos + 3 * r;
+    return (double)a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) +
+           (double)a[1] * ((double)b[2] * c[0] - (double)b[0] * c[2]) +
+           (double)a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0]);
+}
+
+/* The samples of triangle q (0, 1) of cell (a, b) of face f, wound outward of the cube. */
+static void cell_tri(const face *f, size_t a, size_t b, int q, uint32_t t[3])
+{
+    uint32_t v00 = (uint32_t)(f->base + b * f->na + a), v10 = v00 + 1;
+    uint32_t v01 = (uint32_t)(v00 + f->na), v11 = v01 + 1;
+    t[0] = v00;
+    t[1] = q ? (f->reverse ? v01 : v11) : (f->reverse ? v11 : v10);
+    t[2] = q ? (f->reverse ? v11 : v01) : (f->reverse ? v10 : v11);
+}
+
 void api_mesh_free(api_mesh *m)
 {
     if (!m)
         return;
     free(m->pos);
     free(m->nrm);
+    free(m->detj);
     free(m->tri);
     free(m->weld);
     memset(m, 0, sizeof *m);
 }
 
-/* Polls every 8192 steps of a pass over points or triangles. */
-#define POLL(i) ((i) % 8192 == 8191 && stopped(cancel))
-
 int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_mesh *out,
                    api_error *err)
 {
+    memset(out, 0, sizeof *out);
+    if (res[0] < 2 || res[1] < 2 || res[2] < 2) {
+        api_fail(err, "", "a mesh needs at least 2 samples per face edge");
+        return -1;
+    }
     /* e_v x e_w = +e_u, e_u x e_w = -e_v, e_u x e_v = +e_w: which faces must reverse. */
     face faces[6];
     size_t nraw = 0, ntraw = 0;
@@ -208,247 +241,238 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             f->nb = a == 2 ? res[1] : res[2];
             int outward_plus = s == 1, frame_plus = a != 1;
             f->reverse = outward_plus != frame_plus;
+            f->base = nraw;
             nraw += f->na * f->nb;
             ntraw += 2 * (f->na - 1) * (f->nb - 1);
         }
-    float *raw = malloc(3 * nraw * sizeof *raw);
-    uint32_t *rtri = malloc(3 * ntraw * sizeof *rtri);
-    uint8_t *rface = malloc(ntraw);
-    uint32_t *wid = malloc(nraw * sizeof *wid);
-    double *wpos = malloc(3 * nraw * sizeof *wpos);
-    uint32_t *chain = malloc(nraw * sizeof *chain);
-    u64map cells = { 0 }, tris = { 0 };
-    memset(out, 0, sizeof *out);
+    samples raw = { malloc(3 * nraw * sizeof(float)), malloc(3 * nraw * sizeof(float)), malloc(nraw * sizeof(float)) };
+    uint32_t *up = malloc(nraw * sizeof *up);
+    uint32_t *vof = malloc(nraw * sizeof *vof);    /* this face's vertex at each root, or UINT32_MAX */
+    uint32_t *pid = malloc(nraw * sizeof *pid);    /* the position id of each root, or UINT32_MAX */
+    uint8_t *live = malloc(ntraw);
+    double *acc = NULL;
+    uint32_t *vsam = NULL;    /* each vertex's sample */
     int rc = -1, cancelled = 0;
     const char *why = "out of memory building the mesh";
-    if (!raw || !rtri || !rface || !wid || !wpos || !chain)
+    if (!raw.pos || !raw.nrm || !raw.detj || !up || !vof || !pid || !live)
         goto done;
 
     /* 1. Faces. */
-    size_t base = 0, nt = 0;
     for (int fi = 0; fi < 6; fi++) {
-        const face *f = &faces[fi];
-        int r = sample_face(sol, f, res, cancel, raw + 3 * base);
+        int r = sample_face(sol, &faces[fi], res, cancel, &raw);
         if (r) {
             cancelled = r > 0;
             goto done;
         }
-        for (size_t b = 0; b + 1 < f->nb; b++)
-            for (size_t a = 0; a + 1 < f->na; a++) {
-                uint32_t v00 = (uint32_t)(base + b * f->na + a), v10 = v00 + 1;
-                uint32_t v01 = (uint32_t)(v00 + f->na), v11 = v01 + 1;
-                uint32_t q[2][3] = { { v00, v10, v11 }, { v00, v11, v01 } };
-                for (int t = 0; t < 2; t++, nt++) {
-                    rtri[3 * nt] = q[t][0];
-                    rtri[3 * nt + 1] = f->reverse ? q[t][2] : q[t][1];
-                    rtri[3 * nt + 2] = f->reverse ? q[t][1] : q[t][2];
-                    rface[nt] = (uint8_t)fi;
-                }
-            }
-        base += f->na * f->nb;
     }
-
-    /* 2. Weld. */
     double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
     for (size_t i = 0; i < nraw; i++)
         for (int k = 0; k < 3; k++) {
-            if (!isfinite(raw[3 * i + k])) {
+            const float x = raw.pos[3 * i + k];
+            if (!isfinite(x)) {
                 why = "the solid's coordinates exceed the range of float32; no mesh can hold them";
                 goto done;
             }
-            lo[k] = fmin(lo[k], raw[3 * i + k]);
-            hi[k] = fmax(hi[k], raw[3 * i + k]);
+            lo[k] = x < lo[k] ? x : lo[k];
+            hi[k] = x > hi[k] ? x : hi[k];
         }
-    double extent = fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
-    double eps = extent > 0 ? 1e-6 * extent : 1e-30, cell = 4 * eps;
-    if (map_init(&cells, nraw))
-        goto done;
-    size_t npos = 0;
-    for (size_t i = 0; i < nraw; i++) {
-        if (POLL(i)) {
-            cancelled = 1;
-            goto done;
-        }
-        const float *p = raw + 3 * i;
-        int64_t c[3];
-        int span[3][2];     /* neighbouring cells worth a look: only within eps of a side */
-        for (int k = 0; k < 3; k++) {
-            double f = (p[k] - lo[k]) / cell;
-            c[k] = (int64_t)floor(f);
-            double frac = (f - (double)c[k]) * cell;
-            span[k][0] = frac < eps ? -1 : 0;
-            span[k][1] = cell - frac < eps ? 1 : 0;
-        }
-        uint32_t hit = UINT32_MAX;
-        for (int dx = span[0][0]; dx <= span[0][1] && hit == UINT32_MAX; dx++)
-            for (int dy = span[1][0]; dy <= span[1][1] && hit == UINT32_MAX; dy++)
-                for (int dz = span[2][0]; dz <= span[2][1] && hit == UINT32_MAX; dz++) {
-                    uint64_t key = cell_key(c[0] + dx, c[1] + dy, c[2] + dz);
-                    size_t s = slot(&cells, key);
-                    if (cells.keys[s] != key)
-                        continue;
-                    for (uint32_t w = cells.vals[s]; w != UINT32_MAX && hit == UINT32_MAX; w = chain[w])
-                        if (fabs(wpos[3 * w] - p[0]) <= eps && fabs(wpos[3 * w + 1] - p[1]) <= eps &&
-                            fabs(wpos[3 * w + 2] - p[2]) <= eps)
-                            hit = w;
-                }
-        if (hit == UINT32_MAX) {
-            hit = (uint32_t)npos++;
-            for (int k = 0; k < 3; k++)
-                wpos[3 * hit + k] = p[k];
-            uint64_t key = cell_key(c[0], c[1], c[2]);
-            int found;
-            uint32_t head = map_get_or_put(&cells, key, hit, &found);
-            chain[hit] = found ? head : UINT32_MAX;
-            if (found)
-                cells.vals[slot(&cells, key)] = hit;
-        }
-        wid[i] = hit;
-    }
+    const double extent = fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
+    const double eps = extent > 0 ? 1e-6 * extent : 1e-30;
 
-    /* 3. Drop collapsed triangles; cancel coincident pairs of opposite orientation. */
-    for (size_t t = 0; t < nt; t++) {
-        if (POLL(t)) {
-            cancelled = 1;
-            goto done;
-        }
-        uint32_t *w = &rtri[3 * t];
-        double n[3];
-        tri_normal(raw + 3 * w[0], raw + 3 * w[1], raw + 3 * w[2], n);
-        for (int k = 0; k < 3; k++)
-            w[k] = wid[w[k]];                           /* from here on, position ids */
-        if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2] ||
-            sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) <= 1e-12 * extent * extent)
-            rface[t] = DEAD;
-    }
-    /* Only a triangle whose three positions all lie on a second face can have a coincident twin. */
-    uint8_t *mask = calloc(npos + 1, 1);
-    if (!mask)
-        goto done;
-    size_t ncand = 0;
-    for (size_t t = 0; t < nt; t++)
-        if (rface[t] != DEAD)
-            for (int i = 0; i < 3; i++)
-                mask[rtri[3 * t + i]] |= (uint8_t)(1u << rface[t]);
-    for (size_t t = 0; t < nt; t++) {
-        if (rface[t] == DEAD)
-            continue;
-        uint8_t m = mask[rtri[3 * t]] & mask[rtri[3 * t + 1]] & mask[rtri[3 * t + 2]];
-        if (m & (m - 1))     /* two faces or more */
-            ncand++;
-    }
-    if (map_init(&tris, ncand)) {
-        free(mask);
-        goto done;
-    }
-    for (size_t t = 0; t < nt; t++) {
-        if (POLL(t)) {
-            free(mask);
-            cancelled = 1;
-            goto done;
-        }
-        if (rface[t] == DEAD)
-            continue;
-        uint8_t m = mask[rtri[3 * t]] & mask[rtri[3 * t + 1]] & mask[rtri[3 * t + 2]];
-        if (!(m & (m - 1)))
-            continue;
-        uint32_t s3[3];
-        int parity = sorted(&rtri[3 * t], s3);
-        uint64_t key = (mix3(s3) & ~1ull) | (uint64_t)parity;
-        size_t st = slot(&tris, key ^ 1);
-        if (tris.keys[st] == (key ^ 1) && tris.vals[st] != UINT32_MAX) {
-            uint32_t o = tris.vals[st], so[3];
-            sorted(&rtri[3 * o], so);
-            if (so[0] == s3[0] && so[1] == s3[1] && so[2] == s3[2]) {
-                rface[t] = rface[o] = DEAD;             /* coincident faces: inside the solid */
-                tris.vals[st] = UINT32_MAX;
-                continue;
-            }
-        }
-        int found;
-        map_get_or_put(&tris, key, (uint32_t)t, &found);
-        if (found)
-            tris.vals[slot(&tris, key)] = (uint32_t)t;
-    }
-    free(mask);
-
-    /* 4. Outward: the enclosed volume must be positive. */
-    double vol = 0.0;
-    for (size_t t = 0; t < nt; t++) {
-        if (rface[t] == DEAD)
-            continue;
-        const double *p = wpos + 3 * rtri[3 * t], *q = wpos + 3 * rtri[3 * t + 1], *r = wpos + 3 * rtri[3 * t + 2];
-        double c[3];
-        cross(q, r, c);
-        vol += p[0] * c[0] + p[1] * c[1] + p[2] * c[2];
-    }
-    int flip = vol < 0.0;
-
-    /* 5. Vertices are (position, face) pairs; normals are area-weighted. */
-    size_t ntri = 0;
-    for (size_t t = 0; t < nt; t++)
-        ntri += rface[t] != DEAD;
-    out->tri = malloc((3 * ntri + 1) * sizeof *out->tri);
-    uint32_t *vof = malloc((npos + 1) * sizeof *vof);   /* this face's vertex at each position */
-    if (!out->tri || !vof) {
-        free(vof);
-        goto done;
-    }
-    memset(vof, 0xff, (npos + 1) * sizeof *vof);
-    size_t nv = 0, k = 0, first = 0;
+    /* 2. Join: the cube's edges by the lattice; collapsed rows and seams where the map joins them. */
+    for (size_t i = 0; i < nraw; i++)
+        up[i] = (uint32_t)i;
     for (int fi = 0; fi < 6; fi++) {
-        for (size_t t = 0; t < nt; t++) {
-            if (rface[t] != fi)
-                continue;
-            uint32_t w[3] = { rtri[3 * t], rtri[3 * t + (flip ? 2 : 1)], rtri[3 * t + (flip ? 1 : 2)] };
-            for (int i = 0; i < 3; i++) {
-                if (vof[w[i]] == UINT32_MAX) {
-                    vof[w[i]] = (uint32_t)nv;
-                    chain[nv++] = w[i];                 /* chain now maps vertex -> position id */
-                }
-                out->tri[k++] = vof[w[i]];
+        const face *f = &faces[fi];
+        int o[2];
+        face_axes(f, o);
+        size_t ijk[3];
+        ijk[f->axis] = f->side ? res[f->axis] - 1 : 0;
+        for (size_t b = 0; b < f->nb; b++)
+            for (size_t a = 0; a < f->na; a++) {
+                const uint32_t i = (uint32_t)(f->base + b * f->na + a);
+                const float *p = raw.pos + 3 * i;
+                if (a + 1 < f->na && near(p, p + 3, eps))
+                    join(up, i, i + 1);
+                if (b + 1 < f->nb && near(p, p + 3 * f->na, eps))
+                    join(up, i, (uint32_t)(i + f->na));
+                if (a > 0 && a + 1 < f->na && b > 0 && b + 1 < f->nb)
+                    continue;
+                ijk[o[0]] = a, ijk[o[1]] = b;
+                for (int e = 0; e < 3; e++)    /* the neighbouring faces this sample lies on */
+                    if (e != f->axis && (ijk[e] == 0 || ijk[e] == res[e] - 1))
+                        join(up, i, (uint32_t)face_sample(&faces[2 * e + (ijk[e] != 0)], ijk));
             }
-        }
-        for (size_t v = first; v < nv; v++)             /* the next face starts afresh */
-            vof[chain[v]] = UINT32_MAX;
-        first = nv;
     }
-    free(vof);
-    out->pos = malloc((3 * nv + 1) * sizeof *out->pos);
-    out->nrm = malloc((3 * nv + 1) * sizeof *out->nrm);
-    out->weld = malloc((nv ? nv : 1) * sizeof *out->weld);
-    double *acc = calloc(3 * nv + 1, sizeof *acc);
-    if (!out->pos || !out->nrm || !out->weld || !acc) {
-        free(acc);
+    size_t seams[3] = { 0, 0, 0 };   /* samples of opposite faces joined, per axis */
+    for (int a = 0; a < 3; a++) {
+        const face *f0 = &faces[2 * a], *f1 = &faces[2 * a + 1];
+        for (size_t k = 0; k < f0->na * f0->nb; k++)
+            if (near(raw.pos + 3 * (f0->base + k), raw.pos + 3 * (f1->base + k), eps))
+                join(up, (uint32_t)(f0->base + k), (uint32_t)(f1->base + k)), seams[a]++;
+    }
+    for (size_t i = 0; i < nraw; i++)
+        up[i] = find(up, (uint32_t)i);
+    if (stopped(cancel)) {
+        cancelled = 1;
         goto done;
     }
-    for (size_t v = 0; v < nv; v++) {
-        out->weld[v] = chain[v];
-        for (int c = 0; c < 3; c++)
-            out->pos[3 * v + c] = (float)wpos[3 * chain[v] + c];
+
+    /* 3. Triangles that collapse go; so do the cells of opposite faces that coincide. */
+    const double tiny = 1e-12 * extent * extent, tiny2 = tiny * tiny;
+    size_t t = 0, ntri = 0;
+    double vol = 0.0;   /* six times the enclosed volume, over the live triangles */
+    for (int fi = 0; fi < 6; fi++) {
+        const face *f = &faces[fi];
+        for (size_t b = 0; b + 1 < f->nb; b++)
+            for (size_t a = 0; a + 1 < f->na; a++)
+                for (int q = 0; q < 2; q++, t++) {
+                    uint32_t s[3];
+                    cell_tri(f, a, b, q, s);
+                    double n[3];
+                    tri_normal(raw.pos + 3 * s[0], raw.pos + 3 * s[1], raw.pos + 3 * s[2], n);
+                    const uint32_t r0 = up[s[0]], r1 = up[s[1]], r2 = up[s[2]];
+                    live[t] = !(r0 == r1 || r1 == r2 || r0 == r2 || n[0] * n[0] + n[1] * n[1] + n[2] * n[2] <= tiny2);
+                    if (live[t])
+                        vol += tri_volume(raw.pos, r0, r1, r2), ntri++;
+                }
     }
-    for (size_t t = 0; t < ntri; t++) {
-        const uint32_t *w = &out->tri[3 * t];
-        double n[3];
-        tri_normal(out->pos + 3 * w[0], out->pos + 3 * w[1], out->pos + 3 * w[2], n);
-        for (int i = 0; i < 3; i++)
-            for (int c = 0; c < 3; c++)
-                acc[3 * w[i] + c] += n[c];
+    for (int a = 0; a < 3; a++) {
+        const face *f0 = &faces[2 * a], *f1 = &faces[2 * a + 1];
+        if (seams[a] < 3)
+            continue;   /* no triangle of one lies on the other */
+        size_t first0 = 0;    /* the faces' first triangles */
+        for (int fi = 0; fi < 2 * a; fi++)
+            first0 += 2 * (faces[fi].na - 1) * (faces[fi].nb - 1);
+        const size_t first1 = first0 + 2 * (f0->na - 1) * (f0->nb - 1);
+        for (size_t b = 0; b + 1 < f0->nb; b++)
+            for (size_t c = 0; c + 1 < f0->na; c++)
+                for (int q = 0; q < 2; q++) {
+                    const size_t k = 2 * (b * (f0->na - 1) + c) + (size_t)q;
+                    if (!live[first0 + k] || !live[first1 + k])
+                        continue;
+                    uint32_t s0[3], s1[3], r0[3], r1[3];
+                    cell_tri(f0, c, b, q, s0);
+                    cell_tri(f1, c, b, q, s1);
+                    for (int i = 0; i < 3; i++)
+                        s0[i] = up[s0[i]], s1[i] = up[s1[i]];
+                    if (sorted(s0, r0) != sorted(s1, r1) && memcmp(r0, r1, sizeof r0) == 0) {
+                        live[first0 + k] = live[first1 + k] = 0;
+                        vol -= tri_volume(raw.pos, s0[0], s0[1], s0[2]) + tri_volume(raw.pos, s1[0], s1[1], s1[2]);
+                        ntri -= 2;
+                    }
+                }
     }
+
+    /* 4. Outward: the enclosed volume (summed in 3) must be positive. */
+    const int flip = vol < 0.0;
+
+    /* 5. Vertices, (point, face) pairs, made in the order the face's triangles first use them, at the
+     * sample that first does; a second sample of the face at the vertex's point makes it a collapsed
+     * row's point, whose normal comes from its triangles. */
+    out->pos = malloc(3 * nraw * sizeof *out->pos);
+    out->nrm = malloc(3 * nraw * sizeof *out->nrm);
+    out->detj = malloc(nraw * sizeof *out->detj);
+    out->weld = malloc(nraw * sizeof *out->weld);
+    out->tri = malloc((3 * ntri + 1) * sizeof *out->tri);
+    vsam = malloc(nraw * sizeof *vsam);
+    if (!out->pos || !out->nrm || !out->detj || !out->weld || !out->tri || !vsam)
+        goto done;
+    memset(pid, 0xff, nraw * sizeof *pid);
+    size_t nv = 0, npos = 0, k3 = 0, tri_of[7] = { 0 };
+    int has_nan[6] = { 0 };
+    t = 0;
+    for (int fi = 0; fi < 6; fi++) {
+        if (stopped(cancel)) {
+            cancelled = 1;
+            goto done;
+        }
+        const face *f = &faces[fi];
+        const size_t end = f->base + f->na * f->nb, first = nv;
+        const double sgn = (f->reverse ? -1.0 : 1.0) * (flip ? -1.0 : 1.0);
+        for (size_t k = f->base; k < end; k++)
+            vof[up[k]] = UINT32_MAX;
+        for (size_t b = 0; b + 1 < f->nb; b++)
+            for (size_t a = 0; a + 1 < f->na; a++)
+                for (int q = 0; q < 2; q++, t++) {
+                    if (!live[t])
+                        continue;
+                    uint32_t s[3];
+                    cell_tri(f, a, b, q, s);
+                    if (flip) {
+                        const uint32_t x = s[1];
+                        s[1] = s[2], s[2] = x;
+                    }
+                    for (int i = 0; i < 3; i++) {
+                        const uint32_t r = up[s[i]];
+                        if (vof[r] == UINT32_MAX) {
+                            const uint32_t v = (uint32_t)nv++, k = s[i];
+                            vof[r] = v;
+                            vsam[v] = k;
+                            if (pid[r] == UINT32_MAX)
+                                pid[r] = (uint32_t)npos++;
+                            out->weld[v] = pid[r];
+                            memcpy(out->pos + 3 * v, raw.pos + 3 * r, 3 * sizeof(float));
+                            out->detj[v] = raw.detj[k];
+                            const float *n = raw.nrm + 3 * k;
+                            const double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+                            has_nan[fi] |= !(len > tiny);
+                            for (int c = 0; c < 3; c++)
+                                out->nrm[3 * v + c] = len > tiny ? (float)(sgn * n[c] / len) : NAN;
+                        }
+                        out->tri[k3++] = vof[r];
+                    }
+                }
+        for (size_t k = f->base; k < end; k++) {
+            const uint32_t v = vof[up[k]];
+            if (v != UINT32_MAX && v >= first && vsam[v] != k)
+                out->nrm[3 * v] = NAN, has_nan[fi] = 1;
+        }
+        tri_of[fi + 1] = k3 / 3;
+    }
+    /* Area-weighted normals for the vertices marked NaN, from their faces' triangles. */
+    acc = calloc(3 * nv + 1, sizeof *acc);
+    if (!acc)
+        goto done;
+    for (int fi = 0; fi < 6; fi++)
+        for (size_t tt = has_nan[fi] ? tri_of[fi] : tri_of[fi + 1]; tt < tri_of[fi + 1]; tt++) {
+            const uint32_t *w = &out->tri[3 * tt];
+            if (!isnan(out->nrm[3 * w[0]]) && !isnan(out->nrm[3 * w[1]]) && !isnan(out->nrm[3 * w[2]]))
+                continue;
+            double n[3];
+            tri_normal(out->pos + 3 * w[0], out->pos + 3 * w[1], out->pos + 3 * w[2], n);
+            for (int i = 0; i < 3; i++)
+                for (int c = 0; c < 3; c++)
+                    acc[3 * w[i] + c] += n[c];
+        }
     for (int c = 0; c < 3; c++)
         out->min[c] = INFINITY, out->max[c] = -INFINITY;
     for (size_t v = 0; v < nv; v++) {
-        double *n = acc + 3 * v, len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (isnan(out->nrm[3 * v])) {
+            const double *n = acc + 3 * v, len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            for (int c = 0; c < 3; c++)
+                out->nrm[3 * v + c] = len > 0 ? (float)(n[c] / len) : (c == 2 ? 1.0f : 0.0f);
+        }
         for (int c = 0; c < 3; c++) {
-            out->nrm[3 * v + c] = len > 0 ? (float)(n[c] / len) : (c == 2 ? 1.0f : 0.0f);
-            out->min[c] = fminf(out->min[c], out->pos[3 * v + c]);
-            out->max[c] = fmaxf(out->max[c], out->pos[3 * v + c]);
+            const float x = out->pos[3 * v + c];
+            out->min[c] = x < out->min[c] ? x : out->min[c];
+            out->max[c] = x > out->max[c] ? x : out->max[c];
         }
     }
-    free(acc);
     out->nverts = nv;
     out->ntris = ntri;
     out->npos = npos;
+    /* Down to what is used (realloc to a smaller size keeps the block where it cannot move it). */
+    float *p;
+    uint32_t *w;
+    if ((p = realloc(out->pos, (3 * nv + 1) * sizeof *p)))
+        out->pos = p;
+    if ((p = realloc(out->nrm, (3 * nv + 1) * sizeof *p)))
+        out->nrm = p;
+    if ((p = realloc(out->detj, (nv + 1) * sizeof *p)))
+        out->detj = p;
+    if ((w = realloc(out->weld, (nv + 1) * sizeof *w)))
+        out->weld = w;
     rc = 0;
 done:
     if (rc) {
@@ -457,13 +481,14 @@ done:
         if (cancelled && err)
             err->status = API_STATUS_CANCELLED;
     }
-    free(raw);
-    free(rtri);
-    free(rface);
-    free(wid);
-    free(wpos);
-    free(chain);
-    map_free(&cells);
-    map_free(&tris);
+    free(raw.pos);
+    free(raw.nrm);
+    free(raw.detj);
+    free(up);
+    free(vof);
+    free(pid);
+    free(live);
+    free(acc);
+    free(vsam);
     return rc;
 }

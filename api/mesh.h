@@ -8,6 +8,10 @@
  * enclosed volume is positive). Vertices are shared within a face, so normals
  * are smooth across a face and sharp at the creases between faces; weld[]
  * gives each vertex's position id across faces, for formats without normals.
+ * Normals and det J come from the closed form's derivatives at each vertex
+ * (a collapsed row's point, where the face's tangents vanish, takes the
+ * area-weighted normal of its triangles). Seams and collapsed rows are found
+ * from the face grids' structure, not by searching positions (mesh.c).
  */
 #ifndef API_MESH_H
 #define API_MESH_H
@@ -22,6 +26,7 @@ typedef struct {
     size_t nverts, ntris, npos;
     float *pos;        /* 3 nverts */
     float *nrm;        /* 3 nverts, unit length */
+    float *detj;       /* nverts: det J = det(x_u, x_v, x_w) at the vertex (<= 0 where the solid folds) */
     uint32_t *tri;     /* 3 ntris, counter-clockwise seen from outside */
     uint32_t *weld;    /* nverts: position id in [0, npos) */
     float min[3], max[3];   /* of pos, exactly */
@@ -32,8 +37,8 @@ typedef struct {
  * (out zeroed). cancel (NULL: never) is polled between rows of the faces and
  * every few thousand points or triangles of the later passes; when it stops,
  * everything is freed and err has status API_STATUS_CANCELLED. Memory peaks
- * at about 150 to 200 bytes per face sample, 6 res^2 samples in all: about
- * 60 MB at res 256 (api/cost.h estimates it).
+ * at about 120 bytes per face sample, 6 res^2 samples in all: about 48 MB at
+ * res 256 (api/cost.h estimates it).
  */
 int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_mesh *out,
                    api_error *err);

@@ -18,7 +18,9 @@
 #include <cJSON.h>
 #include <cmocka.h>
 
+#include "catalog.h"
 #include "id.h"
+#include "mesh.h"
 #include "output.h"
 #include "support.h"
 #include "template.h"
@@ -503,6 +505,98 @@ static void stl_skin_should_be_closed_and_enclose_the_computed_volume(void **sta
     }
 }
 
+/* Every preset and loft: the skin closed (each edge used once each way), the vertices' normals
+ * (the closed form's) on the side their triangles face, and det J at the vertices of w = 1 equal
+ * to det(x_u, x_v, x_w) from pde_eval_d there. */
+static void every_skin_should_be_closed_with_normals_and_det_j_from_the_closed_form(void **state)
+{
+    (void)state;
+    const char *lofts[] = { "vase", "tower", "blade", "bottle" };
+    const size_t nfig = paper_figure_count(), n = nfig + sizeof lofts / sizeof *lofts;
+    for (size_t f = 0; f < n; f++) {
+        const char *name = f < nfig ? paper_figure_name(f) : lofts[f - nfig];
+        pde_solution *sol;
+        api_error err;
+        if (f < nfig)
+            sol = solve_preset(name, NULL);
+        else {
+            char doc[64];
+            snprintf(doc, sizeof doc, "{\"preset\": \"%s\"}", name);
+            api_model *m = api_model_parse(doc, strlen(doc), &err);
+            assert_non_null(m);
+            assert_int_equal(api_solve(m, &sol, &err), 0);
+            api_model_free(m);
+        }
+        const unsigned res[3] = { 24, 160, 24 };   /* fig. 3's sin 30 pi v: 10 samples a period */
+        size_t len, nt;
+        unsigned char *b = render(sol, NULL, API_FMT_STL, res, &len);
+        if (!(stl_closed_volume(b, len, &nt) > 0))
+            fail_msg("%s: the skin encloses no positive volume", name);
+        free(b);
+
+        api_mesh m;
+        assert_int_equal(api_mesh_build(sol, res, NULL, &m, &err), 0);
+        double *acc = calloc(3 * m.nverts, sizeof *acc);
+        for (size_t t = 0; t < m.ntris; t++) {
+            const float *p[3];
+            for (int i = 0; i < 3; i++)
+                p[i] = m.pos + 3 * m.tri[3 * t + i];
+            double a[3], c[3], d[3];
+            for (int k = 0; k < 3; k++)
+                a[k] = (double)p[1][k] - p[0][k], c[k] = (double)p[2][k] - p[0][k];
+            d[0] = a[1] * c[2] - a[2] * c[1], d[1] = a[2] * c[0] - a[0] * c[2], d[2] = a[0] * c[1] - a[1] * c[0];
+            for (int i = 0; i < 3; i++)
+                for (int k = 0; k < 3; k++)
+                    acc[3 * m.tri[3 * t + i] + k] += d[k];
+        }
+        size_t agree = 0, used = 0;
+        for (size_t v = 0; v < m.nverts; v++) {
+            const double *a = acc + 3 * v;
+            const float *nr = m.nrm + 3 * v;
+            double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+            if (!(la > 0))
+                continue;
+            used++;
+            double c = (a[0] * nr[0] + a[1] * nr[1] + a[2] * nr[2]) / la;
+            agree += c > 0.5;
+            assert_true(fabs(sqrt((double)nr[0] * nr[0] + (double)nr[1] * nr[1] + (double)nr[2] * nr[2]) - 1) < 1e-6);
+        }
+        /* Not all: on a cuspidal edge of a folded face (fig. 3b's) the triangles around a vertex mix
+         * both sheets; a normal of the wrong sign would agree nowhere. */
+        if (agree < used * 90 / 100)
+            fail_msg("%s: only %zu of %zu vertex normals lie within 60 degrees of their triangles'", name, agree, used);
+
+        /* det J at the interior samples of w = 1, found by their positions. */
+        double jmax = 0;
+        for (size_t v = 0; v < m.nverts; v++)
+            jmax = fmax(jmax, fabs(m.detj[v]));
+        size_t checked = 0;
+        for (unsigned i = 1; i + 1 < res[0]; i += 3)
+            for (unsigned j = 1; j + 1 < res[1]; j += 3) {
+                double u = (double)i / (res[0] - 1), vv = (double)j / (res[1] - 1), x[3], xu[3], xv[3], xw[3];
+                pde_eval_d(sol, u, vv, 1.0, x, xu, xv, xw);
+                const double dj = xu[0] * (xv[1] * xw[2] - xv[2] * xw[1]) - xu[1] * (xv[0] * xw[2] - xv[2] * xw[0]) +
+                                  xu[2] * (xv[0] * xw[1] - xv[1] * xw[0]);
+                size_t hit = SIZE_MAX, hits = 0;
+                for (size_t v = 0; v < m.nverts; v++)
+                    if (m.pos[3 * v] == (float)x[0] && m.pos[3 * v + 1] == (float)x[1] && m.pos[3 * v + 2] == (float)x[2] &&
+                        fabs(m.nrm[3 * v + 2]) >= 0)
+                        hit = v, hits++;
+                if (hits != 1)
+                    continue;   /* on a fold or a seam the position does not tell the sample */
+                checked++;
+                if (!(fabs(m.detj[hit] - dj) <= 1e-5 * jmax + 1e-6 * fabs(dj)))
+                    fail_msg("%s: det J at (%g, %g, 1) is %.9g in the mesh, %.9g from pde_eval_d", name, u, vv,
+                             m.detj[hit], dj);
+            }
+        if (checked < 10)
+            fail_msg("%s: only %zu samples of w = 1 found among the vertices", name, checked);
+        free(acc);
+        api_mesh_free(&m);
+        pde_solution_free(sol);
+    }
+}
+
 static void vts_should_hold_the_points_and_det_j(void **state)
 {
     (void)state;
@@ -665,6 +759,7 @@ int main(void)
         cmocka_unit_test(gltf_should_carry_the_id_properties_and_exact_bounds),
         cmocka_unit_test(grid_json_should_read_back_as_the_f32_output),
         cmocka_unit_test(stl_skin_should_be_closed_and_enclose_the_computed_volume),
+        cmocka_unit_test(every_skin_should_be_closed_with_normals_and_det_j_from_the_closed_form),
         cmocka_unit_test(vts_should_hold_the_points_and_det_j),
         cmocka_unit_test(json_should_hold_the_closed_form_properties_and_id),
         cmocka_unit_test(every_output_with_properties_should_carry_each_of_them_by_name),
