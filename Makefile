@@ -9,7 +9,7 @@ STD     := -std=c11 -D_DEFAULT_SOURCE
 WARN    := -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wmissing-prototypes
 CFLAGS  += $(STD) $(OPT) $(WARN) -Icore -Iapi
 LDLIBS  := -lm
-LIBS    := $(shell pkg-config --libs libcjson 2>/dev/null || echo -lcjson) -lnettle $(shell pkg-config --libs fftw3 2>/dev/null || echo -lfftw3)
+LIBS    := $(shell pkg-config --libs libcjson 2>/dev/null || echo -lcjson) -lnettle $(shell pkg-config --libs fftw3 2>/dev/null || echo -lfftw3) -lmeshoptimizer
 CJSON_CFLAGS := $(shell pkg-config --cflags libcjson 2>/dev/null || echo -I/usr/include/cjson)
 CMOCKA  := $(shell pkg-config --libs cmocka 2>/dev/null || echo -lcmocka)
 SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
