@@ -59,16 +59,11 @@ int api_meshopt_encode(const api_mesh *m, api_meshopt *out, api_error *err)
     /* The streams' bounds, each aligned: positions (12), normals (4), det J (4), indices. */
     const size_t cap = align4(vbound) + 2 * align4(meshopt_encodeVertexBufferBound(n, 4)) + align4(ibound) + 16;
     out->data = malloc(cap);
+    int rc = -1;
     if (!idx || !remap || !pos || !nrm4 || !detj || !filtered || !out->data) {
-        free(idx);
-        free(remap);
-        free(pos);
-        free(nrm4);
-        free(detj);
-        free(filtered);
         api_meshopt_free(out);
         api_fail(err, "", "out of memory compressing the mesh");
-        return -1;
+        goto done;
     }
 
     /* Triangles for the vertex cache, then vertices in the order the triangles fetch them. */
@@ -125,12 +120,13 @@ int api_meshopt_encode(const api_mesh *m, api_meshopt *out, api_error *err)
                               .component_type = nv < 65536 ? 5123 : 5125, .type = "SCALAR" };
     w = meshopt_encodeIndexBuffer(out->data + out->len, cap - out->len, idx, ni);
     add_stream(out, &s, w);
-
+    rc = 0;
+done:
     free(idx);
     free(remap);
     free(pos);
     free(nrm4);
     free(detj);
     free(filtered);
-    return 0;
+    return rc;
 }
