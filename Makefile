@@ -44,7 +44,7 @@ FUZZ_REPLAYS := $(patsubst %,build/san/fuzz/%,$(FUZZ_NAMES))
 FUZZ_LIB_SRC := $(filter-out server/main.c,$(SRV_SRC)) $(API_SRC) $(CORE_SRC) tests/support.c
 fuzzobj = $(patsubst %.c,build/fuzz/obj/%.o,$(1))
 
-.PHONY: all test check fuzz bench clean deps run tsan
+.PHONY: all test check fuzz bench clean deps run tsan install uninstall
 all: build/pdesolid build/pdesolidd
 
 # Installs missing Debian and npm packages (a no-op when all are there).
@@ -187,5 +187,33 @@ bench: $(BENCHES) build/pdesolidd build/bench/mhd_minimal
 
 clean:
 	rm -rf build
+
+# ---- `make install [PREFIX=/usr/local] [DESTDIR=]`: the programs, the front-end, the manual pages and
+# the systemd unit (deploy/README.md). The front-end's files are the file column of server/static.c's
+# table, so a file the daemon serves is a file that is installed.
+PREFIX ?= /usr/local
+BINDIR ?= $(PREFIX)/bin
+SBINDIR ?= $(PREFIX)/sbin
+DATADIR ?= $(PREFIX)/share/pdesolid
+MANDIR ?= $(PREFIX)/share/man
+UNITDIR ?= $(PREFIX)/lib/systemd/system
+WEB_FILES := $(shell grep -o '"[^/"][^"]*\.\(html\|js\|css\)"' server/static.c | tr -d '"' | sort -u)
+
+install: all
+	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(SBINDIR) $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(MANDIR)/man8 \
+	    $(DESTDIR)$(UNITDIR)
+	install -m 0755 build/pdesolid $(DESTDIR)$(BINDIR)/pdesolid
+	install -m 0755 build/pdesolidd $(DESTDIR)$(SBINDIR)/pdesolidd
+	install -m 0644 deploy/pdesolid.1 $(DESTDIR)$(MANDIR)/man1/pdesolid.1
+	install -m 0644 deploy/pdesolidd.8 $(DESTDIR)$(MANDIR)/man8/pdesolidd.8
+	sed -e 's|@SBINDIR@|$(SBINDIR)|g' -e 's|@DATADIR@|$(DATADIR)|g' deploy/pdesolidd.service \
+	    > $(DESTDIR)$(UNITDIR)/pdesolidd.service
+	chmod 0644 $(DESTDIR)$(UNITDIR)/pdesolidd.service
+	@set -e; for f in $(WEB_FILES); do install -D -m 0644 clients/web/$$f $(DESTDIR)$(DATADIR)/web/$$f; done
+
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/pdesolid $(DESTDIR)$(SBINDIR)/pdesolidd $(DESTDIR)$(MANDIR)/man1/pdesolid.1 \
+	    $(DESTDIR)$(MANDIR)/man8/pdesolidd.8 $(DESTDIR)$(UNITDIR)/pdesolidd.service
+	rm -rf $(DESTDIR)$(DATADIR)
 
 -include $(shell find build -name '*.d' 2>/dev/null)

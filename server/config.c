@@ -79,7 +79,7 @@ static const flag flags[] = {
       "seconds to finish requests on SIGTERM or SIGINT" },
     { "--cors-origin", "LIST", K_STR, AT(cors), 0, 0, "", "none: same origin only",
       "origins allowed cross-origin calls, comma-separated,\nor * for any" },
-    { "--web", "DIR", K_STR, AT(web), 1, 0, NULL, "clients/web by the binary",
+    { "--web", "DIR", K_STR, AT(web), 1, 0, NULL, "clients/web by the binary, or PREFIX/share/pdesolid/web",
       "the browser front-end's files; DIR/index.html\nmust be readable" },
     { "--log-format", "F", K_LOGFMT, AT(log_format), 0, 0, "text", NULL,
       "access log lines: text, or json (one object\na line)" },
@@ -262,7 +262,8 @@ static void describe(const flag *r, char *out, size_t n)
 }
 
 /* Candidates for the web directory: clients/web beside the binary's directory and up to two levels
- * further up (build/pdesolidd and build/san/pdesolidd both find the source tree's). The first whose
+ * further up (build/pdesolidd and build/san/pdesolidd both find the source tree's), then
+ * share/pdesolid/web beside it (an installed PREFIX/sbin/pdesolidd: `make install`). The first whose
  * index.html is readable, else the first candidate. */
 static void default_web(char *out, size_t n)
 {
@@ -276,13 +277,23 @@ static void default_web(char *out, size_t n)
     if (!slash)
         return;
     *slash = '\0';   /* the binary's directory */
-    for (int up = 0; up < 3; up++) {
-        slash = strrchr(exe, '/');
-        if (!slash)
-            return;
-        *slash = '\0';
-        char dir[PATH_MAX + 16], index[PATH_MAX + 32];
-        snprintf(dir, sizeof dir, "%s/clients/web", exe);
+    char prefix[PATH_MAX];
+    snprintf(prefix, sizeof prefix, "%s", exe);
+    for (int up = 0; up < 4; up++) {
+        char dir[PATH_MAX + 32], index[PATH_MAX + 48];
+        if (up < 3) {
+            slash = strrchr(exe, '/');
+            if (!slash)
+                continue;
+            *slash = '\0';
+            snprintf(dir, sizeof dir, "%s/clients/web", exe);
+        } else {
+            slash = strrchr(prefix, '/');
+            if (!slash)
+                return;
+            *slash = '\0';
+            snprintf(dir, sizeof dir, "%s/share/pdesolid/web", prefix);
+        }
         snprintf(index, sizeof index, "%s/index.html", dir);
         if (up == 0 || !access(index, R_OK))
             snprintf(out, n, "%.1000s", dir);
