@@ -48,17 +48,19 @@ static char dir[] = "/tmp/pdesolid-nginx-XXXXXX";
 
 enum { KEEP, FRONT_PORT, UPSTREAM_PORT };
 
-/* What the test copy changes; each shipped line must be there exactly once. */
+/* What the test copy changes; each shipped line must be there `times` times (every one is changed). */
 static const struct {
     const char *shipped;
     const char *test;
     int port;
+    int times;
 } rewrites[] = {
-    { "listen 80;", "listen 127.0.0.1:%d;", FRONT_PORT },
-    { "listen [::]:80;", "", KEEP },
-    { "server 127.0.0.1:8080;", "server 127.0.0.1:%d;", UPSTREAM_PORT },
-    { "client_header_timeout 10s;", "client_header_timeout 2s;", KEEP },
-    { "client_body_timeout 10s;", "client_body_timeout 2s;", KEEP },
+    { "listen 80;", "listen 127.0.0.1:%d;", FRONT_PORT, 1 },
+    { "listen [::]:80;", "", KEEP, 1 },
+    { "server 127.0.0.1:8080;", "server 127.0.0.1:%d;", UPSTREAM_PORT, 2 },   /* both upstreams */
+    { "client_header_timeout 10s;", "client_header_timeout 2s;", KEEP, 1 },
+    { "client_body_timeout 10s;", "client_body_timeout 2s;", KEEP, 1 },
+    { "proxy_cache_path /var/cache/nginx/pdesolid ", "proxy_cache_path cache ", KEEP, 1 },   /* in the prefix */
 };
 
 /* What the tests below rely on and the copy keeps as shipped. */
@@ -84,6 +86,9 @@ static const char *const shipped_directives[] = {
     "error_page 413 /_problem/413;",
     "error_page 429 /_problem/429;",
     "error_page 502 /_problem/502;",
+    "hash $pdesolid_id consistent;",
+    "proxy_next_upstream error timeout http_502 http_503 http_504 non_idempotent;",
+    "proxy_cache pdesolid_cache;",
 };
 
 typedef struct {
@@ -152,20 +157,22 @@ static char *test_copy(int front_port, int upstream_port)
     if (!text)
         fail_msg("cannot read %s (run the tests from the repository's root)", SHIPPED);
     for (size_t i = 0; i < sizeof rewrites / sizeof *rewrites; i++) {
-        if (count(text, rewrites[i].shipped) != 1)
-            fail_msg("%s has \"%s\" %d times, not once", SHIPPED, rewrites[i].shipped,
-                     count(text, rewrites[i].shipped));
+        if (count(text, rewrites[i].shipped) != rewrites[i].times)
+            fail_msg("%s has \"%s\" %d times, not %d", SHIPPED, rewrites[i].shipped,
+                     count(text, rewrites[i].shipped), rewrites[i].times);
         char to[96];
         int port = rewrites[i].port == FRONT_PORT ? front_port : upstream_port;
         snprintf(to, sizeof to, rewrites[i].test, port);
-        char *at = strstr(text, rewrites[i].shipped);
-        size_t head = (size_t)(at - text), from = strlen(rewrites[i].shipped), tail = strlen(at + from);
-        char *out = malloc(head + strlen(to) + tail + 1);
-        memcpy(out, text, head);
-        memcpy(out + head, to, strlen(to));
-        memcpy(out + head + strlen(to), at + from, tail + 1);
-        free(text);
-        text = out;
+        for (int k = 0; k < rewrites[i].times; k++) {
+            char *at = strstr(text, rewrites[i].shipped);
+            size_t head = (size_t)(at - text), from = strlen(rewrites[i].shipped), tail = strlen(at + from);
+            char *out = malloc(head + strlen(to) + tail + 1);
+            memcpy(out, text, head);
+            memcpy(out + head, to, strlen(to));
+            memcpy(out + head + strlen(to), at + from, tail + 1);
+            free(text);
+            text = out;
+        }
     }
     return text;
 }
@@ -587,6 +594,55 @@ static void a_solve_through_nginx_should_be_byte_identical_to_direct(void **stat
     pair_stop(&d, &f);
 }
 
+/* GET /solids/ID?...: immutable per id and query, so the second is nginx's (HIT) and the same bytes;
+ * another query is another entry; the eval POST is never cached. */
+static void an_ids_answers_should_be_cached_by_nginx_and_answer_if_none_match(void **state)
+{
+    (void)state;
+    static daemon_t d;
+    static front_t f;
+    pair_start(&d, &f);
+    http_reply a = solve(f.base, "/solve", NULL);
+    assert_int_equal(a.status, 200);
+    char id[64], path[128], st[32];
+    assert_true(http_header(a.headers, "X-Solid-Id", id, sizeof id));
+    free(a.body);
+    snprintf(path, sizeof path, "/solids/%s?format=glb&res=12", id);
+    http_reply first = get(NULL, f.base, path), second = get(NULL, f.base, path);
+    assert_int_equal(first.status, 200);
+    assert_int_equal(second.status, 200);
+    assert_true(http_header(first.headers, "X-Cache-Status", st, sizeof st));
+    assert_string_equal(st, "MISS");
+    assert_true(http_header(second.headers, "X-Cache-Status", st, sizeof st));
+    assert_string_equal(st, "HIT");
+    assert_int_equal(first.len, second.len);
+    assert_memory_equal(first.body, second.body, first.len);
+    /* A client that has it: 304 from the cache, by the daemon's ETag. */
+    char etag[128], inm[160];
+    assert_true(http_header(first.headers, "ETag", etag, sizeof etag));
+    snprintf(inm, sizeof inm, "If-None-Match: %s", etag);
+    http_reply cond = http_request(NULL, f.base, "GET", path, NULL, 0, inm, NULL);
+    assert_int_equal(cond.status, 304);
+    assert_int_equal(cond.len, 0);
+    free(cond.body);
+    free(first.body);
+    free(second.body);
+    snprintf(path, sizeof path, "/solids/%s?format=glb&res=13", id);
+    http_reply other = get(NULL, f.base, path);
+    assert_true(http_header(other.headers, "X-Cache-Status", st, sizeof st));
+    assert_string_equal(st, "MISS");
+    free(other.body);
+    snprintf(path, sizeof path, "/solids/%s/eval", id);
+    for (int i = 0; i < 2; i++) {
+        static const char pts[] = "{\"points\": [[0.5, 0.5, 0.5]]}";
+        http_reply e = http_request(NULL, f.base, "POST", path, pts, strlen(pts), NULL, NULL);
+        assert_int_equal(e.status, 200);
+        assert_true(!http_header(e.headers, "X-Cache-Status", st, sizeof st) || strcmp(st, "HIT") != 0);
+        free(e.body);
+    }
+    pair_stop(&d, &f);
+}
+
 static void json_should_be_gzipped_when_asked_and_binary_outputs_never(void **state)
 {
     (void)state;
@@ -996,6 +1052,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         T(the_shipped_conf_should_have_every_directive_the_tests_rely_on),
         T(a_solve_through_nginx_should_be_byte_identical_to_direct),
+        T(an_ids_answers_should_be_cached_by_nginx_and_answer_if_none_match),
         T(json_should_be_gzipped_when_asked_and_binary_outputs_never),
         T(slowloris_on_the_headers_should_be_cut_within_client_header_timeout),
         T(a_trickled_body_should_be_held_by_nginx_and_a_stalled_one_cut_within_client_body_timeout),
