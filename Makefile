@@ -31,6 +31,8 @@ CLI_OBJ  := $(call obj,$(CLI_SRC))
 SRV_OBJ  := $(call obj,$(SRV_SRC))
 MHD      := $(shell pkg-config --libs libmicrohttpd 2>/dev/null || echo -lmicrohttpd)
 CURL     := $(shell pkg-config --libs libcurl 2>/dev/null || echo -lcurl)
+# The server's durable-id stores (server/store_*.c): LMDB and hiredis, linked wherever the server is.
+MHD      += -llmdb $(shell pkg-config --libs hiredis 2>/dev/null || echo -lhiredis)
 
 TESTS := $(patsubst tests/%.c,build/san/tests/%,$(TEST_SRC))
 BENCHES := $(patsubst bench/%.c,build/bench/%,$(BENCH_SRC))
