@@ -172,6 +172,11 @@ build/bench/bench_log: bench/bench_log.c build/obj/server/log.o build/libpdeapi.
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Iserver $^ $(LIBS) $(LDLIBS) -lpthread -o $@
 
+build/bench/bench_store: bench/bench_store.c $(call obj,server/store.c server/store_lmdb.c server/store_redis.c server/sbuf.c) \
+	    build/libpdeapi.a build/libpdecore.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Iserver $^ $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@
+
 # bench_cost measures the heap's peak by wrapping malloc.
 build/bench/bench_cost: LDLIBS += -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free
 
