@@ -156,7 +156,7 @@ build/tsan/pdesolidd: $(SRV_SRC) $(API_SRC) $(CORE_SRC) build/obj/openapi.o
 	$(CC) $(STD) -O1 -g $(WARN) -Icore -Iapi $(CJSON_CFLAGS) -fcx-fortran-rules -fsanitize=thread $^ \
 	    $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@
 
-TSAN_TESTS := test_server test_hostile
+TSAN_TESTS := test_server test_hostile test_store
 
 tsan: build/tsan/pdesolidd $(TSAN_TESTS:%=build/san/tests/%) build/pdesolid build/san/pdesolid
 	@rm -f build/tsan/report.*
