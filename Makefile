@@ -31,6 +31,8 @@ CLI_OBJ  := $(call obj,$(CLI_SRC))
 SRV_OBJ  := $(call obj,$(SRV_SRC))
 MHD      := $(shell pkg-config --libs libmicrohttpd 2>/dev/null || echo -lmicrohttpd)
 CURL     := $(shell pkg-config --libs libcurl 2>/dev/null || echo -lcurl)
+# The server's durable-id stores (server/store_*.c): LMDB and hiredis, linked wherever the server is.
+MHD      += -llmdb $(shell pkg-config --libs hiredis 2>/dev/null || echo -lhiredis)
 
 TESTS := $(patsubst tests/%.c,build/san/tests/%,$(TEST_SRC))
 BENCHES := $(patsubst bench/%.c,build/bench/%,$(BENCH_SRC))
@@ -154,7 +156,7 @@ build/tsan/pdesolidd: $(SRV_SRC) $(API_SRC) $(CORE_SRC) build/obj/openapi.o
 	$(CC) $(STD) -O1 -g $(WARN) -Icore -Iapi $(CJSON_CFLAGS) -fcx-fortran-rules -fsanitize=thread $^ \
 	    $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@
 
-TSAN_TESTS := test_server test_hostile
+TSAN_TESTS := test_server test_hostile test_store
 
 tsan: build/tsan/pdesolidd $(TSAN_TESTS:%=build/san/tests/%) build/pdesolid build/san/pdesolid
 	@rm -f build/tsan/report.*
@@ -169,6 +171,11 @@ build/bench/%: bench/%.c build/libpdeapi.a build/libpdecore.a
 build/bench/bench_log: bench/bench_log.c build/obj/server/log.o build/libpdeapi.a build/libpdecore.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Iserver $^ $(LIBS) $(LDLIBS) -lpthread -o $@
+
+build/bench/bench_store: bench/bench_store.c $(call obj,server/store.c server/store_lmdb.c server/store_redis.c server/sbuf.c) \
+	    build/libpdeapi.a build/libpdecore.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Iserver $^ $(LIBS) $(MHD) $(LDLIBS) -lpthread -o $@
 
 # bench_cost measures the heap's peak by wrapping malloc.
 build/bench/bench_cost: LDLIBS += -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free

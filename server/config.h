@@ -48,6 +48,10 @@ typedef struct {
     size_t max_mem;         /* --max-mem-mb, in bytes: scratch memory of one request beyond the caches */
     int http_threads;       /* --http-threads: libmicrohttpd's polling threads, one per core by default */
     srv_log_format log_format; /* --log-format text|json */
+    char store[1024];       /* --store: DIR, lmdb:DIR, redis://HOST:PORT[/DB] or none (store.h) */
+    size_t store_mb;        /* --store-mb: the LMDB store's bound, MiB */
+    char store_prefix[128]; /* --store-prefix: Redis key prefix */
+    unsigned store_ttl;     /* --store-ttl: Redis entries' lifetime after their last use, s; 0: forever */
 } srv_config;
 
 /* Defaults, then flags. Returns 0 to run, 1 after printing help or the version on out, 2 on a bad

@@ -502,6 +502,7 @@ static void free_server(srv_server *s)
     srv_pool_destroy(s->pool);
     srv_cache_destroy(s->cache);
     srv_rcache_destroy(s->rcache);
+    srv_store_close(s->store);
     srv_metrics_destroy(s->metrics);
     srv_static_free(s->web);
     srv_log_destroy(s->log);
@@ -534,6 +535,11 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
     s->pool = srv_pool_create(c->threads, c->queue, c->max_conns);
     s->log = c->quiet ? NULL : srv_log_create(2, c->log_format);
     s->web = srv_static_load(c->web, err, errlen);
+    srv_store_config sc = { .spec = c->store, .max_mb = c->store_mb, .prefix = c->store_prefix, .ttl_s = c->store_ttl };
+    if (s->web && !(s->store = srv_store_open(&sc, err, errlen)) && *err) {   /* "" for --store none */
+        free_server(s);
+        return NULL;
+    }
     if (!s->cache || !s->rcache || !s->metrics || !s->pool || (!c->quiet && !s->log) || !s->web) {
         snprintf(err, errlen, "out of memory, or a solver thread could not start");
         free_server(s);

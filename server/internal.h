@@ -29,6 +29,7 @@
 #include "output.h"
 #include "pool.h"
 #include "rcache.h"
+#include "store.h"
 #include "route.h"
 
 typedef struct srv_static srv_static;
@@ -41,6 +42,7 @@ struct srv_server {
     srv_cache *cache;
     srv_metrics *metrics;
     srv_rcache *rcache;
+    srv_store *store;            /* durable ids (--store), or NULL for none */
     srv_static *web;
     srv_log *log;                /* the access log, or NULL (--quiet) */
     pthread_mutex_t json_lock;   /* cJSON_Parse writes a global */

@@ -22,6 +22,7 @@
 #include "cost.h"
 #include "internal.h"
 #include "model.h"
+#include "sbuf.h"
 #include "strict.h"
 #include "template.h"
 
@@ -45,6 +46,12 @@ static void get_readyz(srv_req *r)
     if (atomic_load(&s->stopping)) {
         r->retry_after = 1;
         srv_problem(r, 503, NULL, "shutting down");
+    } else if (s->store && !srv_store_ready(s->store)) {
+        /* Still ready: ids in memory and new solves are served; only ids known elsewhere answer 503. */
+        char *text = malloc(1200);
+        if (text)
+            snprintf(text, 1200, "degraded: the store %s is unreachable\n", srv_store_name(s->store));
+        srv_set_text(r, 200, "text/plain; charset=utf-8", text);
     } else {
         srv_set_text(r, 200, "text/plain; charset=utf-8", strdup("ready\n"));
     }
@@ -68,8 +75,13 @@ static void get_metrics(srv_req *r)
     srv_cache_stats cs;
     srv_cache_stats_get(s->cache, &cs);
     size_t in_flight = atomic_load(&s->in_flight);
-    srv_set_text(r, 200, "text/plain; version=0.0.4; charset=utf-8",
-                 srv_metrics_render(s->metrics, &cs, srv_pool_depth(s->pool), in_flight, srv_rcache_hits(s->rcache)));
+    char *text = srv_metrics_render(s->metrics, &cs, srv_pool_depth(s->pool), in_flight, srv_rcache_hits(s->rcache));
+    if (text && s->store) {
+        srv_sbuf b = { text, strlen(text), strlen(text) + 1, 0 };
+        srv_store_metrics(s->store, &b);
+        text = b.oom ? (free(b.s), NULL) : b.s;
+    }
+    srv_set_text(r, 200, "text/plain; version=0.0.4; charset=utf-8", text);
 }
 
 static void get_presets(srv_req *r)
@@ -214,6 +226,25 @@ static void trim_after_parse(const srv_req *r)
         malloc_trim(0);
 }
 
+/* Puts a newly solved id in the store (--store): its canonical model (a loft's, its request: a loft
+ * has no other document) and the request as given. A failure is only counted (/metrics). */
+static void keep(srv_req *r, const char *id, const api_model *m)
+{
+    if (!r->s->store)
+        return;
+    char *request = malloc(r->len + 1);
+    char *model = api_model_loft(m) ? NULL : api_model_json(api_model_get(m));
+    if (request) {
+        memcpy(request, r->body ? r->body : "", r->len);
+        request[r->len] = '\0';
+    }
+    const char *doc = api_model_loft(m) ? request : model;
+    if (doc && request)
+        srv_store_put(r->s->store, id, doc, request);
+    free(model);
+    free(request);
+}
+
 static void post_solve(srv_req *r)
 {
     srv_server *s = r->s;
@@ -256,6 +287,8 @@ static void post_solve(srv_req *r)
     r->tm.cached = hit;
     if (!hit)
         srv_metrics_solve(s->metrics, r->tm.solve);
+    if (e && !hit)
+        keep(r, id, m);
     api_model_free(m);
     if (!e) {
         failed(r, &err);
@@ -264,14 +297,88 @@ static void post_solve(srv_req *r)
     answer_entry(r, e);
 }
 
+/* The problem of a store that cannot answer now (--store). */
+static void store_down(srv_req *r)
+{
+    r->retry_after = 1;
+    srv_problem(r, 503, NULL, "the store %s cannot be reached now, and the solid %s is not in this server's memory; "
+                "try again later", srv_store_name(r->s->store), r->arg);
+}
+
+/* The entry of an id missing from the cache, re-solved from its model in the store (through the cache:
+ * concurrent requests solve once). NULL with the problem set, or with *missing when the store has no such id. */
+static srv_entry *restore(srv_req *r, int *missing)
+{
+    srv_server *s = r->s;
+    char *doc = NULL, *request = NULL;
+    srv_store_status st = srv_store_get(s->store, r->arg, &doc, &request);
+    free(request);
+    *missing = st == SRV_STORE_MISSING;
+    if (st != SRV_STORE_OK) {
+        if (!*missing)
+            store_down(r);
+        return NULL;
+    }
+    api_error err;
+    pthread_mutex_lock(&s->json_lock);
+    api_model *m = api_model_parse(doc, strlen(doc), &err);
+    pthread_mutex_unlock(&s->json_lock);
+    free(doc);
+    char id[API_ID_LEN + 1];
+    pde_diag d;
+    if (!m || api_request_id(m, id, &d) != PDE_OK || strcmp(id, r->arg)) {
+        api_model_free(m);
+        srv_problem(r, 500, NULL, "the store's model of %s does not give that id back", r->arg);
+        return NULL;
+    }
+    api_cost part;
+    api_cost_model(m, &part);
+    if (over_budget(r, &part)) {
+        api_model_free(m);
+        return NULL;
+    }
+    solve_arg sa = { m, &r->cancel };
+    int hit;
+    double t0 = srv_now();
+    srv_entry *e = srv_cache_get(s->cache, id, solve_model, &sa, &hit, &err);
+    r->tm.solve = srv_now() - t0;
+    r->tm.cached = hit;
+    if (!hit)
+        srv_metrics_solve(s->metrics, r->tm.solve);
+    api_model_free(m);
+    if (!e)
+        failed(r, &err);
+    return e;
+}
+
 static srv_entry *find_solid(srv_req *r)
 {
-    srv_entry *e = api_id_valid(r->arg) ? srv_cache_find(r->s->cache, r->arg) : NULL;
-    if (!e)
+    int valid = api_id_valid(r->arg), missing = 1;
+    srv_entry *e = valid ? srv_cache_find(r->s->cache, r->arg) : NULL;
+    if (!e && valid && r->s->store)
+        e = restore(r, &missing);
+    if (!e && missing)
         srv_problem(r, 404, NULL,
-                    "no solid %s in the cache: it was never solved here, or was evicted; POST its model to /solve",
-                    api_id_valid(r->arg) ? r->arg : "with that id (an id is 32 hex digits)");
+                    "no solid %s: it was never solved here, or was evicted; POST its model to /solve",
+                    valid ? r->arg : "with that id (an id is 32 hex digits)");
     return e;
+}
+
+/* The request an id came from, as the store kept it (--store): for share links. */
+static void get_solid_request(srv_req *r)
+{
+    char *doc = NULL, *request = NULL;
+    srv_store_status st = SRV_STORE_MISSING;
+    if (r->s->store && api_id_valid(r->arg))
+        st = srv_store_get(r->s->store, r->arg, &doc, &request);
+    free(doc);
+    if (st == SRV_STORE_OK && request)
+        srv_set_text(r, 200, "application/json", request);
+    else if (st == SRV_STORE_OK || st == SRV_STORE_MISSING)
+        srv_problem(r, 404, NULL, "no request kept for %s: the store (--store) has no such id",
+                    api_id_valid(r->arg) ? r->arg : "that id (an id is 32 hex digits)");
+    else
+        store_down(r);
 }
 
 static void get_solid(srv_req *r)
@@ -376,6 +483,7 @@ const srv_route srv_routes[] = {
     { "solve", "POST", "/solve", post_solve, SRV_RT_BODY | SRV_RT_JOB | SRV_RT_CACHE | SRV_RT_OUTPUT },
     { "solids", "GET", "/solids/{}", get_solid, SRV_RT_JOB | SRV_RT_CACHE | SRV_RT_OUTPUT },
     { "eval", "POST", "/solids/{}/eval", post_eval, SRV_RT_BODY | SRV_RT_JOB },
+    { "request", "GET", "/solids/{}/request", get_solid_request, SRV_RT_JOB },
     { "presets", "GET", "/presets", get_presets, 0 },
     { "preset", "GET", "/presets/{}", get_preset, 0 },
     { "livez", "GET", "/livez", get_livez, 0 },

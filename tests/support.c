@@ -585,8 +585,9 @@ void daemon_start(daemon_t *d, const char *dir, const char *args)
     static int n;
     snprintf(d->log, sizeof d->log, "%s/daemon%d.log", dir, n++);
     char cmd[1024];
-    /* Sanitised builds run several times slower: a job's deadline that suits them (a test's own args win). */
-    snprintf(cmd, sizeof cmd, "exec %s --port 0 --threads 2 --job-timeout 30 %s 2>%s", bin, args, d->log);
+    /* Sanitised builds run several times slower: a job's deadline that suits them; no durable store unless a
+     * test gives --store (a test's own args win). */
+    snprintf(cmd, sizeof cmd, "exec %s --port 0 --threads 2 --job-timeout 30 --store none %s 2>%s", bin, args, d->log);
     pid_t pid = fork();
     if (pid == 0) {
         execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);

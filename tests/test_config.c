@@ -97,6 +97,10 @@ static void defaults_should_be_those_the_usage_gives(void **state)
     assert_true(c.max_work == 1e9);
     assert_int_equal(c.max_mem, 64u << 20);
     assert_int_equal(c.log_format, SRV_LOG_TEXT);
+    assert_string_equal(c.store, "var/store");
+    assert_int_equal(c.store_mb, 256);
+    assert_string_equal(c.store_prefix, "pdesolid:");
+    assert_int_equal(c.store_ttl, 0);
 }
 
 /* One row per flag that takes a value: a value, and the default with that one field set by hand. */
@@ -110,6 +114,8 @@ static const struct {
     { "--request-timeout", "12.5" }, { "--timeout", "7" },         { "--max-conns-per-ip", "3" },
     { "--max-conns", "11" },       { "--grace", "4" },             { "--cors-origin", "http://a.example,http://b.example" },
     { "--web", "clients/web" },    { "--log-format", "json" },
+    { "--store", "redis://127.0.0.1:6379/2" }, { "--store-mb", "3" }, { "--store-prefix", "pde:" },
+    { "--store-ttl", "86400" },
 };
 
 static void expect(srv_config *e, const char *flag)
@@ -152,6 +158,14 @@ static void expect(srv_config *e, const char *flag)
         strcpy(e->web, "clients/web");
     else if (!strcmp(flag, "--log-format"))
         e->log_format = SRV_LOG_JSON;
+    else if (!strcmp(flag, "--store"))
+        strcpy(e->store, "redis://127.0.0.1:6379/2");
+    else if (!strcmp(flag, "--store-mb"))
+        e->store_mb = 3;
+    else if (!strcmp(flag, "--store-prefix"))
+        strcpy(e->store_prefix, "pde:");
+    else if (!strcmp(flag, "--store-ttl"))
+        e->store_ttl = 86400;
     else
         fail_msg("no expectation for %s", flag);
 }
@@ -203,7 +217,7 @@ static void every_flag_in_the_usage_should_be_tested(void **state)
         if (!found)
             fail_msg("%s is in the usage but not in every_flag", name);
     }
-    assert_int_equal(flags, 21);   /* 19 with values, --quiet, --version ("-h, --help" starts otherwise) */
+    assert_int_equal(flags, 25);   /* 23 with values, --quiet, --version ("-h, --help" starts otherwise) */
     assert_non_null(strstr(r.out, "-h, --help"));
 }
 

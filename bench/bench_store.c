@@ -1,0 +1,96 @@
+/*
+ * bench_store: the LMDB store's put and get (server/store_lmdb.c), against a
+ * solve of the model they keep: a put is a synchronous commit (an fsync),
+ * paid once per new id; a get is what a cache miss of a known id costs before
+ * it re-solves; a get in the older half of the LRU order also refreshes its
+ * stamp, a synchronous commit too (scattered), one of a recent id does not. Medians of single calls, on fig4a's canonical model (about
+ * 400 bytes), in a store in $TMPDIR or /tmp. With redis-server on
+ * 127.0.0.1:$REDIS_PORT (when set), the same for Redis.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "model.h"
+#include "bench.h"
+#include "store.h"
+
+#define N 401
+
+static void measure(const char *spec, const char *model, double solve)
+{
+    char why[256];
+    srv_store *s = srv_store_open(&(srv_store_config){ .spec = spec, .max_mb = 64 }, why, sizeof why);
+    if (!s) {
+        fprintf(stderr, "bench_store: %s\n", why);
+        exit(1);
+    }
+    static double put[N], get[N];
+    char id[33];
+    for (int i = 0; i < N; i++) {
+        snprintf(id, sizeof id, "%032x", 0x5eed0000u + (unsigned)i);
+        double t0 = now();
+        if (srv_store_put(s, id, model, "{\"preset\":\"fig4a\"}") != SRV_STORE_OK) {
+            fprintf(stderr, "bench_store: %s: a put failed\n", spec);
+            exit(1);
+        }
+        put[i] = now() - t0;
+    }
+    for (int i = 0; i < N; i++) {
+        snprintf(id, sizeof id, "%032x", 0x5eed0000u + (unsigned)((i * 7) % N));
+        char *m, *r;
+        double t0 = now();
+        srv_store_get(s, id, &m, &r);
+        get[i] = now() - t0;
+        free(m);
+        free(r);
+    }
+    static double hot[N];
+    for (int i = 0; i < N; i++) {   /* the newest id: a read that never refreshes its stamp */
+        char *m, *r;
+        double t0 = now();
+        srv_store_get(s, id, &m, &r);
+        hot[i] = now() - t0;
+        free(m);
+        free(r);
+    }
+    double p = median(put, N), g = median(get, N), h = median(hot, N);
+    printf("%-28s put %7.1f us   get (scattered) %7.2f us   get (recent) %5.2f us = %.2f solves\n", spec, p * 1e6,
+           g * 1e6, h * 1e6, h / solve);
+    srv_store_close(s);
+}
+
+int main(void)
+{
+    const char *tmp = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
+    char dir[512], cmd[600];
+    snprintf(dir, sizeof dir, "%s/bench-store-%d", tmp, (int)getpid());
+    api_model *m = NULL;
+    api_error err;
+    const char *req = "{\"preset\":\"fig4a\"}";
+    m = api_model_parse(req, strlen(req), &err);
+    char *model = api_model_json(api_model_get(m));
+    static double solve[N];
+    for (int i = 0; i < N; i++) {
+        pde_solution *sol;
+        double t0 = now();
+        api_solve(m, &sol, &err);
+        solve[i] = now() - t0;
+        pde_solution_free(sol);
+    }
+    double ts = median(solve, N);
+    printf("fig4a: solve %.1f us, canonical model %zu bytes\n", ts * 1e6, strlen(model));
+    measure(dir, model, ts);
+    if (getenv("REDIS_PORT")) {
+        char spec[64];
+        snprintf(spec, sizeof spec, "redis://127.0.0.1:%s/9", getenv("REDIS_PORT"));
+        measure(spec, model, ts);
+    }
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd))
+        fprintf(stderr, "bench_store: could not remove %s\n", dir);
+    free(model);
+    api_model_free(m);
+    return 0;
+}

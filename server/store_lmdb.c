@@ -1,0 +1,337 @@
+/*
+ * store_lmdb.c: the LMDB store (store.h), the default. One environment per
+ * directory (created 0700 if missing), opened with MDB_NOTLS so that any
+ * solver thread may read; several processes may share it (LMDB's locks).
+ * A put commits with a synchronous write (no MDB_NOSYNC): once it returns,
+ * the id survives SIGKILL and power loss.
+ *
+ * Four databases:
+ *   ids   id -> u32 model length, model, request (the request may be empty)
+ *   age   id -> u64 stamp of its last use
+ *   lru   u64 stamp, big-endian -> id: the least recently used first
+ *   meta  "clock" -> u64 (the last stamp given), "bytes" -> u64 (the sum of
+ *         the ids' keys and values)
+ * A stamp is a counter bumped by each write transaction, which LMDB runs one
+ * at a time across processes, so stamps are unique.
+ *
+ * Bound: the map is --store-mb; the entries' bytes are kept under half of it
+ * (the rest is B-tree pages and copy-on-write room). A put that would go over
+ * evicts the least recently used entries first; a put that still meets
+ * MDB_MAP_FULL evicts an eighth of the entries and tries again.
+ * How often a get writes: a get refreshes its entry's stamp (one write
+ * transaction) only when the entry is in the older half of the LRU order
+ * (its stamp is below clock - entries / 2). Hot entries cost no writes, and
+ * an entry read since it reached the older half is never the next evicted.
+ */
+#include <errno.h>
+#include <lmdb.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "id.h"
+#include "store_impl.h"
+
+typedef struct {
+    MDB_env *env;
+    MDB_dbi ids, age, lru, meta;
+    uint64_t budget;
+    atomic_ullong evictions;
+} lmdb_store;
+
+/* mkdir -p, the last component 0700. */
+static int make_dirs(const char *dir)
+{
+    char path[1024];
+    if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path)
+        return ENAMETOOLONG;
+    for (char *p = path + 1; *p; p++) {
+        if (*p != '/')
+            continue;
+        *p = '\0';
+        if (mkdir(path, 0755) && errno != EEXIST)
+            return errno;
+        *p = '/';
+    }
+    if (mkdir(path, 0700) && errno != EEXIST)
+        return errno;
+    return 0;
+}
+
+static uint64_t get_u64(MDB_txn *t, MDB_dbi dbi, const char *key)
+{
+    MDB_val k = { strlen(key), (void *)key }, v;
+    uint64_t x = 0;
+    if (!mdb_get(t, dbi, &k, &v) && v.mv_size == sizeof x)
+        memcpy(&x, v.mv_data, sizeof x);
+    return x;
+}
+
+static int put_u64(MDB_txn *t, MDB_dbi dbi, const char *key, uint64_t x)
+{
+    MDB_val k = { strlen(key), (void *)key }, v = { sizeof x, &x };
+    return mdb_put(t, dbi, &k, &v, 0);
+}
+
+static void stamp_key(uint64_t stamp, unsigned char out[8])
+{
+    for (int i = 7; i >= 0; i--, stamp >>= 8)
+        out[i] = (unsigned char)stamp;
+}
+
+/* Gives id a new stamp (the next of the clock). */
+static int touch(lmdb_store *L, MDB_txn *t, const char *id)
+{
+    MDB_val k = { API_ID_LEN, (void *)id }, v;
+    int rc;
+    if (!mdb_get(t, L->age, &k, &v) && v.mv_size == 8) {
+        uint64_t old;
+        memcpy(&old, v.mv_data, 8);
+        unsigned char ok[8];
+        stamp_key(old, ok);
+        MDB_val lk = { 8, ok };
+        rc = mdb_del(t, L->lru, &lk, NULL);
+        if (rc && rc != MDB_NOTFOUND)
+            return rc;
+    }
+    uint64_t now = get_u64(t, L->meta, "clock") + 1;
+    if ((rc = put_u64(t, L->meta, "clock", now)))
+        return rc;
+    MDB_val sv = { 8, &now };
+    if ((rc = mdb_put(t, L->age, &k, &sv, 0)))
+        return rc;
+    unsigned char nk[8];
+    stamp_key(now, nk);
+    MDB_val lk = { 8, nk };
+    return mdb_put(t, L->lru, &lk, &k, 0);
+}
+
+/* Evicts the least recently used entry; MDB_NOTFOUND when there is none. */
+static int evict_one(lmdb_store *L, MDB_txn *t)
+{
+    MDB_cursor *c;
+    int rc = mdb_cursor_open(t, L->lru, &c);
+    if (rc)
+        return rc;
+    MDB_val lk, idv;
+    rc = mdb_cursor_get(c, &lk, &idv, MDB_FIRST);
+    if (!rc) {
+        char id[API_ID_LEN];
+        memcpy(id, idv.mv_data, idv.mv_size < API_ID_LEN ? idv.mv_size : API_ID_LEN);
+        MDB_val k = { idv.mv_size < API_ID_LEN ? idv.mv_size : API_ID_LEN, id }, v;
+        rc = mdb_cursor_del(c, 0);
+        if (!rc && !mdb_get(t, L->ids, &k, &v)) {
+            uint64_t bytes = get_u64(t, L->meta, "bytes"), size = k.mv_size + v.mv_size;
+            rc = put_u64(t, L->meta, "bytes", bytes > size ? bytes - size : 0);
+            if (!rc)
+                rc = mdb_del(t, L->ids, &k, NULL);
+        }
+        if (!rc) {
+            rc = mdb_del(t, L->age, &k, NULL);
+            if (rc == MDB_NOTFOUND)
+                rc = 0;
+        }
+        if (!rc)
+            atomic_fetch_add(&L->evictions, 1);
+    }
+    mdb_cursor_close(c);
+    return rc;
+}
+
+static srv_store_status status_of(int rc)
+{
+    return rc == 0 ? SRV_STORE_OK : rc == MDB_NOTFOUND ? SRV_STORE_MISSING : rc == ENOMEM ? SRV_STORE_NOMEM
+                                                                                          : SRV_STORE_ERROR;
+}
+
+static void *lmdb_open(const char *dir, const srv_store_config *cfg, char *why, size_t whylen)
+{
+    lmdb_store *L = calloc(1, sizeof *L);
+    if (!L) {
+        snprintf(why, whylen, "out of memory");
+        return NULL;
+    }
+    size_t mb = cfg->max_mb ? cfg->max_mb : 256;
+    L->budget = (uint64_t)mb << 19;   /* half the map */
+    MDB_txn *t = NULL;
+    int rc = make_dirs(dir);
+    const char *step = "mkdir";
+    if (!rc && !(rc = mdb_env_create(&L->env))) {
+        step = "mdb_env_open";
+        if (!(rc = mdb_env_set_maxdbs(L->env, 4)) && !(rc = mdb_env_set_mapsize(L->env, mb << 20)) &&
+            !(rc = mdb_env_set_maxreaders(L->env, 510)))
+            rc = mdb_env_open(L->env, dir, MDB_NOTLS, 0600);
+    }
+    if (!rc) {
+        int dead;
+        mdb_reader_check(L->env, &dead);   /* readers of processes that died */
+        step = "creating its databases";
+        rc = mdb_txn_begin(L->env, NULL, 0, &t);
+    }
+    if (!rc && !(rc = mdb_dbi_open(t, "ids", MDB_CREATE, &L->ids)) && !(rc = mdb_dbi_open(t, "age", MDB_CREATE, &L->age)) &&
+        !(rc = mdb_dbi_open(t, "lru", MDB_CREATE, &L->lru)) && !(rc = mdb_dbi_open(t, "meta", MDB_CREATE, &L->meta)))
+        rc = mdb_txn_commit(t);
+    else if (t)
+        mdb_txn_abort(t);
+    if (rc) {
+        snprintf(why, whylen, "--store %s: %s: %s", dir, step, rc > 0 ? strerror(rc) : mdb_strerror(rc));
+        if (L->env)
+            mdb_env_close(L->env);
+        free(L);
+        return NULL;
+    }
+    return L;
+}
+
+static char *dup_n(const void *p, size_t n)
+{
+    char *s = malloc(n + 1);
+    if (s) {
+        memcpy(s, p, n);
+        s[n] = '\0';
+    }
+    return s;
+}
+
+static srv_store_status lmdb_get(void *b, const char *id, char **model, char **request)
+{
+    lmdb_store *L = b;
+    MDB_txn *t;
+    int rc = mdb_txn_begin(L->env, NULL, MDB_RDONLY, &t);
+    if (rc == MDB_MAP_RESIZED) {   /* another process grew the map */
+        mdb_env_set_mapsize(L->env, 0);
+        rc = mdb_txn_begin(L->env, NULL, MDB_RDONLY, &t);
+    }
+    if (rc)
+        return status_of(rc);
+    MDB_val k = { API_ID_LEN, (void *)id }, v;
+    int refresh = 0;
+    rc = mdb_get(t, L->ids, &k, &v);
+    if (!rc) {
+        uint32_t mlen = 0;
+        if (v.mv_size < 4 || (memcpy(&mlen, v.mv_data, 4), mlen > v.mv_size - 4)) {
+            rc = MDB_CORRUPTED;
+        } else {
+            const char *p = (const char *)v.mv_data + 4;
+            size_t rlen = v.mv_size - 4 - mlen;
+            *model = dup_n(p, mlen);
+            *request = rlen ? dup_n(p + mlen, rlen) : NULL;
+            if (!*model || (rlen && !*request)) {
+                free(*model);
+                free(*request);
+                *model = *request = NULL;
+                rc = ENOMEM;
+            }
+        }
+        MDB_val sv;
+        MDB_stat st;
+        if (!rc && !mdb_get(t, L->age, &k, &sv) && sv.mv_size == 8 && !mdb_stat(t, L->ids, &st)) {
+            uint64_t stamp, clock = get_u64(t, L->meta, "clock");
+            memcpy(&stamp, sv.mv_data, 8);
+            refresh = stamp + st.ms_entries / 2 < clock;
+        }
+    }
+    mdb_txn_abort(t);
+    if (!rc && refresh && !mdb_txn_begin(L->env, NULL, 0, &t)) {
+        if (!mdb_get(t, L->ids, &k, &v) && !touch(L, t, id))
+            mdb_txn_commit(t);
+        else
+            mdb_txn_abort(t);
+    }
+    return status_of(rc);
+}
+
+static srv_store_status lmdb_put(void *b, const char *id, const char *model, const char *request)
+{
+    lmdb_store *L = b;
+    size_t mlen = strlen(model), rlen = request ? strlen(request) : 0;
+    uint64_t size = API_ID_LEN + 4 + mlen + rlen;
+    if (mlen > UINT32_MAX || size > L->budget)
+        return SRV_STORE_ERROR;
+    int rc = 0;
+    for (int attempt = 0; attempt < 4; attempt++) {
+        MDB_txn *t;
+        rc = mdb_txn_begin(L->env, NULL, 0, &t);
+        if (rc == MDB_MAP_RESIZED) {
+            mdb_env_set_mapsize(L->env, 0);
+            rc = mdb_txn_begin(L->env, NULL, 0, &t);
+        }
+        if (rc)
+            return status_of(rc);
+        MDB_val k = { API_ID_LEN, (void *)id }, v;
+        if (!mdb_get(t, L->ids, &k, &v)) {   /* immutable: a known id only gets a new stamp */
+            rc = touch(L, t, id);
+        } else {
+            uint64_t bytes = get_u64(t, L->meta, "bytes");
+            while (!rc && bytes + size > L->budget) {
+                rc = evict_one(L, t);
+                bytes = get_u64(t, L->meta, "bytes");
+            }
+            if (rc == MDB_NOTFOUND)
+                rc = 0;
+            v.mv_size = size - API_ID_LEN;
+            if (!rc && !(rc = mdb_put(t, L->ids, &k, &v, MDB_RESERVE))) {
+                uint32_t m32 = (uint32_t)mlen;
+                memcpy(v.mv_data, &m32, 4);
+                memcpy((char *)v.mv_data + 4, model, mlen);
+                memcpy((char *)v.mv_data + 4 + mlen, request ? request : "", rlen);
+                rc = put_u64(t, L->meta, "bytes", bytes + size);
+            }
+            if (!rc)
+                rc = touch(L, t, id);
+        }
+        if (!rc)
+            return status_of(mdb_txn_commit(t));
+        mdb_txn_abort(t);
+        if (rc != MDB_MAP_FULL)
+            break;
+        /* Full before the budget (pages, not bytes): evict an eighth and try again. */
+        if (mdb_txn_begin(L->env, NULL, 0, &t))
+            break;
+        MDB_stat st;
+        int e = mdb_stat(t, L->ids, &st);
+        for (size_t i = 0; !e && i < st.ms_entries / 8 + 1; i++)
+            e = evict_one(L, t);
+        if (e && e != MDB_NOTFOUND) {
+            mdb_txn_abort(t);
+            break;
+        }
+        if (mdb_txn_commit(t))
+            break;
+    }
+    return status_of(rc);
+}
+
+static void lmdb_stats(void *b, srv_store_stats *out)
+{
+    lmdb_store *L = b;
+    MDB_txn *t;
+    out->up = 1;
+    out->evictions = atomic_load(&L->evictions);
+    if (mdb_txn_begin(L->env, NULL, MDB_RDONLY, &t))
+        return;
+    MDB_stat st;
+    if (!mdb_stat(t, L->ids, &st))
+        out->entries = st.ms_entries;
+    out->bytes = get_u64(t, L->meta, "bytes");
+    mdb_txn_abort(t);
+}
+
+static int lmdb_ready(void *b)
+{
+    (void)b;
+    return 1;
+}
+
+static void lmdb_close(void *b)
+{
+    lmdb_store *L = b;
+    mdb_env_close(L->env);
+    free(L);
+}
+
+const srv_store_backend srv_store_lmdb = { "lmdb:", 0, lmdb_open, lmdb_get, lmdb_put, lmdb_stats, lmdb_ready, lmdb_close };
