@@ -221,6 +221,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     memset(out, 0, sizeof *out);
     int rc = -1, cancelled = 0;
     const char *why = "out of memory building the mesh";
+    api_status why_status = API_ERR_NOMEM;
     if (!raw || !rtri || !rface || !wid || !wpos || !chain)
         goto done;
 
@@ -254,6 +255,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         for (int k = 0; k < 3; k++) {
             if (!isfinite(raw[3 * i + k])) {
                 why = "the solid's coordinates exceed the range of float32; no mesh can hold them";
+                why_status = API_ERR_DOCUMENT;
                 goto done;
             }
             lo[k] = fmin(lo[k], raw[3 * i + k]);
@@ -453,9 +455,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
 done:
     if (rc) {
         api_mesh_free(out);
-        api_fail(err, "", "%s", cancelled ? "cancelled" : why);
-        if (cancelled && err)
-            err->status = API_STATUS_CANCELLED;
+        api_fail(err, cancelled ? API_ERR_CANCELLED : why_status, "", "%s", cancelled ? "cancelled" : why);
     }
     free(raw);
     free(rtri);

@@ -47,7 +47,7 @@ int api_format_parse(const char *name, api_format *f, api_error *err)
             *f = (api_format)i;
             return 0;
         }
-    return api_fail(err, "", "format: \"%.40s\" is not a format; the formats are json, grid, f32, gltf, glb, vts, stl",
+    return api_fail(err, API_ERR_DOCUMENT, "", "format: \"%.40s\" is not a format; the formats are json, grid, f32, gltf, glb, vts, stl",
                     name);
 }
 
@@ -65,7 +65,7 @@ int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *er
     const char *s = text;
     while (n < 3) {
         if (*s < '0' || *s > '9')
-            return api_fail(err, "", "res: \"%.40s\" is not N or NU,NV,NW (whole numbers)", text);
+            return api_fail(err, API_ERR_DOCUMENT, "", "res: \"%.40s\" is not N or NU,NV,NW (whole numbers)", text);
         char *end;
         v[n++] = strtoull(s, &end, 10);
         s = end;
@@ -74,20 +74,20 @@ int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *er
         s++;
     }
     if (*s || (n != 1 && n != 3))
-        return api_fail(err, "", "res: \"%.40s\" is not N or NU,NV,NW (whole numbers)", text);
+        return api_fail(err, API_ERR_DOCUMENT, "", "res: \"%.40s\" is not N or NU,NV,NW (whole numbers)", text);
     if (n == 1)
         v[1] = v[2] = v[0];
     unsigned long long total = 1;
     for (int i = 0; i < 3; i++) {
         if (v[i] < 2)
-            return api_fail(err, "", "res: %llu is too few; at least 2 %s", v[i], what);
+            return api_fail(err, API_ERR_DOCUMENT, "", "res: %llu is too few; at least 2 %s", v[i], what);
         if (v[i] > max)
-            return api_fail(err, "", "res: %llu is more than the limit of %u %s for %s", v[i], max, what,
+            return api_fail(err, API_ERR_DOCUMENT, "", "res: %llu is more than the limit of %u %s for %s", v[i], max, what,
                             formats[f].name);
         total *= v[i];
     }
     if (!mesh && total > API_RES_GRID_POINTS)
-        return api_fail(err, "", "res: %llu points in all is more than the limit of %u", total, API_RES_GRID_POINTS);
+        return api_fail(err, API_ERR_DOCUMENT, "", "res: %llu points in all is more than the limit of %u", total, API_RES_GRID_POINTS);
     for (int i = 0; i < 3; i++)
         res[i] = (unsigned)v[i];
     return 0;
@@ -375,9 +375,7 @@ static cJSON *numbers(const double *v, int n)
 /* -1 with err set to the cancellation of api_error (model.h). */
 static int cancelled(api_error *err)
 {
-    api_fail(err, "", "cancelled");
-    err->status = API_STATUS_CANCELLED;
-    return -1;
+    return api_fail(err, API_ERR_CANCELLED, "", "cancelled");
 }
 
 static int stopped(const pde_cancel *c)
@@ -667,7 +665,7 @@ static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
     if (api_mesh_build(o->sol, o->res, cancel, &o->mesh, err))
         return -1;
     if (o->mesh.ntris == 0) {
-        api_fail(err, "", "the solid has no skin: every face collapses to a line or a point");
+        api_fail(err, API_ERR_DOCUMENT, "", "the solid has no skin: every face collapses to a line or a point");
         return -1;
     }
     size_t nv = o->mesh.nverts, nt = o->mesh.ntris;
@@ -855,7 +853,7 @@ api_output *api_output_open(const pde_solution *sol, const char *id, const pde_p
         err = &local;
     api_output *o = calloc(1, sizeof *o);
     if (!o) {
-        api_fail(err, "", "out of memory");
+        api_fail(err, API_ERR_NOMEM, "", "out of memory");
         return NULL;
     }
     o->fmt = f;
@@ -898,7 +896,7 @@ api_output *api_output_open(const pde_solution *sol, const char *id, const pde_p
     }
     if (rc) {
         if (!err->message[0])
-            api_fail(err, "", "out of memory");
+            api_fail(err, API_ERR_NOMEM, "", "out of memory");
         api_output_free(o);
         return NULL;
     }

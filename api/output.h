@@ -64,7 +64,7 @@ typedef struct api_output api_output;
  * NULL and err on failure (out of memory, a mesh out of range). The long work
  * happens here: the properties it computes, the mesh (gltf, glb, stl), the
  * whole json document; cancel (NULL: never) is polled through it, and when
- * it stops the call frees everything and err has status API_STATUS_CANCELLED.
+ * it stops the call frees everything and err has status API_ERR_CANCELLED.
  * Grid formats only set up their sampling tables here (api/cost.h's bytes).
  */
 api_output *api_output_open(const pde_solution *sol, const char *id, const pde_props *props, api_format f,

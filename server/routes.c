@@ -133,7 +133,7 @@ static int over_budget(srv_req *r, const api_cost *part)
 /* An api/ error, or the problem of a job that was stopped. */
 static void failed(srv_req *r, const api_error *err)
 {
-    if (err->status == API_STATUS_CANCELLED)
+    if (err->status == API_ERR_CANCELLED)
         stopped(r);
     else
         srv_problem_api(r, err);

@@ -112,7 +112,7 @@ static api_model *preset_model(const options *o, api_error *err)
     if (loft) {   /* a loft of the gallery: its document */
         cJSON_Delete(loft);
         if (o->nparams) {
-            api_fail(err, "/params", "the loft preset \"%s\" takes no --param; `pdesolid presets` shows its document", o->preset);
+            api_fail(err, API_ERR_DOCUMENT, "/params", "the loft preset \"%s\" takes no --param; `pdesolid presets` shows its document", o->preset);
             return NULL;
         }
         char body[128];
@@ -120,7 +120,7 @@ static api_model *preset_model(const options *o, api_error *err)
         return api_model_parse(body, (size_t)n, err);
     }
     if (!ps) {
-        api_fail(err, "/preset", "no preset \"%s\"; `pdesolid presets` lists them", o->preset);
+        api_fail(err, API_ERR_DOCUMENT, "/preset", "no preset \"%s\"; `pdesolid presets` lists them", o->preset);
         return NULL;
     }
     const api_template *t = api_preset_template(ps);
@@ -130,7 +130,7 @@ static api_model *preset_model(const options *o, api_error *err)
         char name[64];
         const char *eq = strchr(o->params[i], '=');
         if (!eq || eq == o->params[i] || (size_t)(eq - o->params[i]) >= sizeof name) {
-            api_fail(err, "", "--param %s: write NAME=VALUE", o->params[i]);
+            api_fail(err, API_ERR_DOCUMENT, "", "--param %s: write NAME=VALUE", o->params[i]);
             return NULL;
         }
         snprintf(name, sizeof name, "%.*s", (int)(eq - o->params[i]), o->params[i]);
@@ -141,13 +141,13 @@ static api_model *preset_model(const options *o, api_error *err)
         do {
             v[n++] = strtod(s, &end);
             if (end == s) {
-                api_fail(err, "", "--param %s: \"%s\" is not a number", name, s);
+                api_fail(err, API_ERR_DOCUMENT, "", "--param %s: \"%s\" is not a number", name, s);
                 return NULL;
             }
             s = end + (*end == ',');
         } while (*end == ',' && n < 3);
         if (*end) {
-            api_fail(err, "", "--param %s: \"%s\" is not a number or x,y,z", name, eq + 1);
+            api_fail(err, API_ERR_DOCUMENT, "", "--param %s: \"%s\" is not a number or x,y,z", name, eq + 1);
             return NULL;
         }
         if (api_params_set(t, &p, name, v, n, err))
