@@ -45,7 +45,8 @@ static const char usage[] =
     "  --format F           solve: json, grid, f32, gltf, glb, vts or stl\n"
     "  --res N|NU,NV,NW     samples per axis (grid, f32, vts; default 33) or per face\n"
     "                       edge (gltf, glb, stl; default 64)\n"
-    "  -o FILE              write to FILE instead of standard output\n"
+    "  -o FILE              write to FILE instead of standard output; solve without\n"
+    "                       --format takes the format from FILE's extension\n"
     "  --server URL         solve and eval on a pdesolidd (e.g. http://127.0.0.1:8080)\n"
     "                       instead of here; the output is the same\n"
     "  -h, --help           this text\n"
@@ -287,8 +288,35 @@ static int remote(const options *o, int eval)
     return rc;
 }
 
-static int cmd_solve(const options *o)
+/*
+ * The format of -o FILE without --format: the one whose extension FILE ends with (the longest, so that
+ * x.grid.json is a grid). 0, or 2 with a message naming the extensions.
+ */
+static int format_from_extension(options *o)
 {
+    size_t n = strlen(o->out), best = 0;
+    for (int i = 0; i < API_FMT_COUNT; i++) {
+        const api_format_info *f = api_format_info_of((api_format)i);
+        size_t k = strlen(f->ext);
+        if (k < n && k > best && strcmp(o->out + n - k, f->ext) == 0) {
+            best = k;
+            o->format = f->name;
+        }
+    }
+    if (best)
+        return 0;
+    fprintf(stderr, "pdesolid: %s: no format has this extension; give --format, or end the name with one of", o->out);
+    for (int i = 0; i < API_FMT_COUNT; i++)
+        fprintf(stderr, "%s %s", i ? "," : "", api_format_info_of((api_format)i)->ext);
+    fputc('\n', stderr);
+    return 2;
+}
+
+static int cmd_solve(const options *oo)
+{
+    options copy = *oo, *o = &copy;
+    if (o->out && !o->format && format_from_extension(o))
+        return 2;
     if (o->server)
         return remote(o, 0);
     pde_solution *sol;
@@ -424,9 +452,15 @@ int main(int argc, char **argv)
     int model_args = o.preset ? 0 : 1;
     if (strcmp(cmd, "solve") == 0 && o.nargs == model_args)
         return cmd_solve(&o);
-    if (strcmp(cmd, "eval") == 0 && o.nargs == model_args + 1)
+    int eval = strcmp(cmd, "eval") == 0 && o.nargs == model_args + 1;
+    int presets = strcmp(cmd, "presets") == 0 && o.nargs == 0;
+    if ((eval || presets) && o.out && !freopen(o.out, "wb", stdout)) {   /* -o is never ignored */
+        fprintf(stderr, "pdesolid: %s: %s\n", o.out, strerror(errno));
+        return 1;
+    }
+    if (eval)
         return cmd_eval(&o);
-    if (strcmp(cmd, "presets") == 0 && o.nargs == 0)
+    if (presets)
         return cmd_presets();
     fprintf(stderr, "pdesolid: unknown command or wrong arguments: %s\n\n%s", cmd, usage);
     return 2;
