@@ -18,6 +18,7 @@
 #include <cJSON.h>
 #include <cmocka.h>
 
+#include "output.h"
 #include "support.h"
 
 static char dir[] = "/tmp/pdesolid-cli-XXXXXX";
@@ -170,7 +171,7 @@ static void bad_input_should_exit_2_and_name_the_field(void **state)
         { "solve --preset fig4a --param c=-1,-1,0", "/params/c/2: c of component z is 0" },
         { "solve --preset fig4a --format obj -o x", "\"obj\" is not a format" },
         { "solve --preset fig4a --format grid --res 9999", "limit of 4096" },
-        { "solve fig4a.json --param p0=1", "--param goes with --preset" },
+        { "solve fig4a.json --param p0=1", "--param goes with --preset or --template" },
         { "solve --res", "--res needs a value" },
         { "solve --bogus fig4a.json", "unknown option --bogus" },
     };
@@ -275,6 +276,48 @@ static void output_file_should_never_be_ignored(void **state)
     free(err);
 }
 
+/* --template NAME is the request {"template": NAME, "params": {...}}: the same solid, by its id; its defaults
+ * are the family's first figure (example4's is fig4a); --help lists every format of the table. */
+static void templates_should_work_from_the_command_line(void **state)
+{
+    (void)state;
+    char *a, *b, *err;
+    write_text("treq.json", "{\"template\":\"example4\",\"params\":{\"p0\":12345,\"c\":[-11,-11,-10]}}");
+    assert_int_equal(run(1, "solve --template example4 --param p0=12345 --param c=-11,-11,-10", &a, &err), 0);
+    free(err);
+    assert_int_equal(run(1, "solve treq.json", &b, &err), 0);
+    free(err);
+    assert_memory_equal(a, b, strcspn(b, "\n"));
+    assert_non_null(strstr(a, "solid "));
+    free(a);
+    free(b);
+    assert_int_equal(run(1, "solve --template example4", &a, &err), 0);
+    free(err);
+    assert_int_equal(run(1, "solve --preset fig4a", &b, &err), 0);
+    free(err);
+    assert_memory_equal(a, b, strcspn(b, "\n"));
+    free(a);
+    free(b);
+    assert_int_equal(run(1, "solve --template example9", &a, &err), 2);
+    assert_non_null(strstr(err, "/template: no template \"example9\"; the templates are example1, example2"));
+    free(a);
+    free(err);
+    assert_int_equal(run(1, "solve --template example4 --preset fig4a", &a, &err), 2);
+    assert_non_null(strstr(err, "not both"));
+    free(a);
+    free(err);
+    assert_int_equal(run(1, "--help", &a, &err), 0);
+    for (int i = 0; i < API_FMT_COUNT; i++) {
+        const api_format_info *f = api_format_info_of((api_format)i);
+        char line[64];
+        snprintf(line, sizeof line, "  %-6s %-11s %s", f->name, f->ext, f->mime);
+        if (!strstr(a, line))
+            fail_msg("--help lacks \"%s\":\n%s", line, a);
+    }
+    free(a);
+    free(err);
+}
+
 static void presets_and_formats_should_work_from_the_command_line(void **state)
 {
     (void)state;
@@ -326,6 +369,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(presets_and_formats_should_work_from_the_command_line),
         cmocka_unit_test(output_file_should_never_be_ignored),
+        cmocka_unit_test(templates_should_work_from_the_command_line),
         cmocka_unit_test(eval_should_agree_with_the_independent_solution),
         cmocka_unit_test(solve_should_print_the_closed_form_and_properties),
         cmocka_unit_test(bad_input_should_exit_2_and_name_the_field),
