@@ -26,14 +26,34 @@
 #define CHUNK_WORK (1u << 21)
 
 static const api_format_info formats[API_FMT_COUNT] = {
-    { "json", "application/json", ".json", 0, 1 },
-    { "grid", "application/json", ".grid.json", 0, 0 },
-    { "f32", "application/octet-stream", ".f32", 0, 0 },
-    { "gltf", "model/gltf+json", ".gltf", 1, 1 },
-    { "glb", "model/gltf-binary", ".glb", 1, 1 },
-    { "vts", "application/xml", ".vts", 0, 1 },
-    { "stl", "model/stl", ".stl", 1, 0 },
+    { "json", "application/json", ".json", 0, 1, 0 },
+    { "grid", "application/json", ".grid.json", 0, 0, 0 },
+    { "f32", "application/octet-stream", ".f32", 0, 0, 1 },
+    { "gltf", "model/gltf+json", ".gltf", 1, 1, 0 },
+    { "glb", "model/gltf-binary", ".glb", 1, 1, 1 },
+    { "vts", "application/xml", ".vts", 0, 1, 1 },   /* XML around raw appended float32 */
+    { "stl", "model/stl", ".stl", 1, 0, 1 },
 };
+
+char *api_formats_json(void)
+{
+    cJSON *a = cJSON_CreateArray();
+    int ok = a != NULL;
+    for (int i = 0; ok && i < API_FMT_COUNT; i++) {
+        const api_format_info *f = &formats[i];
+        cJSON *o = cJSON_CreateObject();
+        ok = o && cJSON_AddItemToArray(a, o) && cJSON_AddStringToObject(o, "name", f->name) &&
+             cJSON_AddStringToObject(o, "media_type", f->mime) && cJSON_AddStringToObject(o, "extension", f->ext) &&
+             cJSON_AddBoolToObject(o, "binary", f->binary) && cJSON_AddBoolToObject(o, "mesh", f->mesh) &&
+             cJSON_AddBoolToObject(o, "properties", f->props) &&
+             cJSON_AddNumberToObject(o, "default_res", f->mesh ? API_RES_MESH_DEFAULT : API_RES_GRID_DEFAULT);
+        if (!o)
+            break;
+    }
+    char *s = ok ? cJSON_PrintUnformatted(a) : NULL;
+    cJSON_Delete(a);
+    return s;
+}
 
 const api_format_info *api_format_info_of(api_format f)
 {
@@ -47,8 +67,11 @@ int api_format_parse(const char *name, api_format *f, api_error *err)
             *f = (api_format)i;
             return 0;
         }
-    return api_fail(err, API_ERR_DOCUMENT, "", "format: \"%.40s\" is not a format; the formats are json, grid, f32, gltf, glb, vts, stl",
-                    name);
+    char list[256];
+    size_t n = 0;
+    for (int i = 0; i < API_FMT_COUNT && n < sizeof list; i++)   /* the list from the table */
+        n += (size_t)snprintf(list + n, sizeof list - n, "%s%s", i ? ", " : "", formats[i].name);
+    return api_fail(err, API_ERR_DOCUMENT, "", "format: \"%.40s\" is not a format; the formats are %s", name, list);
 }
 
 int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *err)

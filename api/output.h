@@ -41,9 +41,13 @@ typedef struct {
     const char *ext;       /* file extension, with the dot */
     int mesh;              /* resolution per face edge rather than per volume axis */
     int props;             /* carries the properties: api_output_open() computes them when not given */
+    int binary;            /* bytes that are not text: not written to a terminal */
 } api_format_info;
 
 const api_format_info *api_format_info_of(api_format f);
+/* The table as GET /formats serves it: [{"name", "media_type", "extension", "binary", "mesh", "properties",
+ * "default_res"}, ...] in the table's order (malloc'd; NULL if out of memory). */
+char *api_formats_json(void);
 /* Returns 0, or -1 with err listing the formats. */
 int api_format_parse(const char *name, api_format *f, api_error *err);
 

@@ -72,6 +72,11 @@ static void get_metrics(srv_req *r)
                  srv_metrics_render(s->metrics, &cs, srv_pool_depth(s->pool), in_flight, srv_rcache_hits(s->rcache)));
 }
 
+static void get_formats(srv_req *r)
+{
+    srv_set_text(r, 200, "application/json", api_formats_json());
+}
+
 static void get_presets(srv_req *r)
 {
     srv_set_text(r, 200, "application/json", api_presets_json());
@@ -378,6 +383,7 @@ const srv_route srv_routes[] = {
     { "eval", "POST", "/solids/{}/eval", post_eval, SRV_RT_BODY | SRV_RT_JOB },
     { "presets", "GET", "/presets", get_presets, 0 },
     { "preset", "GET", "/presets/{}", get_preset, 0 },
+    { "formats", "GET", "/formats", get_formats, 0 },
     { "livez", "GET", "/livez", get_livez, 0 },
     { "readyz", "GET", "/readyz", get_readyz, 0 },
     { "version", "GET", "/version", get_version, 0 },

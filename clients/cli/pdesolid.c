@@ -209,8 +209,7 @@ static int write_output(const options *o, const pde_solution *sol, const char *i
     unsigned res[3];
     if (api_format_parse(o->format, &f, &err) || api_res_parse(o->res, f, res, &err))
         return report("option", &err);
-    if (!o->out && isatty(STDOUT_FILENO) && (f == API_FMT_F32 || f == API_FMT_GLB || f == API_FMT_STL ||
-                                             f == API_FMT_VTS)) {
+    if (!o->out && isatty(STDOUT_FILENO) && api_format_info_of(f)->binary) {
         fprintf(stderr, "pdesolid: %s is binary; give -o FILE, or redirect standard output\n", o->format);
         return 2;
     }

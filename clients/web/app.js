@@ -264,11 +264,12 @@ const downloads = {};
 function updateDownloads() {
   for (const [fmt, c] of Object.entries(downloads)) c.enable(Boolean(state.id));
 }
-function download(format, res) {
+// f: a row of GET /formats; a mesh at the view's samples per face edge, a grid at the format's default.
+function download(f) {
   if (!state.id) return;
   const a = document.createElement('a');
-  a.href = `/solids/${state.id}?format=${format}&res=${res}`;
-  a.download = `${state.preset || state.template || 'loft'}-${state.id.slice(0, 8)}${{ grid: '.grid.json' }[format] || '.' + format}`;
+  a.href = `/solids/${state.id}?format=${f.name}&res=${f.mesh ? state.res : f.default_res}`;
+  a.download = `${state.preset || state.template || 'loft'}-${state.id.slice(0, 8)}${f.extension}`;
   document.body.appendChild(a);
   a.click();
   a.remove();
@@ -336,7 +337,7 @@ async function loadPreset(name) {
 
 async function main() {
   resize();
-  const list = await (await fetch('/presets')).json();
+  const [list, formats] = await Promise.all([fetch('/presets'), fetch('/formats')].map((p) => p.then((r) => r.json())));
   for (const t of list.templates) ui.templates[t.name] = t;
   ui.presets = list.presets;
   const gallery = el('gallery');
@@ -359,12 +360,10 @@ async function main() {
   ];
   for (const c of toggles) c.domElement.dataset.view = c.property;
   const dl = ui.gui.addFolder('Download');
-  const acts = {
-    glb: () => download('glb', state.res), gltf: () => download('gltf', state.res), stl: () => download('stl', state.res),
-    vts: () => download('vts', 33), grid: () => download('grid', 33),
-  };
-  for (const [fmt, name] of [['glb', '.glb'], ['gltf', '.gltf'], ['stl', '.stl'], ['vts', '.vts (volume, det J)'], ['grid', 'grid (JSON)']])
-    downloads[fmt] = dl.add(acts, fmt).name(name);
+  // The menu is the server's table of formats (GET /formats): a new format appears here without a change.
+  const acts = Object.fromEntries(formats.map((f) => [f.name, () => download(f)]));
+  for (const f of formats)
+    downloads[f.name] = dl.add(acts, f.name).name(`${f.extension} (${f.name}${f.mesh ? ', skin' : ''})`);
   dl.close();
   ui.loft = mountLoftEditor(ui.gui, {
     // Editing the loft makes it the solid shown; a problem found before solving shows as the server's would.
