@@ -701,8 +701,14 @@ static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
     o->blob = malloc(o->blob_len);
     if (!o->blob)
         return -1;
-    memcpy(o->blob, o->mesh.pos, 12 * nv);
-    memcpy(o->blob + 12 * nv, o->mesh.nrm, 12 * nv);
+    /* glTF is +Y up: (X, Y, Z) = (x, z, -y), a rotation (x and the solid's handedness kept); the paper's
+     * height w, along z, stands along +Y. Negation is exact, so min and max stay the float32 values. */
+    float *bp = (float *)o->blob, *bn = bp + 3 * nv;
+    for (size_t i = 0; i < nv; i++) {
+        const float *p = o->mesh.pos + 3 * i, *q = o->mesh.nrm + 3 * i;
+        bp[3 * i] = p[0], bp[3 * i + 1] = p[2], bp[3 * i + 2] = -p[1];
+        bn[3 * i] = q[0], bn[3 * i + 1] = q[2], bn[3 * i + 2] = -q[1];
+    }
     memcpy(o->blob + 24 * nv, o->mesh.tri, 12 * nt);
     const pde_props *props = props_of(o, cancel, err);
     if (!props)
@@ -713,7 +719,7 @@ static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
     /* min and max as the exact float32 values (17 digits of the double they widen to). */
     char mm[256];
     snprintf(mm, sizeof mm, "\"min\":[%.17g,%.17g,%.17g],\"max\":[%.17g,%.17g,%.17g]", o->mesh.min[0],
-             o->mesh.min[1], o->mesh.min[2], o->mesh.max[0], o->mesh.max[1], o->mesh.max[2]);
+             o->mesh.min[2], -o->mesh.max[1], o->mesh.max[0], o->mesh.max[2], -o->mesh.min[1]);
     int gltf = o->fmt == API_FMT_GLTF;
     size_t cap = 2048 + strlen(pj);
     o->text = malloc(cap);
@@ -723,7 +729,8 @@ static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
     }
     int n = snprintf(
         o->text, cap,
-        "{\"asset\":{\"version\":\"2.0\",\"generator\":\"pdesolid\",\"extras\":{\"id\":\"%s\",\"properties\":%s}},"
+        "{\"asset\":{\"version\":\"2.0\",\"generator\":\"pdesolid\",\"extras\":{\"id\":\"%s\",\"units\":\"metres\","
+        "\"up\":\"+Y; glTF (X, Y, Z) = the model's (x, z, -y)\",\"properties\":%s}},"
         "\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"name\":\"solid\"}],"
         "\"meshes\":[{\"name\":\"skin\",\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2,\"mode\":4}]}],"
         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\",%s},"
