@@ -99,6 +99,9 @@ build/san/tests/%: build/san/tests/%.o build/san/tests/support.o $(call san,$(fi
                    $(API_SRC) $(CORE_SRC)) build/obj/openapi.o
 	$(CC) $(CFLAGS) $(SAN) $^ $(LIBS) $(CMOCKA) $(CURL) $(MHD) $(LDLIBS) -lpthread -o $@
 
+# test_errors fails allocations on purpose: malloc, calloc and realloc wrapped at link time.
+build/san/tests/test_errors: LDLIBS += -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc
+
 # Test binaries that start pdesolidd, or run the CLI, need them built first (order-only: a new
 # daemon does not relink the test). Found by what the tests read, so a new test needs no entry here.
 DAEMON_TESTS := $(patsubst tests/%.c,build/san/tests/%,$(shell grep -l 'daemon_start\|PDESOLIDD_SAN' $(TEST_SRC)))

@@ -1,6 +1,6 @@
 /*
  * jsonparse.h: the pieces of api/'s strict JSON reading that model.c and loft.c share (internal to
- * api/). Each check fills err with a JSON pointer and a sentence (api_fail, status 422) and returns
+ * api/). Each check fills err with a JSON pointer and a sentence (api_fail, API_ERR_DOCUMENT) and returns
  * -1 on failure, 0 on success.
  */
 #ifndef API_JSONPARSE_H

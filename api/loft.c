@@ -282,20 +282,18 @@ static int fit_grid(records *rs, int k, const double (*p)[3], int nu, int nv, in
 static int get_points(const cJSON *j, const char *ptr, int want, double (**out)[3], int *n, api_error *err)
 {
     if (!cJSON_IsArray(j))
-        return api_fail(err, ptr, "must be an array of points [x, y, z], not %s", api_json_type(j));
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "must be an array of points [x, y, z], not %s", api_json_type(j));
     int k = cJSON_GetArraySize(j);
     if (want && k != want)
-        return api_fail(err, ptr, "has %d vectors; it needs one for each of the profile's %d points", k, want);
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "has %d vectors; it needs one for each of the profile's %d points", k, want);
     if (k < 3)
-        return api_fail(err, ptr, "has %d points; a closed curve needs at least 3", k);
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "has %d points; a closed curve needs at least 3", k);
     if (k > API_LOFT_MAX_POINTS) {
-        api_fail(err, ptr, "has %d points, over the limit of %d", k, API_LOFT_MAX_POINTS);
-        err->status = 413;
-        return -1;
+        return api_fail(err, API_ERR_LIMIT, ptr, "has %d points, over the limit of %d", k, API_LOFT_MAX_POINTS);
     }
     double(*p)[3] = malloc((size_t)k * sizeof *p);
     if (!p)
-        return api_fail(err, ptr, "out of memory");
+        return api_fail(err, API_ERR_NOMEM, ptr, "out of memory");
     int i = 0;
     for (const cJSON *c = j->child; c; c = c->next, i++) {
         if (!quick_vector3(c, p[i]))
@@ -325,7 +323,7 @@ static int parse_terms(const cJSON *j, const char *ptr, records *rs, int k, int 
         char q[200];
         api_json_child(q, sizeof q, ptr, comp_key[c]);
         if (!cJSON_IsArray(comps[c]))
-            return api_fail(err, q, "must be an array of terms, not %s", api_json_type(comps[c]));
+            return api_fail(err, API_ERR_DOCUMENT, q, "must be an array of terms, not %s", api_json_type(comps[c]));
         int i = 0;
         for (const cJSON *t = comps[c]->child; t; t = t->next, i++) {
             char r[220], s[240];
@@ -349,7 +347,7 @@ static int parse_terms(const cJSON *j, const char *ptr, records *rs, int k, int 
                 return -1;
             *tangent |= f[3] != NULL;
             if (push(rs, c, u, v, k, x, xw))
-                return api_fail(err, r, "out of memory");
+                return api_fail(err, API_ERR_NOMEM, r, "out of memory");
         }
     }
     return 0;
@@ -360,27 +358,25 @@ static int parse_grid(const cJSON *g, const cJSON *per, const char *ptr, int k, 
                       api_error *err)
 {
     if (per && !cJSON_IsBool(per))
-        return api_fail(err, ptr, "\"periodic\" must be true or false");
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "\"periodic\" must be true or false");
     const int periodic = per && cJSON_IsTrue(per);
     if (!cJSON_IsArray(g) || cJSON_GetArraySize(g) < (periodic ? 3 : 2))
-        return api_fail(err, ptr, "must be an array of at least %d rows (one per v) of points [x, y, z]", periodic ? 3 : 2);
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "must be an array of at least %d rows (one per v) of points [x, y, z]", periodic ? 3 : 2);
     const int nv = cJSON_GetArraySize(g), nu = cJSON_IsArray(g->child) ? cJSON_GetArraySize(g->child) : 0;
     if (nu < 2)
-        return api_fail(err, ptr, "each row must be an array of at least 2 points [x, y, z] (one per u)");
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "each row must be an array of at least 2 points [x, y, z] (one per u)");
     if ((long)nu * nv > API_LOFT_MAX_GRID) {
-        api_fail(err, ptr, "has %d x %d points, over the limit of %d", nv, nu, API_LOFT_MAX_GRID);
-        err->status = 413;
-        return -1;
+        return api_fail(err, API_ERR_LIMIT, ptr, "has %d x %d points, over the limit of %d", nv, nu, API_LOFT_MAX_GRID);
     }
     double(*p)[3] = malloc((size_t)nu * nv * sizeof *p);
     if (!p)
-        return api_fail(err, ptr, "out of memory");
+        return api_fail(err, API_ERR_NOMEM, ptr, "out of memory");
     int j = 0, rc = 0;
     for (const cJSON *row = g->child; row && !rc; row = row->next, j++) {
         char r[220];
         snprintf(r, sizeof r, "%s/%d", ptr, j);
         if (!cJSON_IsArray(row) || cJSON_GetArraySize(row) != nu) {
-            rc = api_fail(err, r, "must be an array of %d points, as the first row", nu);
+            rc = api_fail(err, API_ERR_DOCUMENT, r, "must be an array of %d points, as the first row", nu);
             break;
         }
         int i = 0;
@@ -393,7 +389,7 @@ static int parse_grid(const cJSON *g, const cJSON *per, const char *ptr, int k, 
         }
     }
     if (!rc && fit_grid(rs, k, (const double(*)[3])p, nu, nv, periodic, tol, fit))
-        rc = api_fail(err, ptr, "out of memory");
+        rc = api_fail(err, API_ERR_NOMEM, ptr, "out of memory");
     free(p);
     return rc;
 }
@@ -407,23 +403,23 @@ static int parse_section(const cJSON *j, const char *ptr, int k, double tol, api
         return -1;
     api_json_child(q, sizeof q, ptr, "w");
     if (!f[0])
-        return api_fail(err, q, "is required: the section's place along w, from 0 to 1");
+        return api_fail(err, API_ERR_DOCUMENT, q, "is required: the section's place along w, from 0 to 1");
     if (api_json_number(f[0], q, &l->sec[k].w, err))
         return -1;
     if (!!f[1] + !!f[4] + !!f[5] != 1)
-        return api_fail(err, ptr, "a section needs one of \"profile\" (points of a curve), \"grid\" (a sampled surface) "
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "a section needs one of \"profile\" (points of a curve), \"grid\" (a sampled surface) "
                         "or \"terms\" (closed form)");
     if (f[6] && !f[5])
-        return api_fail(err, ptr, "\"periodic\" goes with \"grid\"");
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "\"periodic\" goes with \"grid\"");
     if (f[5]) {
         if (f[2] || f[3])
-            return api_fail(err, ptr, "\"tangent\" and \"centre\" go with \"profile\"");
+            return api_fail(err, API_ERR_DOCUMENT, ptr, "\"tangent\" and \"centre\" go with \"profile\"");
         api_json_child(q, sizeof q, ptr, "grid");
         return parse_grid(f[5], f[6], q, k, tol, rs, &l->fit_error, err);
     }
     if (f[4]) {
         if (f[2] || f[3])
-            return api_fail(err, ptr, "\"tangent\" and \"centre\" go with \"profile\"; in \"terms\", give x_w as \"dw\"");
+            return api_fail(err, API_ERR_DOCUMENT, ptr, "\"tangent\" and \"centre\" go with \"profile\"; in \"terms\", give x_w as \"dw\"");
         api_json_child(q, sizeof q, ptr, "terms");
         return parse_terms(f[4], q, rs, k, &l->sec[k].tangent, err);
     }
@@ -442,9 +438,9 @@ static int parse_section(const cJSON *j, const char *ptr, int k, double tol, api
         l->sec[k].tangent = 1;
     }
     if (!rc && fit_curve(rs, k, 0, (const double(*)[3])pts, n, f[3] ? centre : NULL, tol, &l->fit_error))
-        rc = api_fail(err, ptr, "out of memory");
+        rc = api_fail(err, API_ERR_NOMEM, ptr, "out of memory");
     if (!rc && tan && fit_curve(rs, k, 1, (const double(*)[3])tan, nt, NULL, tol, &l->fit_error))
-        rc = api_fail(err, ptr, "out of memory");
+        rc = api_fail(err, API_ERR_NOMEM, ptr, "out of memory");
     free(pts);
     free(tan);
     return rc;
@@ -470,7 +466,7 @@ static int build_terms(api_loft *l, records *rs, api_error *err)
     for (int c = 0; c < 3; c++)
         l->t[c] = calloc(nt[c] ? nt[c] : 1, sizeof *l->t[c]);
     if (!l->vals || !l->t[0] || !l->t[1] || !l->t[2])
-        return api_fail(err, "", "out of memory");
+        return api_fail(err, API_ERR_NOMEM, "", "out of memory");
     double *x = l->vals;
     for (size_t i = 0, used = 0; i < rs->n; i++) {
         const record *r = &rs->r[i];
@@ -497,14 +493,14 @@ api_loft *api_loft_parse(const cJSON *j, const char *ptr, api_error *err)
     api_loft *l = calloc(1, sizeof *l);
     records rs = { 0 };
     if (!l) {
-        api_fail(err, ptr, "out of memory");
+        api_fail(err, API_ERR_NOMEM, ptr, "out of memory");
         return NULL;
     }
     double tol = API_LOFT_TOL;
     int rc = 0;
     api_json_child(q, sizeof q, ptr, "pde");
     if (!f[0])
-        rc = api_fail(err, q, "is required: {\"a\": [..], \"b\": [..], \"c\": [..]}, the PDE's coefficients");
+        rc = api_fail(err, API_ERR_DOCUMENT, q, "is required: {\"a\": [..], \"b\": [..], \"c\": [..]}, the PDE's coefficients");
     else if (!(rc = api_json_object(f[0], q, abc, p, err)))
         for (int k = 0; k < 3 && !rc; k++) {
             double v[3];
@@ -517,22 +513,21 @@ api_loft *api_loft_parse(const cJSON *j, const char *ptr, api_error *err)
     if (!rc && f[2]) {
         api_json_child(q, sizeof q, ptr, "tol");
         if (!(rc = api_json_number(f[2], q, &tol, err)) && !(tol >= 0 && tol < 1))
-            rc = api_fail(err, q, "must be at least 0 and below 1: the fraction of a section's size below which harmonics are dropped");
+            rc = api_fail(err, API_ERR_DOCUMENT, q, "must be at least 0 and below 1: the fraction of a section's size below which harmonics are dropped");
     }
     api_json_child(q, sizeof q, ptr, "sections");
     int ns = cJSON_IsArray(f[1]) ? cJSON_GetArraySize(f[1]) : -1;
     if (!rc && !f[1])
-        rc = api_fail(err, q, "is required: an array of sections, the first at w = 0 and the last at w = 1");
+        rc = api_fail(err, API_ERR_DOCUMENT, q, "is required: an array of sections, the first at w = 0 and the last at w = 1");
     else if (!rc && ns < 0)
-        rc = api_fail(err, q, "must be an array of sections, not %s", api_json_type(f[1]));
+        rc = api_fail(err, API_ERR_DOCUMENT, q, "must be an array of sections, not %s", api_json_type(f[1]));
     else if (!rc && ns < 2)
-        rc = api_fail(err, q, "has %d section%s; a loft needs at least 2, at w = 0 and w = 1", ns, ns == 1 ? "" : "s");
+        rc = api_fail(err, API_ERR_DOCUMENT, q, "has %d section%s; a loft needs at least 2, at w = 0 and w = 1", ns, ns == 1 ? "" : "s");
     else if (!rc && ns > PDE_MAX_SECTIONS) {
-        rc = api_fail(err, q, "has %d sections, over the limit of %d", ns, PDE_MAX_SECTIONS);
-        err->status = 413;
+        rc = api_fail(err, API_ERR_LIMIT, q, "has %d sections, over the limit of %d", ns, PDE_MAX_SECTIONS);
     }
     if (!rc && !(l->sec = calloc((size_t)ns, sizeof *l->sec)))
-        rc = api_fail(err, ptr, "out of memory");
+        rc = api_fail(err, API_ERR_NOMEM, ptr, "out of memory");
     int k = 0;
     for (const cJSON *s = rc ? NULL : f[1]->child; s && !rc; s = s->next, k++) {
         char r[220];
@@ -585,8 +580,7 @@ int api_loft_solve(const api_loft *l, const char *ptr, const pde_cancel *cancel,
         snprintf(p, sizeof p, "%s/pde/%s/%d", ptr, d.field, d.component);
     else
         snprintf(p, sizeof p, "%s/pde", ptr);
-    api_fail(err, p, "%s", d.message[0] ? d.message : pde_strerror(st));
-    if (st == PDE_ERR_LIMIT)
-        err->status = 413;
+    api_fail(err, api_status_of(st), p, "%s",
+             d.message[0] ? d.message : pde_strerror(st));
     return (int)st;
 }

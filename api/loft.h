@@ -16,7 +16,7 @@
  * interpolated by their trigonometric polynomial, computed with FFTW's real DFT, and the section is
  * x(u, v) = C + u (P(v) - C): terms u^0 (C), u^1 (the mean minus C), u cos(2 pi m v), u sin(2 pi m v).
  * Harmonics below tol (default API_LOFT_TOL) of the section's size are dropped. Errors follow
- * model.h's convention: a JSON pointer, a sentence, status 422 (413 over a limit).
+ * error.h's convention: a JSON pointer, a sentence, API_ERR_DOCUMENT (API_ERR_LIMIT over a limit).
  *
  * Every call is reentrant: FFTW's plans are made once per size under a lock, and executed on new
  * arrays from any thread.

@@ -226,7 +226,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
 {
     memset(out, 0, sizeof *out);
     if (res[0] < 2 || res[1] < 2 || res[2] < 2) {
-        api_fail(err, "", "a mesh needs at least 2 samples per face edge");
+        api_fail(err, API_ERR_LIMIT, "", "a mesh needs at least 2 samples per face edge");
         return -1;
     }
     /* e_v x e_w = +e_u, e_u x e_w = -e_v, e_u x e_v = +e_w: which faces must reverse. */
@@ -254,6 +254,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     uint32_t *vsam = NULL;    /* each vertex's sample */
     int rc = -1, cancelled = 0;
     const char *why = "out of memory building the mesh";
+    api_status why_status = API_ERR_NOMEM;
     if (!raw.pos || !raw.nrm || !raw.detj || !up || !vof || !pid || !live)
         goto done;
 
@@ -271,6 +272,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             const float x = raw.pos[3 * i + k];
             if (!isfinite(x)) {
                 why = "the solid's coordinates exceed the range of float32; no mesh can hold them";
+                why_status = API_ERR_DOCUMENT;
                 goto done;
             }
             lo[k] = x < lo[k] ? x : lo[k];
@@ -477,9 +479,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
 done:
     if (rc) {
         api_mesh_free(out);
-        api_fail(err, "", "%s", cancelled ? "cancelled" : why);
-        if (cancelled && err)
-            err->status = API_STATUS_CANCELLED;
+        api_fail(err, cancelled ? API_ERR_CANCELLED : why_status, "", "%s", cancelled ? "cancelled" : why);
     }
     free(raw.pos);
     free(raw.nrm);

@@ -36,7 +36,7 @@ typedef struct {
  * res[0..2]: samples along u, v and w on the faces. Returns 0, or -1 with err
  * (out zeroed). cancel (NULL: never) is polled between rows of the faces and
  * every few thousand points or triangles of the later passes; when it stops,
- * everything is freed and err has status API_STATUS_CANCELLED. Memory peaks
+ * everything is freed and err has status API_ERR_CANCELLED. Memory peaks
  * at about 120 bytes per face sample, 6 res^2 samples in all: about 48 MB at
  * res 256 (api/cost.h estimates it).
  */

@@ -62,7 +62,7 @@ int api_meshopt_encode(const api_mesh *m, api_meshopt *out, api_error *err)
     int rc = -1;
     if (!idx || !remap || !pos || !nrm4 || !detj || !filtered || !out->data) {
         api_meshopt_free(out);
-        api_fail(err, "", "out of memory compressing the mesh");
+        api_fail_nomem(err);
         goto done;
     }
 

@@ -34,11 +34,26 @@ static const char *const comp_key[3] = { "x", "y", "z" };
  * (a key, a preset's name, a truncated %.60s) and however it is cut, the error
  * is valid UTF-8 with no control characters, fit for a JSON body or a terminal.
  */
-int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
+static const char *const status_text[] = {
+    [API_OK] = "no error",
+    [API_ERR_NOMEM] = "out of memory",
+    [API_ERR_LIMIT] = "over a size limit",
+    [API_ERR_DOCUMENT] = "a bad document",
+    [API_ERR_NOT_JSON] = "not JSON",
+    [API_ERR_CANCELLED] = "cancelled",
+    [API_ERR_NOT_FOUND] = "not found",
+};
+
+const char *api_strerror(api_status s)
+{
+    return (unsigned)s < sizeof status_text / sizeof *status_text && status_text[s] ? status_text[s] : "unknown error";
+}
+
+int api_fail(api_error *err, api_status status, const char *pointer, const char *fmt, ...)
 {
     if (!err)
         return -1;
-    err->status = 422;
+    err->status = status;
     char text[1024];
     api_text_clean(err->pointer, sizeof err->pointer, pointer, strlen(pointer));
     va_list ap;
@@ -51,10 +66,19 @@ int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
 
 int api_fail_cancelled(api_error *err)
 {
-    api_fail(err, "", "cancelled");
-    if (err)
-        err->status = API_STATUS_CANCELLED;
+    api_fail(err, API_ERR_CANCELLED, "", "cancelled");
     return (int)PDE_ERR_CANCELLED;
+}
+
+api_status api_status_of(pde_status st)
+{
+    return st == PDE_OK ? API_OK : st == PDE_ERR_NOMEM ? API_ERR_NOMEM : st == PDE_ERR_LIMIT ? API_ERR_LIMIT
+         : st == PDE_ERR_CANCELLED ? API_ERR_CANCELLED : API_ERR_DOCUMENT;
+}
+
+int api_fail_nomem(api_error *err)
+{
+    return api_fail(err, API_ERR_NOMEM, "", "out of memory");
 }
 
 /* ptr + "/" + key as RFC 6901 writes a key: ~ as ~0 and / as ~1. */
@@ -99,7 +123,7 @@ int api_json_object(const cJSON *obj, const char *ptr, const char *const *keys,
                         const cJSON **found, api_error *err)
 {
     if (!cJSON_IsObject(obj))
-        return api_fail(err, ptr, "must be an object, not %s", api_json_type(obj));
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "must be an object, not %s", api_json_type(obj));
     size_t nk = 0;
     while (keys[nk])
         found[nk++] = NULL;
@@ -114,11 +138,11 @@ int api_json_object(const cJSON *obj, const char *ptr, const char *const *keys,
                 snprintf(allowed + strlen(allowed), sizeof allowed - strlen(allowed), "%s\"%s\"",
                          k ? ", " : "", keys[k]);
             api_json_child(at, sizeof at, ptr, c->string);
-            return api_fail(err, at, "unknown key \"%s\"; the keys here are %s", quoted(q, c->string), allowed);
+            return api_fail(err, API_ERR_DOCUMENT, at, "unknown key \"%s\"; the keys here are %s", quoted(q, c->string), allowed);
         }
         if (found[i]) {
             api_json_child(at, sizeof at, ptr, keys[i]);
-            return api_fail(err, at, "the key \"%s\" appears twice", keys[i]);
+            return api_fail(err, API_ERR_DOCUMENT, at, "the key \"%s\" appears twice", keys[i]);
         }
         found[i] = c;
     }
@@ -133,9 +157,9 @@ int api_json_number(const cJSON *j, const char *ptr, double *out, api_error *err
         return 0;
     }
     if (!cJSON_IsNumber(j))
-        return api_fail(err, ptr, "must be a number, not %s", api_json_type(j));
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "must be a number, not %s", api_json_type(j));
     if (!isfinite(j->valuedouble))
-        return api_fail(err, ptr, "must be a finite number; this one overflows a double");
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "must be a finite number; this one overflows a double");
     *out = j->valuedouble;
     return 0;
 }
@@ -154,23 +178,23 @@ int api_json_factor(const cJSON *j, const char *ptr, pde_factor *f, api_error *e
     for (int k = 0; k < 6; k++)
         if (found[k]) {
             if (which >= 0)
-                return api_fail(err, ptr, "a factor has one key, not both \"%s\" and \"%s\"",
+                return api_fail(err, API_ERR_DOCUMENT, ptr, "a factor has one key, not both \"%s\" and \"%s\"",
                                 kinds[which], kinds[k]);
             which = k;
         }
     if (which < 0)
-        return api_fail(err, ptr, "a factor needs one of \"pow\", \"sin\", \"cos\", \"exp\", \"sinh\", \"cosh\"");
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "a factor needs one of \"pow\", \"sin\", \"cos\", \"exp\", \"sinh\", \"cosh\"");
     char p[200];
     api_json_child(p, sizeof p, ptr, kinds[which]);
     if (api_json_number(found[which], p, &f->p, err))
         return -1;
     f->kind = (pde_factor_kind)which;
     if (which == PDE_POW && (f->p != floor(f->p) || f->p < 0 || f->p > PDE_MAX_POW))
-        return api_fail(err, p, "the power must be a whole number from 0 to %d, not %.17g", PDE_MAX_POW, f->p);
+        return api_fail(err, API_ERR_DOCUMENT, p, "the power must be a whole number from 0 to %d, not %.17g", PDE_MAX_POW, f->p);
     if ((which == PDE_SIN || which == PDE_COS) && fabs(f->p) > 1e6)
-        return api_fail(err, p, "k must be at most 1e6 in size (the factor is %s(k*pi*t))", kinds[which]);
+        return api_fail(err, API_ERR_DOCUMENT, p, "k must be at most 1e6 in size (the factor is %s(k*pi*t))", kinds[which]);
     if (which >= PDE_EXP && fabs(f->p) > PDE_MAX_ARG)
-        return api_fail(err, p, "alpha must be at most %g in size, or %s(alpha*t) overflows a double",
+        return api_fail(err, API_ERR_DOCUMENT, p, "alpha must be at most %g in size, or %s(alpha*t) overflows a double",
                         PDE_MAX_ARG, kinds[which]);
     return 0;
 }
@@ -178,9 +202,9 @@ int api_json_factor(const cJSON *j, const char *ptr, pde_factor *f, api_error *e
 int api_json_vector3(const cJSON *j, const char *ptr, double out[3], api_error *err)
 {
     if (!j)
-        return api_fail(err, ptr, "is required: an array of three numbers, one for each of x, y, z");
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "is required: an array of three numbers, one for each of x, y, z");
     if (!cJSON_IsArray(j) || cJSON_GetArraySize(j) != 3)
-        return api_fail(err, ptr, "must be an array of three numbers, one for each of x, y, z");
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "must be an array of three numbers, one for each of x, y, z");
     int i = 0;
     for (const cJSON *c = j->child; c; c = c->next, i++) {
         char p[200];
@@ -195,13 +219,11 @@ int api_json_vector3(const cJSON *j, const char *ptr, double out[3], api_error *
 static int term_array(const cJSON *j, const char *ptr, size_t *n, api_error *err)
 {
     if (!cJSON_IsArray(j))
-        return api_fail(err, ptr, "must be an array of terms, not %s", api_json_type(j));
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "must be an array of terms, not %s", api_json_type(j));
     size_t k = 0;
     for (const cJSON *c = j->child; c; c = c->next)
         if (++k > API_MAX_TERMS) {
-            api_fail(err, ptr, "has more than %d terms, the limit", API_MAX_TERMS);
-            err->status = 413;
-            return -1;
+            return api_fail(err, API_ERR_LIMIT, ptr, "has more than %d terms, the limit", API_MAX_TERMS);
         }
     *n = k;
     return 0;
@@ -215,7 +237,7 @@ static int parse_bterms(const cJSON *j, const char *ptr, api_model *m, int ci, a
         return -1;
     m->b[ci] = calloc(n ? n : 1, sizeof *m->b[ci]);
     if (!m->b[ci])
-        return api_fail(err, ptr, "out of memory");
+        return api_fail(err, API_ERR_NOMEM, ptr, "out of memory");
     size_t i = 0;
     for (const cJSON *c = j->child; c; c = c->next, i++) {
         char p[200], q[220];
@@ -249,7 +271,7 @@ static int parse_fterms(const cJSON *j, const char *ptr, api_model *m, int ci, a
         return -1;
     m->f[ci] = calloc(n ? n : 1, sizeof *m->f[ci]);
     if (!m->f[ci])
-        return api_fail(err, ptr, "out of memory");
+        return api_fail(err, API_ERR_NOMEM, ptr, "out of memory");
     size_t i = 0;
     for (const cJSON *c = j->child; c; c = c->next, i++) {
         char p[200], q[220];
@@ -282,7 +304,7 @@ static int parse_model(const cJSON *root, api_model *m, api_error *err)
     if (api_json_object(root, "", top, t, err))
         return -1;
     if (!t[0])
-        return api_fail(err, "/pde", "is required: {\"a\": [..], \"b\": [..], \"c\": [..]}, the PDE's coefficients");
+        return api_fail(err, API_ERR_DOCUMENT, "/pde", "is required: {\"a\": [..], \"b\": [..], \"c\": [..]}, the PDE's coefficients");
     if (api_json_object(t[0], "/pde", abc, p, err))
         return -1;
     double v[3][3];
@@ -325,13 +347,13 @@ static api_model *parse_request(const cJSON *root, api_error *err)
     if (api_json_object(root, "", keys, k, err))
         return NULL;
     if (k[0] && k[1]) {
-        api_fail(err, "", "give either \"preset\" or \"template\", not both");
+        api_fail(err, API_ERR_DOCUMENT, "", "give either \"preset\" or \"template\", not both");
         return NULL;
     }
     const cJSON *name = k[0] ? k[0] : k[1];
     const char *ptr = k[0] ? "/preset" : "/template";
     if (!cJSON_IsString(name)) {
-        api_fail(err, ptr, "must be a string, not %s", api_json_type(name));
+        api_fail(err, API_ERR_DOCUMENT, ptr, "must be a string, not %s", api_json_type(name));
         return NULL;
     }
     const api_template *t;
@@ -342,10 +364,10 @@ static api_model *parse_request(const cJSON *root, api_error *err)
         if (doc) {
             api_model *m = NULL;
             if (k[2])
-                api_fail(err, "/params", "the loft preset \"%s\" takes no params; POST its document (GET /presets/%s) "
+                api_fail(err, API_ERR_DOCUMENT, "/params", "the loft preset \"%s\" takes no params; POST its document (GET /presets/%s) "
                          "with your changes", name->valuestring, name->valuestring);
             else if (!(m = calloc(1, sizeof *m)))
-                api_fail(err, "", "out of memory");
+                api_fail(err, API_ERR_NOMEM, "", "out of memory");
             else if (!(m->loft = api_loft_parse(cJSON_GetObjectItemCaseSensitive(doc, "loft"), "/loft", err))) {
                 free(m);
                 m = NULL;
@@ -357,7 +379,7 @@ static api_model *parse_request(const cJSON *root, api_error *err)
     if (k[0]) {
         const api_preset *ps = api_preset_find(name->valuestring);
         if (!ps) {
-            api_fail(err, ptr, "no preset \"%s\"; GET /presets (or `pdesolid presets`) lists them",
+            api_fail(err, API_ERR_DOCUMENT, ptr, "no preset \"%s\"; GET /presets (or `pdesolid presets`) lists them",
                      quoted(q0, name->valuestring));
             return NULL;
         }
@@ -365,7 +387,7 @@ static api_model *parse_request(const cJSON *root, api_error *err)
         api_preset_params(ps, &p);
     } else {
         if (!(t = api_template_find(name->valuestring))) {
-            api_fail(err, ptr, "no template \"%s\"; the templates are example1, example2, example3, example4",
+            api_fail(err, API_ERR_DOCUMENT, ptr, "no template \"%s\"; the templates are example1, example2, example3, example4",
                      quoted(q0, name->valuestring));
             return NULL;
         }
@@ -373,7 +395,7 @@ static api_model *parse_request(const cJSON *root, api_error *err)
     }
     if (k[2]) {
         if (!cJSON_IsObject(k[2])) {
-            api_fail(err, "/params", "must be an object of parameter values, not %s", api_json_type(k[2]));
+            api_fail(err, API_ERR_DOCUMENT, "/params", "must be an object of parameter values, not %s", api_json_type(k[2]));
             return NULL;
         }
         for (const cJSON *c = k[2]->child; c; c = c->next) {
@@ -381,7 +403,7 @@ static api_model *parse_request(const cJSON *root, api_error *err)
             api_json_child(q, sizeof q, "/params", c->string);
             for (const cJSON *d = k[2]->child; d != c; d = d->next)
                 if (strcmp(d->string, c->string) == 0) {
-                    api_fail(err, q, "the key \"%s\" appears twice", quoted(q0, c->string));
+                    api_fail(err, API_ERR_DOCUMENT, q, "the key \"%s\" appears twice", quoted(q0, c->string));
                     return NULL;
                 }
             double v[3];
@@ -396,7 +418,7 @@ static api_model *parse_request(const cJSON *root, api_error *err)
                         return NULL;
                 }
             } else {
-                api_fail(err, q, "must be a number, or an array of three for a, b and c; not %s", api_json_type(c));
+                api_fail(err, API_ERR_DOCUMENT, q, "must be a number, or an array of three for a, b and c; not %s", api_json_type(c));
                 return NULL;
             }
             if (n == 1 && api_json_number(c, q, &v[0], err))
@@ -422,14 +444,14 @@ static cJSON *parse_json(const char *text, size_t len, api_error *err)
         return NULL;
     char *copy = malloc(len + 1);
     if (!copy) {
-        api_fail(err, "", "out of memory");
+        api_fail(err, API_ERR_NOMEM, "", "out of memory");
         return NULL;
     }
     memcpy(copy, text, len);
     copy[len] = '\0';
     cJSON *root = cJSON_ParseWithLength(copy, len + 1);
     if (!root)   /* checked JSON that cJSON still refuses: it ran out of memory */
-        api_fail(err, "", "out of memory");
+        api_fail(err, API_ERR_NOMEM, "", "out of memory");
     free(copy);
     return root;
 }
@@ -447,13 +469,13 @@ api_model *api_model_parse(const char *text, size_t len, api_error *err)
         static const char *const keys[] = { "loft", NULL };
         const cJSON *f[1];
         if (!api_json_object(root, "", keys, f, err) && (m = calloc(1, sizeof *m)) == NULL)
-            api_fail(err, "", "out of memory");
+            api_fail(err, API_ERR_NOMEM, "", "out of memory");
         if (m && !(m->loft = api_loft_parse(f[0], "/loft", err))) {
             api_model_free(m);
             m = NULL;
         }
     } else if (!(m = calloc(1, sizeof *m))) {
-        api_fail(err, "", "out of memory");
+        api_fail(err, API_ERR_NOMEM, "", "out of memory");
     } else if (parse_model(root, m, err)) {
         api_model_free(m);
         m = NULL;
@@ -466,7 +488,7 @@ api_model *api_model_build(const pde_model *src, int from_params, api_error *err
 {
     api_model *m = calloc(1, sizeof *m);
     if (!m) {
-        api_fail(err, "", "out of memory");
+        api_fail(err, API_ERR_NOMEM, "", "out of memory");
         return NULL;
     }
     m->m = *src;
@@ -477,7 +499,7 @@ api_model *api_model_build(const pde_model *src, int from_params, api_error *err
         m->f[c] = malloc((nf ? nf : 1) * sizeof *m->f[c]);
         if (!m->b[c] || !m->f[c]) {
             api_model_free(m);
-            api_fail(err, "", "out of memory");
+            api_fail(err, API_ERR_NOMEM, "", "out of memory");
             return NULL;
         }
         if (nb)
@@ -536,7 +558,7 @@ int api_solve_ex(const api_model *m, const pde_cancel *cancel, pde_solution **ou
     else if (d.component >= 0 && d.term >= 0)
         snprintf(ptr, sizeof ptr, "/%s/%s/%ld%s%s", d.in_force ? "force" : "boundary",
                  comp_key[d.component], d.term, d.field[0] ? "/" : "", d.field);
-    api_fail(err, ptr, "%s", d.message[0] ? d.message : pde_strerror(st));
+    api_fail(err, api_status_of(st), ptr, "%s", d.message[0] ? d.message : pde_strerror(st));
     return (int)st;
 }
 
@@ -544,24 +566,22 @@ int api_solve_ex(const api_model *m, const pde_cancel *cancel, pde_solution **ou
 static int points_from(const cJSON *arr, const char *ptr, size_t max, double **out, size_t *count, api_error *err)
 {
     if (!cJSON_IsArray(arr))
-        return api_fail(err, ptr, "must be an array of [u, v, w] points, not %s", api_json_type(arr));
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "must be an array of [u, v, w] points, not %s", api_json_type(arr));
     size_t k = 0;
     for (const cJSON *c = arr->child; c; c = c->next)
         if (++k > max) {
-            api_fail(err, ptr, "has more than %zu points, the limit", max);
-            err->status = 413;
-            return -1;
+            return api_fail(err, API_ERR_LIMIT, ptr, "has more than %zu points, the limit", max);
         }
     double *pts = malloc((k ? k : 1) * 3 * sizeof *pts);
     if (!pts)
-        return api_fail(err, ptr, "out of memory");
+        return api_fail(err, API_ERR_NOMEM, ptr, "out of memory");
     size_t i = 0;
     for (const cJSON *c = arr->child; c; c = c->next, i++) {
         char p[64];
         snprintf(p, sizeof p, "%.40s/%zu", ptr, i);
         if (!cJSON_IsArray(c) || cJSON_GetArraySize(c) != 3) {
             free(pts);
-            return api_fail(err, p, "must be a point [u, v, w] of three numbers");
+            return api_fail(err, API_ERR_DOCUMENT, p, "must be a point [u, v, w] of three numbers");
         }
         int q = 0;
         for (const cJSON *x = c->child; x; x = x->next, q++) {
@@ -598,9 +618,9 @@ int api_eval_parse(const char *text, size_t len, size_t max_points, double **out
     const cJSON *k[2];
     int rc = api_json_object(root, "", keys, k, err);
     if (!rc && !k[0])
-        rc = api_fail(err, "/points", "is required: an array of [u, v, w] points");
+        rc = api_fail(err, API_ERR_DOCUMENT, "/points", "is required: an array of [u, v, w] points");
     if (!rc && k[1] && !cJSON_IsBool(k[1]))
-        rc = api_fail(err, "/derivatives", "must be true or false, not %s", api_json_type(k[1]));
+        rc = api_fail(err, API_ERR_DOCUMENT, "/derivatives", "must be true or false, not %s", api_json_type(k[1]));
     if (!rc)
         rc = points_from(k[0], "/points", max_points, out, n, err);
     if (!rc)
@@ -613,25 +633,31 @@ cJSON *api_factor_tree(pde_factor f)
 {
     static const char *const kinds[] = { "pow", "sin", "cos", "exp", "sinh", "cosh" };
     cJSON *o = cJSON_CreateObject();
-    if (o)
-        cJSON_AddNumberToObject(o, kinds[f.kind], f.p);
+    if (o && !cJSON_AddNumberToObject(o, kinds[f.kind], f.p)) {
+        cJSON_Delete(o);
+        return NULL;
+    }
     return o;
 }
 
-static void add_factor(cJSON *o, const char *key, pde_factor f)
+/* 1 when done (or nothing to do), 0 out of memory. */
+static int add_factor(cJSON *o, const char *key, pde_factor f)
 {
-    if (f.kind != PDE_POW || f.p != 0)   /* 1, the default, is left out */
-        cJSON_AddItemToObject(o, key, api_factor_tree(f));
+    if (f.kind == PDE_POW && f.p == 0)   /* 1, the default, is left out */
+        return 1;
+    cJSON *t = api_factor_tree(f);
+    if (t && cJSON_AddItemToObject(o, key, t))
+        return 1;
+    cJSON_Delete(t);
+    return 0;
 }
 
+/* Every allocation is checked: out of memory anywhere gives NULL, never a partial tree. */
 cJSON *api_model_tree(const pde_model *m)
 {
     cJSON *root = cJSON_CreateObject(), *pde = cJSON_AddObjectToObject(root, "pde");
     cJSON *bd = cJSON_AddObjectToObject(root, "boundary"), *fo = cJSON_AddObjectToObject(root, "force");
-    if (!pde || !bd || !fo) {
-        cJSON_Delete(root);
-        return NULL;
-    }
+    int ok = pde && bd && fo;
     double abc[3][3];
     for (int c = 0; c < 3; c++) {
         abc[0][c] = m->comp[c].a;
@@ -639,36 +665,49 @@ cJSON *api_model_tree(const pde_model *m)
         abc[2][c] = m->comp[c].c;
     }
     static const char *const names[3] = { "a", "b", "c" };
-    for (int k = 0; k < 3; k++)
-        cJSON_AddItemToObject(pde, names[k], cJSON_CreateDoubleArray(abc[k], 3));
-    for (int c = 0; c < 3; c++) {
+    for (int k = 0; ok && k < 3; k++) {
+        cJSON *arr = cJSON_CreateDoubleArray(abc[k], 3);
+        ok = arr && cJSON_AddItemToObject(pde, names[k], arr);
+        if (!ok)
+            cJSON_Delete(arr);
+    }
+    for (int c = 0; ok && c < 3; c++) {
         const pde_component *k = &m->comp[c];
         if (k->nbterms) {
             cJSON *list = cJSON_AddArrayToObject(bd, comp_key[c]);
-            for (size_t j = 0; list && j < k->nbterms; j++) {
+            ok = list != NULL;
+            for (size_t j = 0; ok && j < k->nbterms; j++) {
                 const pde_bterm *t = &k->bterms[j];
                 cJSON *o = cJSON_CreateObject();
-                cJSON_AddItemToArray(list, o);
-                add_factor(o, "u", t->u);
-                add_factor(o, "v", t->v);
-                cJSON_AddNumberToObject(o, "w0", t->w0);
-                cJSON_AddNumberToObject(o, "dw0", t->dw0);
-                cJSON_AddNumberToObject(o, "w1", t->w1);
-                cJSON_AddNumberToObject(o, "dw1", t->dw1);
+                ok = o && cJSON_AddItemToArray(list, o);
+                if (!ok) {
+                    cJSON_Delete(o);
+                    break;
+                }
+                ok = add_factor(o, "u", t->u) && add_factor(o, "v", t->v) && cJSON_AddNumberToObject(o, "w0", t->w0) &&
+                     cJSON_AddNumberToObject(o, "dw0", t->dw0) && cJSON_AddNumberToObject(o, "w1", t->w1) &&
+                     cJSON_AddNumberToObject(o, "dw1", t->dw1);
             }
         }
-        if (k->nfterms) {
+        if (ok && k->nfterms) {
             cJSON *list = cJSON_AddArrayToObject(fo, comp_key[c]);
-            for (size_t j = 0; list && j < k->nfterms; j++) {
+            ok = list != NULL;
+            for (size_t j = 0; ok && j < k->nfterms; j++) {
                 const pde_fterm *t = &k->fterms[j];
                 cJSON *o = cJSON_CreateObject();
-                cJSON_AddItemToArray(list, o);
-                cJSON_AddNumberToObject(o, "coef", t->coef);
-                add_factor(o, "u", t->u);
-                add_factor(o, "v", t->v);
-                add_factor(o, "w", t->w);
+                ok = o && cJSON_AddItemToArray(list, o);
+                if (!ok) {
+                    cJSON_Delete(o);
+                    break;
+                }
+                ok = cJSON_AddNumberToObject(o, "coef", t->coef) && add_factor(o, "u", t->u) &&
+                     add_factor(o, "v", t->v) && add_factor(o, "w", t->w);
             }
         }
+    }
+    if (!ok) {
+        cJSON_Delete(root);
+        return NULL;
     }
     return root;
 }

@@ -21,7 +21,7 @@
  * three arrays are required. Unknown and duplicate keys are errors whose
  * pointer is the key itself ("/boundry"). Every parser here first runs
  * api_json_check() (strict.h), so text with NUL, invalid UTF-8 or leading
- * zeros is a 400 before cJSON reads it.
+ * zeros is API_ERR_NOT_JSON before cJSON reads it.
  *
  * Parsing uses cJSON, which records its last error in a global: callers that
  * parse on several threads must serialise api_model_parse() and
@@ -32,22 +32,9 @@
 
 #include <stddef.h>
 
+#include "error.h"
 #include "pde.h"
 
-/*
- * A JSON pointer (RFC 6901) to the field at fault, "" for the whole document,
- * a sentence, and the HTTP status it calls for: 400 for text that is not
- * JSON, 413 for a document over a size limit, 422 for anything else wrong,
- * and API_STATUS_CANCELLED (503) with the message "cancelled" when a call
- * given a pde_cancel (pde.h) was asked to stop.
- */
-typedef struct {
-    char pointer[160];
-    char message[320];
-    int status;
-} api_error;
-
-#define API_STATUS_CANCELLED 503
 
 #define API_MAX_TERMS 4096    /* terms in one component's boundary or force list */
 #define API_MAX_POINTS 1000000
@@ -76,9 +63,12 @@ const pde_model *api_model_get(const api_model *m);
 /* The loft of a loft document, or NULL for a model. */
 const pde_loft *api_model_loft(const api_model *m);
 
+/* The api_status of a core status: NOMEM, LIMIT and CANCELLED as themselves, the rest a bad document. */
+api_status api_status_of(pde_status st);
+
 /* pde_solve() with the core's diagnosis turned into a JSON pointer. Returns 0 or the pde_status. */
 int api_solve(const api_model *m, pde_solution **out, api_error *err);
-/* The same, polling cancel (NULL: never) between modes; stopped: API_STATUS_CANCELLED. */
+/* The same, polling cancel (NULL: never) between modes; stopped: API_ERR_CANCELLED. */
 int api_solve_ex(const api_model *m, const pde_cancel *cancel, pde_solution **out, api_error *err);
 
 /*
@@ -89,7 +79,7 @@ int api_points_parse(const char *text, size_t len, double **out, size_t *n, api_
 
 /*
  * Parses an eval request {"points": [[u, v, w], ...], "derivatives": false}
- * with at most max_points points (over it: status 413). Returns 0, or -1.
+ * with at most max_points points (over it: API_ERR_LIMIT). Returns 0, or -1.
  */
 int api_eval_parse(const char *text, size_t len, size_t max_points, double **out, size_t *n, int *derivatives,
                    api_error *err);
@@ -101,13 +91,5 @@ struct cJSON *api_model_tree(const pde_model *m);
 /* One factor as {"sin": k} and so on, a cJSON tree. */
 struct cJSON *api_factor_tree(pde_factor f);
 
-/* Sets err from a printf format, with status 422; returns -1, for one-line error returns. The pointer
- * and the message pass through api_text_clean(): valid UTF-8, no control characters, whatever they quote. */
-int api_fail(api_error *err, const char *pointer, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-
-/* Sets err to the "cancelled" problem (status API_STATUS_CANCELLED) and returns PDE_ERR_CANCELLED: a
- * solve that its pde_cancel stopped. */
-int api_fail_cancelled(api_error *err);
 
 #endif

@@ -26,14 +26,34 @@
 #define CHUNK_WORK (1u << 21)
 
 static const api_format_info formats[API_FMT_COUNT] = {
-    { "json", "application/json", ".json", 0, 1 },
-    { "grid", "application/json", ".grid.json", 0, 0 },
-    { "f32", "application/octet-stream", ".f32", 0, 0 },
-    { "gltf", "model/gltf+json", ".gltf", 1, 1 },
-    { "glb", "model/gltf-binary", ".glb", 1, 1 },
-    { "vts", "application/xml", ".vts", 0, 1 },
-    { "stl", "model/stl", ".stl", 1, 0 },
+    { "json", "application/json", ".json", 0, 1, 0 },
+    { "grid", "application/json", ".grid.json", 0, 0, 0 },
+    { "f32", "application/octet-stream", ".f32", 0, 0, 1 },
+    { "gltf", "model/gltf+json", ".gltf", 1, 1, 0 },
+    { "glb", "model/gltf-binary", ".glb", 1, 1, 1 },
+    { "vts", "application/xml", ".vts", 0, 1, 1 },   /* XML around raw appended float32 */
+    { "stl", "model/stl", ".stl", 1, 0, 1 },
 };
+
+char *api_formats_json(void)
+{
+    cJSON *a = cJSON_CreateArray();
+    int ok = a != NULL;
+    for (int i = 0; ok && i < API_FMT_COUNT; i++) {
+        const api_format_info *f = &formats[i];
+        cJSON *o = cJSON_CreateObject();
+        ok = o && cJSON_AddItemToArray(a, o) && cJSON_AddStringToObject(o, "name", f->name) &&
+             cJSON_AddStringToObject(o, "media_type", f->mime) && cJSON_AddStringToObject(o, "extension", f->ext) &&
+             cJSON_AddBoolToObject(o, "binary", f->binary) && cJSON_AddBoolToObject(o, "mesh", f->mesh) &&
+             cJSON_AddBoolToObject(o, "properties", f->props) &&
+             cJSON_AddNumberToObject(o, "default_res", f->mesh ? API_RES_MESH_DEFAULT : API_RES_GRID_DEFAULT);
+        if (!o)
+            break;
+    }
+    char *s = ok ? cJSON_PrintUnformatted(a) : NULL;
+    cJSON_Delete(a);
+    return s;
+}
 
 const api_format_info *api_format_info_of(api_format f)
 {
@@ -47,8 +67,11 @@ int api_format_parse(const char *name, api_format *f, api_error *err)
             *f = (api_format)i;
             return 0;
         }
-    return api_fail(err, "", "format: \"%.40s\" is not a format; the formats are json, grid, f32, gltf, glb, vts, stl",
-                    name);
+    char list[256];
+    size_t n = 0;
+    for (int i = 0; i < API_FMT_COUNT && n < sizeof list; i++)   /* the list from the table */
+        n += (size_t)snprintf(list + n, sizeof list - n, "%s%s", i ? ", " : "", formats[i].name);
+    return api_fail(err, API_ERR_DOCUMENT, "", "format: \"%.40s\" is not a format; the formats are %s", name, list);
 }
 
 int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *err)
@@ -65,7 +88,7 @@ int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *er
     const char *s = text;
     while (n < 3) {
         if (*s < '0' || *s > '9')
-            return api_fail(err, "", "res: \"%.40s\" is not N or NU,NV,NW (whole numbers)", text);
+            return api_fail(err, API_ERR_DOCUMENT, "", "res: \"%.40s\" is not N or NU,NV,NW (whole numbers)", text);
         char *end;
         v[n++] = strtoull(s, &end, 10);
         s = end;
@@ -74,20 +97,20 @@ int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *er
         s++;
     }
     if (*s || (n != 1 && n != 3))
-        return api_fail(err, "", "res: \"%.40s\" is not N or NU,NV,NW (whole numbers)", text);
+        return api_fail(err, API_ERR_DOCUMENT, "", "res: \"%.40s\" is not N or NU,NV,NW (whole numbers)", text);
     if (n == 1)
         v[1] = v[2] = v[0];
     unsigned long long total = 1;
     for (int i = 0; i < 3; i++) {
         if (v[i] < 2)
-            return api_fail(err, "", "res: %llu is too few; at least 2 %s", v[i], what);
+            return api_fail(err, API_ERR_DOCUMENT, "", "res: %llu is too few; at least 2 %s", v[i], what);
         if (v[i] > max)
-            return api_fail(err, "", "res: %llu is more than the limit of %u %s for %s", v[i], max, what,
+            return api_fail(err, API_ERR_DOCUMENT, "", "res: %llu is more than the limit of %u %s for %s", v[i], max, what,
                             formats[f].name);
         total *= v[i];
     }
     if (!mesh && total > API_RES_GRID_POINTS)
-        return api_fail(err, "", "res: %llu points in all is more than the limit of %u", total, API_RES_GRID_POINTS);
+        return api_fail(err, API_ERR_DOCUMENT, "", "res: %llu points in all is more than the limit of %u", total, API_RES_GRID_POINTS);
     for (int i = 0; i < 3; i++)
         res[i] = (unsigned)v[i];
     return 0;
@@ -375,9 +398,7 @@ static cJSON *numbers(const double *v, int n)
 /* -1 with err set to the cancellation of api_error (model.h). */
 static int cancelled(api_error *err)
 {
-    api_fail(err, "", "cancelled");
-    err->status = API_STATUS_CANCELLED;
-    return -1;
+    return api_fail(err, API_ERR_CANCELLED, "", "cancelled");
 }
 
 static int stopped(const pde_cancel *c)
@@ -667,7 +688,7 @@ static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
     if (api_mesh_build(o->sol, o->res, cancel, &o->mesh, err))
         return -1;
     if (o->mesh.ntris == 0) {
-        api_fail(err, "", "the solid has no skin: every face collapses to a line or a point");
+        api_fail(err, API_ERR_DOCUMENT, "", "the solid has no skin: every face collapses to a line or a point");
         return -1;
     }
     size_t nv = o->mesh.nverts, nt = o->mesh.ntris;
@@ -680,8 +701,14 @@ static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
     o->blob = malloc(o->blob_len);
     if (!o->blob)
         return -1;
-    memcpy(o->blob, o->mesh.pos, 12 * nv);
-    memcpy(o->blob + 12 * nv, o->mesh.nrm, 12 * nv);
+    /* glTF is +Y up: (X, Y, Z) = (x, z, -y), a rotation (x and the solid's handedness kept); the paper's
+     * height w, along z, stands along +Y. Negation is exact, so min and max stay the float32 values. */
+    float *bp = (float *)o->blob, *bn = bp + 3 * nv;
+    for (size_t i = 0; i < nv; i++) {
+        const float *p = o->mesh.pos + 3 * i, *q = o->mesh.nrm + 3 * i;
+        bp[3 * i] = p[0], bp[3 * i + 1] = p[2], bp[3 * i + 2] = -p[1];
+        bn[3 * i] = q[0], bn[3 * i + 1] = q[2], bn[3 * i + 2] = -q[1];
+    }
     memcpy(o->blob + 24 * nv, o->mesh.tri, 12 * nt);
     const pde_props *props = props_of(o, cancel, err);
     if (!props)
@@ -692,7 +719,7 @@ static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
     /* min and max as the exact float32 values (17 digits of the double they widen to). */
     char mm[256];
     snprintf(mm, sizeof mm, "\"min\":[%.17g,%.17g,%.17g],\"max\":[%.17g,%.17g,%.17g]", o->mesh.min[0],
-             o->mesh.min[1], o->mesh.min[2], o->mesh.max[0], o->mesh.max[1], o->mesh.max[2]);
+             o->mesh.min[2], -o->mesh.max[1], o->mesh.max[0], o->mesh.max[2], -o->mesh.min[1]);
     int gltf = o->fmt == API_FMT_GLTF;
     size_t cap = 2048 + strlen(pj);
     o->text = malloc(cap);
@@ -702,7 +729,8 @@ static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
     }
     int n = snprintf(
         o->text, cap,
-        "{\"asset\":{\"version\":\"2.0\",\"generator\":\"pdesolid\",\"extras\":{\"id\":\"%s\",\"properties\":%s}},"
+        "{\"asset\":{\"version\":\"2.0\",\"generator\":\"pdesolid\",\"extras\":{\"id\":\"%s\",\"units\":\"metres\","
+        "\"up\":\"+Y; glTF (X, Y, Z) = the model's (x, z, -y)\",\"properties\":%s}},"
         "\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"name\":\"solid\"}],"
         "\"meshes\":[{\"name\":\"skin\",\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2,\"mode\":4}]}],"
         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\",%s},"
@@ -855,7 +883,7 @@ api_output *api_output_open(const pde_solution *sol, const char *id, const pde_p
         err = &local;
     api_output *o = calloc(1, sizeof *o);
     if (!o) {
-        api_fail(err, "", "out of memory");
+        api_fail(err, API_ERR_NOMEM, "", "out of memory");
         return NULL;
     }
     o->fmt = f;
@@ -898,7 +926,7 @@ api_output *api_output_open(const pde_solution *sol, const char *id, const pde_p
     }
     if (rc) {
         if (!err->message[0])
-            api_fail(err, "", "out of memory");
+            api_fail(err, API_ERR_NOMEM, "", "out of memory");
         api_output_free(o);
         return NULL;
     }

@@ -41,9 +41,13 @@ typedef struct {
     const char *ext;       /* file extension, with the dot */
     int mesh;              /* resolution per face edge rather than per volume axis */
     int props;             /* carries the properties: api_output_open() computes them when not given */
+    int binary;            /* bytes that are not text: not written to a terminal */
 } api_format_info;
 
 const api_format_info *api_format_info_of(api_format f);
+/* The table as GET /formats serves it: [{"name", "media_type", "extension", "binary", "mesh", "properties",
+ * "default_res"}, ...] in the table's order (malloc'd; NULL if out of memory). */
+char *api_formats_json(void);
 /* Returns 0, or -1 with err listing the formats. */
 int api_format_parse(const char *name, api_format *f, api_error *err);
 
@@ -64,7 +68,7 @@ typedef struct api_output api_output;
  * NULL and err on failure (out of memory, a mesh out of range). The long work
  * happens here: the properties it computes, the mesh (gltf, glb, stl), the
  * whole json document; cancel (NULL: never) is polled through it, and when
- * it stops the call frees everything and err has status API_STATUS_CANCELLED.
+ * it stops the call frees everything and err has status API_ERR_CANCELLED.
  * Grid formats only set up their sampling tables here (api/cost.h's bytes).
  */
 api_output *api_output_open(const pde_solution *sol, const char *id, const pde_props *props, api_format f,

@@ -246,9 +246,8 @@ static int fail(checker *c, size_t at, int levels, const char *fmt, ...)
         if (c->s[i] == '\n')
             line++, col = 0;
     build_pointer(c, levels, ptr, sizeof ptr);
-    api_fail(c->err, ptr, "not valid JSON: %s, at line %zu, column %zu (byte %zu%s)", what, line, col, at,
+    api_fail(c->err, API_ERR_NOT_JSON, ptr, "not valid JSON: %s, at line %zu, column %zu (byte %zu%s)", what, line, col, at,
              at >= c->len ? ", the end of the text" : "");
-    c->err->status = 400;
     return -1;
 }
 
@@ -415,9 +414,8 @@ int api_json_check(const char *text, size_t len, api_error *err)
             if (b == '{' || b == '[') {
                 if (c.depth == API_MAX_DEPTH) {
                     if (err) {
-                        api_fail(err, "", "the document nests arrays and objects deeper than %d levels, the "
+                        api_fail(err, API_ERR_LIMIT, "", "the document nests arrays and objects deeper than %d levels, the "
                                  "limit (at byte %zu)", API_MAX_DEPTH, c.pos);
-                        err->status = 413;
                     }
                     return -1;
                 }
@@ -496,7 +494,7 @@ int api_eval_check(const double *values, const double *du, const double *dv, con
                 if (!isfinite(arr[a][3 * i + k])) {
                     char ptr[40];
                     snprintf(ptr, sizeof ptr, "/points/%zu", i);
-                    return api_fail(err, ptr, "%s is not a finite number at this point: its %c component is %s; "
+                    return api_fail(err, API_ERR_DOCUMENT, ptr, "%s is not a finite number at this point: its %c component is %s; "
                                     "points far outside the unit cube can overflow a double", names[a], "xyz"[k],
                                     isnan(arr[a][3 * i + k]) ? "NaN" : "infinite");
                 }

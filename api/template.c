@@ -241,14 +241,14 @@ int api_params_set(const api_template *t, api_params *p, const char *name, const
         char list[400] = "";
         for (size_t i = 0; i < t->nparams; i++)
             snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", t->params[i].name);
-        return api_fail(err, ptr, "%s has no parameter \"%.60s\"; its parameters are %s", t->name, name, list);
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "%s has no parameter \"%.60s\"; its parameters are %s", t->name, name, list);
     }
     if (n != want)
-        return api_fail(err, ptr, want == 3 ? "must be an array of three numbers, for x, y and z"
+        return api_fail(err, API_ERR_DOCUMENT, ptr, want == 3 ? "must be an array of three numbers, for x, y and z"
                                              : "must be a number");
     for (int i = 0; i < n; i++)
         if (!isfinite(vals[i]))
-            return api_fail(err, ptr, "must be finite");
+            return api_fail(err, API_ERR_DOCUMENT, ptr, "must be finite");
     memcpy(&p->v[s], vals, (size_t)n * sizeof *vals);
     return 0;
 }

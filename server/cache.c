@@ -173,8 +173,7 @@ srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void 
     }
     if (!e) {
         pthread_mutex_unlock(&c->lock);
-        api_fail(err, "", "out of memory");
-        err->status = 500;
+        api_fail_nomem(err);
         return NULL;
     }
     memcpy(e->id, id, sizeof e->id);

@@ -107,6 +107,8 @@ double srv_now(void);
 void srv_problem(srv_req *r, int status, const char *pointer, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 void srv_problem_api(srv_req *r, const api_error *e);
+/* An api_status as HTTP: NOMEM 500, LIMIT 413, DOCUMENT 422, NOT_JSON 400, CANCELLED 503, NOT_FOUND 404. */
+int srv_http_status(api_status s);
 /* Takes text (malloc'd; NULL means out of memory, which becomes a 500). */
 void srv_set_text(srv_req *r, int status, const char *ctype, char *text);
 /* 1 if the request's Origin may call: no Origin, the same origin, or --cors-origin lists it. */

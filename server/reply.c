@@ -62,10 +62,31 @@ void srv_problem(srv_req *r, int status, const char *pointer, const char *fmt, .
     r->etag[0] = '\0';   /* a problem is not the representation the ETag would name */
 }
 
+/* The one place an api_status becomes an HTTP status. */
+int srv_http_status(api_status s)
+{
+    switch (s) {
+    case API_ERR_NOMEM:
+        return 500;
+    case API_ERR_LIMIT:
+        return 413;
+    case API_ERR_NOT_JSON:
+        return 400;
+    case API_ERR_CANCELLED:
+        return 503;
+    case API_ERR_NOT_FOUND:
+        return 404;
+    case API_OK:   /* an error without a status is a bug; call it a bad document, as api_fail's callers meant */
+    case API_ERR_DOCUMENT:
+        break;
+    }
+    return 422;
+}
+
 /* detail reads as a sentence on its own: the pointer, then what is wrong there. */
 void srv_problem_api(srv_req *r, const api_error *e)
 {
-    srv_problem(r, e->status ? e->status : 422, e->pointer, "%s%s%s", e->pointer, e->pointer[0] ? ": " : "",
+    srv_problem(r, srv_http_status(e->status), e->pointer, "%s%s%s", e->pointer, e->pointer[0] ? ": " : "",
                 e->message);
 }
 

@@ -84,6 +84,11 @@ static void get_metrics(srv_req *r)
     srv_set_text(r, 200, "text/plain; version=0.0.4; charset=utf-8", text);
 }
 
+static void get_formats(srv_req *r)
+{
+    srv_set_text(r, 200, "application/json", api_formats_json());
+}
+
 static void get_presets(srv_req *r)
 {
     srv_set_text(r, 200, "application/json", api_presets_json());
@@ -145,7 +150,7 @@ static int over_budget(srv_req *r, const api_cost *part)
 /* An api/ error, or the problem of a job that was stopped. */
 static void failed(srv_req *r, const api_error *err)
 {
-    if (err->status == API_STATUS_CANCELLED)
+    if (err->status == API_ERR_CANCELLED)
         stopped(r);
     else
         srv_problem_api(r, err);
@@ -486,6 +491,7 @@ const srv_route srv_routes[] = {
     { "request", "GET", "/solids/{}/request", get_solid_request, SRV_RT_JOB },
     { "presets", "GET", "/presets", get_presets, 0 },
     { "preset", "GET", "/presets/{}", get_preset, 0 },
+    { "formats", "GET", "/formats", get_formats, 0 },
     { "livez", "GET", "/livez", get_livez, 0 },
     { "readyz", "GET", "/readyz", get_readyz, 0 },
     { "version", "GET", "/version", get_version, 0 },

@@ -18,6 +18,7 @@
 #include <cJSON.h>
 #include <cmocka.h>
 
+#include "output.h"
 #include "support.h"
 
 static char dir[] = "/tmp/pdesolid-cli-XXXXXX";
@@ -170,7 +171,7 @@ static void bad_input_should_exit_2_and_name_the_field(void **state)
         { "solve --preset fig4a --param c=-1,-1,0", "/params/c/2: c of component z is 0" },
         { "solve --preset fig4a --format obj -o x", "\"obj\" is not a format" },
         { "solve --preset fig4a --format grid --res 9999", "limit of 4096" },
-        { "solve fig4a.json --param p0=1", "--param goes with --preset" },
+        { "solve fig4a.json --param p0=1", "--param goes with --preset or --template" },
         { "solve --res", "--res needs a value" },
         { "solve --bogus fig4a.json", "unknown option --bogus" },
     };
@@ -190,6 +191,130 @@ static void bad_input_should_exit_2_and_name_the_field(void **state)
     assert_int_equal(run(1, "eval - pts.json <bad.json", &out, &err), 2);
     assert_non_null(strstr(err, "-: /boundary/x/0/u/pow"));
     free(out);
+    free(err);
+}
+
+/* -o is never ignored: the format comes from the file's extension (the table's), a bad one or an
+ * unwritable path fails with a message and a nonzero status, and eval writes its values there too. */
+static void output_file_should_never_be_ignored(void **state)
+{
+    (void)state;
+    char *out, *err, path[256];
+    size_t len;
+    const char *exts[] = { "json", "grid.json", "glb", "stl" };
+    for (size_t i = 0; i < sizeof exts / sizeof *exts; i++) {
+        char args[128];
+        snprintf(args, sizeof args, "solve --preset fig3d --res 8 -o byext.%s", exts[i]);
+        if (run(1, args, &out, &err) != 0)
+            fail_msg("pdesolid %s: %s", args, err);
+        assert_string_equal(out, "");
+        free(out);
+        free(err);
+        snprintf(path, sizeof path, "%s/byext.%s", dir, exts[i]);
+        unsigned char *got = (unsigned char *)read_file(path, &len);
+        assert_non_null(got);
+        /* What the extension names: glb's magic, stl's 84 + 50 n bytes, grid's resolution, json's id. */
+        if (!strcmp(exts[i], "glb"))
+            assert_memory_equal(got, "glTF", 4);
+        else if (!strcmp(exts[i], "stl"))
+            assert_int_equal((len - 84) % 50, 0);
+        else if (!strcmp(exts[i], "grid.json"))
+            assert_non_null(strstr((char *)got, "\"resolution\""));
+        else
+            assert_non_null(strstr((char *)got, "\"properties\""));
+        free(got);
+    }
+    assert_int_equal(run(1, "solve --preset fig3d -o solid.txt", &out, &err), 2);
+    assert_non_null(strstr(err, "solid.txt"));
+    assert_non_null(strstr(err, ".glb"));
+    snprintf(path, sizeof path, "%s/solid.txt", dir);
+    assert_int_not_equal(access(path, F_OK), 0);
+    free(out);
+    free(err);
+    assert_int_equal(run(1, "solve --preset fig3d -o /nonexistent/dir/x.json", &out, &err), 1);
+    assert_non_null(strstr(err, "/nonexistent/dir/x.json"));
+    free(out);
+    free(err);
+    write_text("one.json", "[[0.3,0.6,0.7]]");
+    char *direct;
+    assert_int_equal(run(1, "eval --preset fig4b one.json", &direct, &err), 0);
+    free(err);
+    assert_int_equal(run(1, "eval --preset fig4b one.json -o vals.json", &out, &err), 0);
+    assert_string_equal(out, "");
+    free(out);
+    free(err);
+    snprintf(path, sizeof path, "%s/vals.json", dir);
+    char *written = read_file(path, NULL);
+    assert_non_null(written);
+    assert_string_equal(written, direct);
+    free(written);
+    free(direct);
+    /* README's eval of examples/points.json, offline: 4 points, the first fig. 4a's at (0.5, 0.25, 0.5). */
+    char cwd[1024], args[2200];
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    snprintf(args, sizeof args, "eval %s/examples/fig4a.json %s/examples/points.json", cwd, cwd);
+    assert_int_equal(run(1, args, &out, &err), 0);
+    char *readme = out;
+    free(err);
+    assert_int_equal(run(1, "eval --preset fig4a one.json", &out, &err), 0);   /* a different point: */
+    free(out);
+    free(err);
+    write_text("mid.json", "[[0.5, 0.25, 0.5]]");
+    assert_int_equal(run(1, "eval --preset fig4a mid.json", &out, &err), 0);
+    out[strcspn(out, "]") + 1] = '\0';
+    size_t lines = 0;
+    for (const char *c = readme; *c; c++)
+        lines += *c == '\n';
+    if (strncmp(readme, out, strlen(out)) != 0 || lines != 4)
+        fail_msg("examples/points.json: %s, want 4 points starting %s", readme, out);
+    free(readme);
+    free(out);
+    free(err);
+    assert_int_equal(run(1, "eval --preset fig4b one.json -o /nonexistent/dir/v.json", &out, &err), 1);
+    assert_non_null(strstr(err, "/nonexistent/dir/v.json"));
+    free(out);
+    free(err);
+}
+
+/* --template NAME is the request {"template": NAME, "params": {...}}: the same solid, by its id; its defaults
+ * are the family's first figure (example4's is fig4a); --help lists every format of the table. */
+static void templates_should_work_from_the_command_line(void **state)
+{
+    (void)state;
+    char *a, *b, *err;
+    write_text("treq.json", "{\"template\":\"example4\",\"params\":{\"p0\":12345,\"c\":[-11,-11,-10]}}");
+    assert_int_equal(run(1, "solve --template example4 --param p0=12345 --param c=-11,-11,-10", &a, &err), 0);
+    free(err);
+    assert_int_equal(run(1, "solve treq.json", &b, &err), 0);
+    free(err);
+    assert_memory_equal(a, b, strcspn(b, "\n"));
+    assert_non_null(strstr(a, "solid "));
+    free(a);
+    free(b);
+    assert_int_equal(run(1, "solve --template example4", &a, &err), 0);
+    free(err);
+    assert_int_equal(run(1, "solve --preset fig4a", &b, &err), 0);
+    free(err);
+    assert_memory_equal(a, b, strcspn(b, "\n"));
+    free(a);
+    free(b);
+    assert_int_equal(run(1, "solve --template example9", &a, &err), 2);
+    assert_non_null(strstr(err, "/template: no template \"example9\"; the templates are example1, example2"));
+    free(a);
+    free(err);
+    assert_int_equal(run(1, "solve --template example4 --preset fig4a", &a, &err), 2);
+    assert_non_null(strstr(err, "not both"));
+    free(a);
+    free(err);
+    assert_int_equal(run(1, "--help", &a, &err), 0);
+    for (int i = 0; i < API_FMT_COUNT; i++) {
+        const api_format_info *f = api_format_info_of((api_format)i);
+        char line[64];
+        snprintf(line, sizeof line, "  %-6s %-11s %s", f->name, f->ext, f->mime);
+        if (!strstr(a, line))
+            fail_msg("--help lacks \"%s\":\n%s", line, a);
+    }
+    free(a);
     free(err);
 }
 
@@ -243,6 +368,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(presets_and_formats_should_work_from_the_command_line),
+        cmocka_unit_test(output_file_should_never_be_ignored),
+        cmocka_unit_test(templates_should_work_from_the_command_line),
         cmocka_unit_test(eval_should_agree_with_the_independent_solution),
         cmocka_unit_test(solve_should_print_the_closed_form_and_properties),
         cmocka_unit_test(bad_input_should_exit_2_and_name_the_field),

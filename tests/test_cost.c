@@ -189,13 +189,13 @@ static int call_mesh(const void *arg, const pde_cancel *cancel)
 {
     const out_arg *a = arg;
     api_mesh m;
-    api_error err = { .status = 0 };
+    api_error err = { .status = API_OK };
     int rc = api_mesh_build(a->sol, a->res, cancel, &m, &err);
     if (rc == 0) {
         assert_true(m.ntris > 0);
         api_mesh_free(&m);
     } else {
-        assert_int_equal(err.status, API_STATUS_CANCELLED);
+        assert_int_equal(err.status, API_ERR_CANCELLED);
         assert_string_equal(err.message, "cancelled");
         assert_null(m.pos);
         assert_null(m.tri);
@@ -216,10 +216,10 @@ static void mesh_build_should_stop_at_the_poll_that_asks_and_free_everything(voi
 static int call_output(const void *arg, const pde_cancel *cancel)
 {
     const out_arg *a = arg;
-    api_error err = { .status = 0 };
+    api_error err = { .status = API_OK };
     api_output *o = api_output_open(a->sol, "id", NULL, a->fmt, a->res, cancel, &err);
     if (!o) {
-        assert_int_equal(err.status, API_STATUS_CANCELLED);
+        assert_int_equal(err.status, API_ERR_CANCELLED);
         assert_string_equal(err.message, "cancelled");
         return -1;
     }

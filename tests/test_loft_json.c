@@ -389,7 +389,7 @@ static void a_near_resonant_loft_should_report_its_harmonic_and_condition(void *
 
 /* ---- bad input ---- */
 
-static void expect_bad(const char *doc, const char *pointer, int status)
+static void expect_bad(const char *doc, const char *pointer, api_status status)
 {
     api_error err;
     api_model *m = api_model_parse(doc, strlen(doc), &err);
@@ -402,7 +402,7 @@ static void expect_bad(const char *doc, const char *pointer, int status)
             fail_msg("accepted: %.200s", doc);
     }
     if (strcmp(err.pointer, pointer) != 0 || err.status != status)
-        fail_msg("pointer %s (status %d), want %s (%d): %s", err.pointer, err.status, pointer, status, err.message);
+        fail_msg("pointer %s (status %d), want %s (%d): %s", err.pointer, (int)err.status, pointer, (int)status, err.message);
     assert_true(strlen(err.message) > 10);
 }
 
@@ -413,46 +413,46 @@ static void every_bad_loft_should_name_its_field(void **state)
 {
     (void)state;
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": [[1, 0, 0], [0, 1, 0]]}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
-               "/loft/sections/0/profile", 422);
+               "/loft/sections/0/profile", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": " TRI(0) "}, {\"w\": 0.6, \"profile\": " TRI(1)
                "}, {\"w\": 0.4, \"profile\": " TRI(1) "}, {\"w\": 1, \"profile\": " TRI(2) "}]}}",
-               "/loft/sections/2/w", 422);
+               "/loft/sections/2/w", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0.1, \"profile\": " TRI(0) "}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
-               "/loft/sections/0/w", 422);
+               "/loft/sections/0/w", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": " TRI(0) "}, {\"w\": 0.9, \"profile\": " TRI(1) "}]}}",
-               "/loft/sections/1/w", 422);
+               "/loft/sections/1/w", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": " TRI(0) ", \"tangent\": [[0, 0, 1]]}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
-               "/loft/sections/0/tangent", 422);
+               "/loft/sections/0/tangent", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": [[1e999, 0, 0], [0, 1, 0], [0, 0, 1]]}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
-               "/loft/sections/0/profile/0/0", 422);
-    expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": " TRI(0) "}]}}", "/loft/sections", 422);
+               "/loft/sections/0/profile/0/0", API_ERR_DOCUMENT);
+    expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": " TRI(0) "}]}}", "/loft/sections", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": " TRI(0) ", \"terms\": {}}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
-               "/loft/sections/0", 422);
+               "/loft/sections/0", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"profile\": " TRI(0) "}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
-               "/loft/sections/0/w", 422);
+               "/loft/sections/0/w", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profle\": " TRI(0) "}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
-               "/loft/sections/0/profle", 422);
+               "/loft/sections/0/profle", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], \"c\": [1, 0, 1]}, \"sections\": [{\"w\": 0, \"profile\": " TRI(0)
                "}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
-               "/loft/pde/c/1", 422);
-    expect_bad("{\"loft\": {" PDE3 "}, \"boundary\": {}}", "/boundary", 422);
+               "/loft/pde/c/1", API_ERR_DOCUMENT);
+    expect_bad("{\"loft\": {" PDE3 "}, \"boundary\": {}}", "/boundary", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"grid\": [[[0, 0, 0], [1, 0, 0]], [[0, 1, 0]]]}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
-               "/loft/sections/0/grid/1", 422);
+               "/loft/sections/0/grid/1", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"periodic\": true, \"profile\": " TRI(0) "}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
-               "/loft/sections/0", 422);
+               "/loft/sections/0", API_ERR_DOCUMENT);
     /* Limits: sections and points. */
     sbuf b = { 0 };
     put(&b, "{\"loft\": {" PDE3 ", \"sections\": [");
     for (int k = 0; k <= PDE_MAX_SECTIONS; k++)
         put(&b, "%s{\"w\": %.17g, \"profile\": " TRI(0) "}", k ? ", " : "", (double)k / PDE_MAX_SECTIONS);
     put(&b, "]}}");
-    expect_bad(b.s, "/loft/sections", 413);
+    expect_bad(b.s, "/loft/sections", API_ERR_LIMIT);
     b.n = 0;
     put(&b, "{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": [");
     for (int j = 0; j <= API_LOFT_MAX_POINTS; j++)
         put(&b, "%s[%d, 0, 0]", j ? ", " : "", j);
     put(&b, "]}, {\"w\": 1, \"profile\": " TRI(1) "}]}}");
-    expect_bad(b.s, "/loft/sections/0/profile", 413);
+    expect_bad(b.s, "/loft/sections/0/profile", API_ERR_LIMIT);
     free(b.s);
 }
 

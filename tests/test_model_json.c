@@ -172,14 +172,14 @@ static void model_should_refuse_deep_nesting_and_huge_documents(void **state)
     assert_null(parse(deep, &err));
     assert_string_equal(err.pointer, "");
     assert_non_null(strstr(err.message, "deeper than 64 levels"));
-    assert_int_equal(err.status, 413);
+    assert_int_equal(err.status, API_ERR_LIMIT);
     free(deep);
     /* Depth inside strings does not count; 64 levels parse (and fail the schema, 422). */
     char nest[200] = "{\"pde\":\"[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[\"}";
     assert_null(parse(nest, &err));
-    assert_int_equal(err.status, 422);
+    assert_int_equal(err.status, API_ERR_DOCUMENT);
     assert_null(parse("{\"pde\": ", &err));
-    assert_int_equal(err.status, 400);
+    assert_int_equal(err.status, API_ERR_NOT_JSON);
     /* 6000 terms, over 2 MB with padding: over the term limit. */
     size_t cap = 3 << 20, len = 0;
     char *big = malloc(cap);
@@ -191,7 +191,7 @@ static void model_should_refuse_deep_nesting_and_huge_documents(void **state)
     assert_null(parse(big, &err));
     assert_string_equal(err.pointer, "/boundary/x");
     assert_non_null(strstr(err.message, "limit"));
-    assert_int_equal(err.status, 413);
+    assert_int_equal(err.status, API_ERR_LIMIT);
     free(big);
 }
 
@@ -225,18 +225,18 @@ static void model_should_refuse_nul_leading_zeros_and_invalid_utf8_as_not_json(v
         free(copy);
         if (m)
             fail_msg("case %zu parsed", i);
-        if (err.status != 400 || strcmp(err.pointer, cases[i].pointer) != 0 || !strstr(err.message, cases[i].words))
-            fail_msg("case %zu: got %d %s: %s", i, err.status, err.pointer, err.message);
+        if (err.status != API_ERR_NOT_JSON || strcmp(err.pointer, cases[i].pointer) != 0 || !strstr(err.message, cases[i].words))
+            fail_msg("case %zu: got %d %s: %s", i, (int)err.status, err.pointer, err.message);
     }
     double *p;
     size_t n;
     int d;
     const char *pts = "{\"points\":[[0,0,01]]}";
     assert_int_equal(api_eval_parse(pts, strlen(pts), 10, &p, &n, &d, &perr), -1);
-    assert_int_equal(perr.status, 400);
+    assert_int_equal(perr.status, API_ERR_NOT_JSON);
     assert_string_equal(perr.pointer, "/points/0/2");
     assert_int_equal(api_points_parse("[[0,0,1]]\0", 10, &p, &n, &perr), -1);
-    assert_int_equal(perr.status, 400);
+    assert_int_equal(perr.status, API_ERR_NOT_JSON);
 }
 
 static void solve_errors_should_point_at_the_term_or_coefficient(void **state)
@@ -285,7 +285,7 @@ static void eval_requests_should_parse_and_name_bad_entries(void **state)
         assert_int_equal(api_eval_parse(cases[i][0], strlen(cases[i][0]), 2, &p, &n, &d, &err), -1);
         assert_string_equal(err.pointer, cases[i][1]);
         assert_non_null(strstr(err.message, cases[i][2]));
-        assert_int_equal(err.status, i == 4 ? 413 : 422);
+        assert_int_equal(err.status, i == 4 ? API_ERR_LIMIT : API_ERR_DOCUMENT);
     }
 }
 

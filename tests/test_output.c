@@ -395,6 +395,50 @@ static void gltf_should_carry_the_id_properties_and_exact_bounds(void **state)
     pde_solution_free(sol);
 }
 
+/* glTF is +Y up: fig4a's height (z in the model, w in the paper: 0 to 3) lies along glTF's +Y. The GLB's
+ * POSITION min and max are the STL's (the same skin, in the model's frame) as (x, z, -y), exactly. */
+static void gltf_should_stand_the_height_along_plus_y(void **state)
+{
+    (void)state;
+    pde_solution *sol = solve_preset("fig4a", NULL);
+    const unsigned res[3] = { 24, 24, 24 };
+    size_t glen, slen;
+    unsigned char *glb = render(sol, NULL, API_FMT_GLB, res, &glen);
+    unsigned char *stl = render(sol, NULL, API_FMT_STL, res, &slen);
+    float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    uint32_t ntri;
+    memcpy(&ntri, stl + 80, 4);
+    for (uint32_t t = 0; t < ntri; t++)
+        for (int v = 0; v < 3; v++)
+            for (int c = 0; c < 3; c++) {
+                float x;
+                memcpy(&x, stl + 84 + 50 * (size_t)t + 12 + 12 * v + 4 * c, 4);
+                lo[c] = fminf(lo[c], x), hi[c] = fmaxf(hi[c], x);
+            }
+    uint32_t jlen;
+    memcpy(&jlen, glb + 12, 4);
+    char *json = strndup((char *)glb + 20, jlen);
+    cJSON *g = cJSON_Parse(json);
+    const cJSON *pos = cJSON_GetArrayItem(cJSON_GetObjectItem(g, "accessors"), 0);
+    const cJSON *mn = cJSON_GetObjectItem(pos, "min"), *mx = cJSON_GetObjectItem(pos, "max");
+    const double want_min[3] = { lo[0], lo[2], -hi[1] }, want_max[3] = { hi[0], hi[2], -lo[1] };
+    for (int c = 0; c < 3; c++) {
+        if (cJSON_GetArrayItem(mn, c)->valuedouble != want_min[c] || cJSON_GetArrayItem(mx, c)->valuedouble != want_max[c])
+            fail_msg("axis %d: glTF [%.9g, %.9g], want [%.9g, %.9g]", c, cJSON_GetArrayItem(mn, c)->valuedouble,
+                     cJSON_GetArrayItem(mx, c)->valuedouble, want_min[c], want_max[c]);
+    }
+    /* The height, 3 m, along +Y; and the asset says so, in metres. */
+    assert_float_equal(cJSON_GetArrayItem(mn, 1)->valuedouble, 0.0, 1e-6);
+    assert_float_equal(cJSON_GetArrayItem(mx, 1)->valuedouble, 3.0, 1e-6);
+    const cJSON *extras = cJSON_GetObjectItem(cJSON_GetObjectItem(g, "asset"), "extras");
+    assert_string_equal(cJSON_GetObjectItem(extras, "units")->valuestring, "metres");
+    cJSON_Delete(g);
+    free(json);
+    free(glb);
+    free(stl);
+    pde_solution_free(sol);
+}
+
 static void grid_json_should_read_back_as_the_f32_output(void **state)
 {
     (void)state;
@@ -757,6 +801,7 @@ int main(void)
         cmocka_unit_test(presets_should_be_the_tests_own_transcription),
         cmocka_unit_test(every_preset_should_give_gltf_and_glb_that_the_khronos_validator_passes),
         cmocka_unit_test(gltf_should_carry_the_id_properties_and_exact_bounds),
+        cmocka_unit_test(gltf_should_stand_the_height_along_plus_y),
         cmocka_unit_test(grid_json_should_read_back_as_the_f32_output),
         cmocka_unit_test(stl_skin_should_be_closed_and_enclose_the_computed_volume),
         cmocka_unit_test(every_skin_should_be_closed_with_normals_and_det_j_from_the_closed_form),

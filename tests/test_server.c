@@ -27,6 +27,7 @@
 
 #include "id.h"
 #include "loft.h"
+#include "output.h"
 #include "support.h"
 #include "template.h"
 
@@ -634,6 +635,51 @@ static void sigterm_should_let_a_request_in_flight_complete(void **state)
 
 /* ---- the small routes ---- */
 
+/* GET /formats lists output.h's table, and each row is true: POST /solve?format=NAME answers with its media
+ * type, its body is binary exactly when the row says so, and default_res is api_res_parse's default. */
+static void formats_should_list_the_table_and_each_row_should_hold(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    reply r = http(&d, "GET", "/formats", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    cJSON *j = cJSON_Parse(r.body);
+    assert_true(cJSON_IsArray(j));
+    assert_int_equal(cJSON_GetArraySize(j), API_FMT_COUNT);
+    for (int i = 0; i < API_FMT_COUNT; i++) {
+        const api_format_info *f = api_format_info_of((api_format)i);
+        const cJSON *row = cJSON_GetArrayItem(j, i);
+        assert_string_equal(cJSON_GetObjectItem(row, "name")->valuestring, f->name);
+        assert_string_equal(cJSON_GetObjectItem(row, "media_type")->valuestring, f->mime);
+        assert_string_equal(cJSON_GetObjectItem(row, "extension")->valuestring, f->ext);
+        assert_int_equal(cJSON_IsTrue(cJSON_GetObjectItem(row, "mesh")), f->mesh);
+        assert_int_equal(cJSON_IsTrue(cJSON_GetObjectItem(row, "properties")), f->props);
+        assert_true(cJSON_IsBool(cJSON_GetObjectItem(row, "binary")));
+        unsigned res[3];
+        assert_int_equal(api_res_parse(NULL, (api_format)i, res, NULL), 0);
+        assert_int_equal(cJSON_GetObjectItem(row, "default_res")->valueint, (int)res[0]);
+        char path[96], ctype[96];
+        snprintf(path, sizeof path, "/solve?format=%s&res=4", f->name);
+        reply s = post(&d, path, "{\"preset\":\"fig3d\"}");
+        assert_int_equal(s.status, 200);
+        assert_true(header_value(&s, "Content-Type", ctype, sizeof ctype));
+        if (strncmp(ctype, f->mime, strlen(f->mime)) != 0)
+            fail_msg("%s: Content-Type %s, GET /formats says %s", f->name, ctype, f->mime);
+        /* binary: the body has a byte no text format writes (a NUL or a byte over 0x7f), at res 4 of fig3d */
+        int high = 0;
+        for (size_t k = 0; k < s.len; k++)
+            high |= s.body[k] == 0 || (unsigned char)s.body[k] > 0x7f;
+        if (high != cJSON_IsTrue(cJSON_GetObjectItem(row, "binary")))
+            fail_msg("%s: binary %d, but its body %s", f->name, cJSON_IsTrue(cJSON_GetObjectItem(row, "binary")),
+                     high ? "has bytes outside printable ASCII" : "is text");
+        free(s.body);
+    }
+    cJSON_Delete(j);
+    free(r.body);
+    stop(&d);
+}
+
 static void presets_version_health_metrics_and_cors_should_answer(void **state)
 {
     (void)state;
@@ -695,7 +741,8 @@ static void openapi_should_be_valid_and_name_every_route(void **state)
     char *paths = read_file(cmd, NULL);
     /* The routes of server/http.c, in the document, and nothing else. */
     const char *routes[] = { "/solve", "/solids/{id}", "/solids/{id}/eval", "/solids/{id}/request", "/presets",
-                             "/presets/{name}", "/livez", "/readyz", "/version", "/metrics", "/", "/openapi.yaml" };
+                             "/presets/{name}", "/livez", "/readyz", "/version", "/metrics", "/", "/openapi.yaml",
+                             "/formats" };
     size_t listed = 0;
     for (const char *p = paths; *p; p += strcspn(p, "\n") + (p[strcspn(p, "\n")] != 0))
         listed++;
@@ -785,6 +832,7 @@ int main(void)
         cmocka_unit_test(two_content_lengths_and_stalled_clients_should_be_refused),
         cmocka_unit_test(sigterm_should_let_a_request_in_flight_complete),
         cmocka_unit_test(presets_version_health_metrics_and_cors_should_answer),
+        cmocka_unit_test(formats_should_list_the_table_and_each_row_should_hold),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("server", tests, setup, teardown);

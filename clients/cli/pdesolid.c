@@ -40,12 +40,15 @@ static const char usage[] =
     "\n"
     "options:\n"
     "  --preset NAME        instead of MODEL.json: a preset (see `pdesolid presets`)\n"
-    "  --param NAME=VALUE   with --preset, a parameter; VALUE is a number, or x,y,z for\n"
+    "  --template NAME      instead of MODEL.json: a template (example1 to example4,\n"
+    "                       docs/API.md), its defaults changed by --param\n"
+    "  --param NAME=VALUE   with --preset or --template, a parameter; VALUE is a number, or x,y,z for\n"
     "                       a, b and c; repeatable\n"
-    "  --format F           solve: json, grid, f32, gltf, glb, vts or stl\n"
+    "  --format F           solve: one of the formats below\n"
     "  --res N|NU,NV,NW     samples per axis (grid, f32, vts; default 33) or per face\n"
     "                       edge (gltf, glb, stl; default 64)\n"
-    "  -o FILE              write to FILE instead of standard output\n"
+    "  -o FILE              write to FILE instead of standard output; solve without\n"
+    "                       --format takes the format from FILE's extension\n"
     "  --server URL         solve and eval on a pdesolidd (e.g. http://127.0.0.1:8080)\n"
     "                       instead of here; the output is the same\n"
     "  -h, --help           this text\n"
@@ -55,7 +58,7 @@ static const char usage[] =
     "pointer), 1 anything else.\n";
 
 typedef struct {
-    const char *preset, *format, *res, *out, *server;
+    const char *preset, *template, *format, *res, *out, *server;
     const char *params[64];
     int nparams;
     const char *args[3];
@@ -104,33 +107,46 @@ static int report(const char *what, const api_error *err)
     return 2;
 }
 
-/* The model of --preset and --param. */
+/* The model of --preset (or --template) and --param. */
 static api_model *preset_model(const options *o, api_error *err)
 {
-    const api_preset *ps = api_preset_find(o->preset);
-    cJSON *loft = ps ? NULL : api_loft_preset_tree(o->preset);
+    const api_template *t = NULL;
+    api_params p;
+    if (o->template) {
+        if (!(t = api_template_find(o->template))) {
+            char names[256] = "";
+            for (size_t i = 0, n = 0; i < api_template_count() && n < sizeof names; i++)
+                n += (size_t)snprintf(names + n, sizeof names - n, "%s%s", i ? ", " : "", api_template_name(api_template_at(i)));
+            api_fail(err, API_ERR_DOCUMENT, "/template", "no template \"%s\"; the templates are %s", o->template, names);
+            return NULL;
+        }
+        api_template_defaults(t, &p);
+    }
+    const api_preset *ps = t ? NULL : api_preset_find(o->preset);
+    cJSON *loft = ps || t ? NULL : api_loft_preset_tree(o->preset);
     if (loft) {   /* a loft of the gallery: its document */
         cJSON_Delete(loft);
         if (o->nparams) {
-            api_fail(err, "/params", "the loft preset \"%s\" takes no --param; `pdesolid presets` shows its document", o->preset);
+            api_fail(err, API_ERR_DOCUMENT, "/params", "the loft preset \"%s\" takes no --param; `pdesolid presets` shows its document", o->preset);
             return NULL;
         }
         char body[128];
         int n = snprintf(body, sizeof body, "{\"preset\": \"%.60s\"}", o->preset);
         return api_model_parse(body, (size_t)n, err);
     }
-    if (!ps) {
-        api_fail(err, "/preset", "no preset \"%s\"; `pdesolid presets` lists them", o->preset);
+    if (!ps && !t) {
+        api_fail(err, API_ERR_DOCUMENT, "/preset", "no preset \"%s\"; `pdesolid presets` lists them", o->preset);
         return NULL;
     }
-    const api_template *t = api_preset_template(ps);
-    api_params p;
-    api_preset_params(ps, &p);
+    if (ps) {
+        t = api_preset_template(ps);
+        api_preset_params(ps, &p);
+    }
     for (int i = 0; i < o->nparams; i++) {
         char name[64];
         const char *eq = strchr(o->params[i], '=');
         if (!eq || eq == o->params[i] || (size_t)(eq - o->params[i]) >= sizeof name) {
-            api_fail(err, "", "--param %s: write NAME=VALUE", o->params[i]);
+            api_fail(err, API_ERR_DOCUMENT, "", "--param %s: write NAME=VALUE", o->params[i]);
             return NULL;
         }
         snprintf(name, sizeof name, "%.*s", (int)(eq - o->params[i]), o->params[i]);
@@ -141,13 +157,13 @@ static api_model *preset_model(const options *o, api_error *err)
         do {
             v[n++] = strtod(s, &end);
             if (end == s) {
-                api_fail(err, "", "--param %s: \"%s\" is not a number", name, s);
+                api_fail(err, API_ERR_DOCUMENT, "", "--param %s: \"%s\" is not a number", name, s);
                 return NULL;
             }
             s = end + (*end == ',');
         } while (*end == ',' && n < 3);
         if (*end) {
-            api_fail(err, "", "--param %s: \"%s\" is not a number or x,y,z", name, eq + 1);
+            api_fail(err, API_ERR_DOCUMENT, "", "--param %s: \"%s\" is not a number or x,y,z", name, eq + 1);
             return NULL;
         }
         if (api_params_set(t, &p, name, v, n, err))
@@ -162,8 +178,8 @@ static int load(const options *o, const char *path, pde_solution **sol, char *id
     api_error err;
     api_model *m;
     const char *what = path;
-    if (o->preset) {
-        what = o->preset;
+    if (o->preset || o->template) {
+        what = o->preset ? o->preset : o->template;
         m = preset_model(o, &err);
     } else {
         size_t len;
@@ -193,8 +209,7 @@ static int write_output(const options *o, const pde_solution *sol, const char *i
     unsigned res[3];
     if (api_format_parse(o->format, &f, &err) || api_res_parse(o->res, f, res, &err))
         return report("option", &err);
-    if (!o->out && isatty(STDOUT_FILENO) && (f == API_FMT_F32 || f == API_FMT_GLB || f == API_FMT_STL ||
-                                             f == API_FMT_VTS)) {
+    if (!o->out && isatty(STDOUT_FILENO) && api_format_info_of(f)->binary) {
         fprintf(stderr, "pdesolid: %s is binary; give -o FILE, or redirect standard output\n", o->format);
         return 2;
     }
@@ -226,13 +241,14 @@ static int write_output(const options *o, const pde_solution *sol, const char *i
 /* The request for --server: the model file's text, or {"preset": NAME, "params": {...}}. NULL on error. */
 static char *request_text(const options *o, const char *path, size_t *len)
 {
-    if (!o->preset)
+    if (!o->preset && !o->template)
         return slurp(path, len);
     size_t cap = 256 + 96 * (size_t)o->nparams, n = 0;
     char *b = malloc(cap);
     if (!b)
         return NULL;
-    n += (size_t)snprintf(b, cap, "{\"preset\":\"%.60s\",\"params\":{", o->preset);
+    n += (size_t)snprintf(b, cap, "{\"%s\":\"%.60s\",\"params\":{", o->preset ? "preset" : "template",
+                          o->preset ? o->preset : o->template);
     for (int i = 0; i < o->nparams; i++) {
         const char *eq = strchr(o->params[i], '=');
         double v[3];
@@ -262,7 +278,7 @@ static char *request_text(const options *o, const char *path, size_t *len)
 static int remote(const options *o, int eval)
 {
     size_t len, plen = 0;
-    char *body = request_text(o, o->nargs && !o->preset ? o->args[0] : NULL, &len);
+    char *body = request_text(o, o->nargs && !o->preset && !o->template ? o->args[0] : NULL, &len);
     if (!body)
         return 2;
     char *pts = eval ? slurp(o->args[o->nargs - 1], &plen) : NULL;
@@ -287,8 +303,35 @@ static int remote(const options *o, int eval)
     return rc;
 }
 
-static int cmd_solve(const options *o)
+/*
+ * The format of -o FILE without --format: the one whose extension FILE ends with (the longest, so that
+ * x.grid.json is a grid). 0, or 2 with a message naming the extensions.
+ */
+static int format_from_extension(options *o)
 {
+    size_t n = strlen(o->out), best = 0;
+    for (int i = 0; i < API_FMT_COUNT; i++) {
+        const api_format_info *f = api_format_info_of((api_format)i);
+        size_t k = strlen(f->ext);
+        if (k < n && k > best && strcmp(o->out + n - k, f->ext) == 0) {
+            best = k;
+            o->format = f->name;
+        }
+    }
+    if (best)
+        return 0;
+    fprintf(stderr, "pdesolid: %s: no format has this extension; give --format, or end the name with one of", o->out);
+    for (int i = 0; i < API_FMT_COUNT; i++)
+        fprintf(stderr, "%s %s", i ? "," : "", api_format_info_of((api_format)i)->ext);
+    fputc('\n', stderr);
+    return 2;
+}
+
+static int cmd_solve(const options *oo)
+{
+    options copy = *oo, *o = &copy;
+    if (o->out && !o->format && format_from_extension(o))
+        return 2;
     if (o->server)
         return remote(o, 0);
     pde_solution *sol;
@@ -364,6 +407,17 @@ static int cmd_presets(void)
     return 0;
 }
 
+/* The usage, then the formats as output.h's table has them. */
+static void print_usage(FILE *f)
+{
+    fputs(usage, f);
+    fputs("\nformats (--format NAME, or -o FILE ending with the extension):\n", f);
+    for (int i = 0; i < API_FMT_COUNT; i++) {
+        const api_format_info *fi = api_format_info_of((api_format)i);
+        fprintf(f, "  %-6s %-11s %s%s\n", fi->name, fi->ext, fi->mime, fi->mesh ? " (a mesh of the skin)" : "");
+    }
+}
+
 int main(int argc, char **argv)
 {
     options o = { 0 };
@@ -372,13 +426,15 @@ int main(int argc, char **argv)
         const char *a = argv[i];
         const char **val = NULL;
         if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0 || strcmp(a, "help") == 0) {
-            fputs(usage, stdout);
+            print_usage(stdout);
             return 0;
         } else if (strcmp(a, "--version") == 0) {
             printf("pdesolid %s\n", PDESOLID_VERSION);
             return 0;
         } else if (strcmp(a, "--preset") == 0) {
             val = &o.preset;
+        } else if (strcmp(a, "--template") == 0) {
+            val = &o.template;
         } else if (strcmp(a, "--format") == 0) {
             val = &o.format;
         } else if (strcmp(a, "--res") == 0) {
@@ -395,7 +451,8 @@ int main(int argc, char **argv)
             o.params[o.nparams++] = argv[++i];
             continue;
         } else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "pdesolid: unknown option %s\n\n%s", a, usage);
+            fprintf(stderr, "pdesolid: unknown option %s\n\n", a);
+            print_usage(stderr);
             return 2;
         } else if (!cmd) {
             cmd = a;
@@ -414,20 +471,31 @@ int main(int argc, char **argv)
         *val = argv[++i];
     }
     if (!cmd) {
-        fputs(usage, stderr);
+        print_usage(stderr);
         return 2;
     }
-    if (o.nparams && !o.preset) {
-        fprintf(stderr, "pdesolid: --param goes with --preset\n");
+    if (o.nparams && !o.preset && !o.template) {
+        fprintf(stderr, "pdesolid: --param goes with --preset or --template\n");
         return 2;
     }
-    int model_args = o.preset ? 0 : 1;
+    if (o.preset && o.template) {
+        fprintf(stderr, "pdesolid: give --preset or --template, not both\n");
+        return 2;
+    }
+    int model_args = o.preset || o.template ? 0 : 1;
     if (strcmp(cmd, "solve") == 0 && o.nargs == model_args)
         return cmd_solve(&o);
-    if (strcmp(cmd, "eval") == 0 && o.nargs == model_args + 1)
+    int eval = strcmp(cmd, "eval") == 0 && o.nargs == model_args + 1;
+    int presets = strcmp(cmd, "presets") == 0 && o.nargs == 0;
+    if ((eval || presets) && o.out && !freopen(o.out, "wb", stdout)) {   /* -o is never ignored */
+        fprintf(stderr, "pdesolid: %s: %s\n", o.out, strerror(errno));
+        return 1;
+    }
+    if (eval)
         return cmd_eval(&o);
-    if (strcmp(cmd, "presets") == 0 && o.nargs == 0)
+    if (presets)
         return cmd_presets();
-    fprintf(stderr, "pdesolid: unknown command or wrong arguments: %s\n\n%s", cmd, usage);
+    fprintf(stderr, "pdesolid: unknown command or wrong arguments: %s\n\n", cmd);
+    print_usage(stderr);
     return 2;
 }

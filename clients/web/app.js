@@ -19,12 +19,12 @@ renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
 view.appendChild(renderer.domElement);
 const scene = new THREE.Scene();
 scene.background = new THREE.Color(0xf4f5f7);
+// glTF's +Y is up (the server writes the model's (x, z, -y)); three's camera is +Y up already.
 const camera = new THREE.PerspectiveCamera(40, 1, 0.01, 1000);
-camera.up.set(0, 0, 1);
 const controls = new OrbitControls(camera, renderer.domElement);
 scene.add(new THREE.HemisphereLight(0xffffff, 0x8890a0, 1.6));
 const sun = new THREE.DirectionalLight(0xffffff, 1.8);
-sun.position.set(3, -4, 6);
+sun.position.set(3, 6, 4);
 scene.add(sun);
 const solid = new THREE.Group();
 scene.add(solid);
@@ -45,7 +45,7 @@ window.addEventListener('resize', resize);
 function frame(box) {
   const c = box.getCenter(new THREE.Vector3()), r = box.getSize(new THREE.Vector3()).length() / 2 || 1;
   controls.target.copy(c);
-  camera.position.copy(c).add(new THREE.Vector3(1.6 * r, -2.2 * r, 1.3 * r));
+  camera.position.copy(c).add(new THREE.Vector3(1.6 * r, 1.3 * r, 2.2 * r));
   camera.near = r / 100;
   camera.far = r * 100;
   camera.updateProjectionMatrix();
@@ -223,7 +223,10 @@ async function refreshGridViews() {
   const n = 17, id = state.id;
   const resp = await fetch(`/solids/${id}?format=f32&res=${n}`);
   if (!resp.ok || id !== state.id) return;
-  const p = new Float32Array(await resp.arrayBuffer());
+  const raw = new Float32Array(await resp.arrayBuffer());
+  // The grid is in the model's frame (z up); drawn beside the glTF skin, in glTF's: (x, z, -y).
+  const p = new Float32Array(raw.length);
+  for (let i = 0; i < raw.length; i += 3) { p[i] = raw[i]; p[i + 1] = raw[i + 2]; p[i + 2] = -raw[i + 1]; }
   const at = (i, j, k) => 3 * ((k * n + j) * n + i);
   if (state.lines) {
     // Lines of constant parameter on the six faces of the cube.
@@ -264,11 +267,12 @@ const downloads = {};
 function updateDownloads() {
   for (const [fmt, c] of Object.entries(downloads)) c.enable(Boolean(state.id));
 }
-function download(format, res) {
+// f: a row of GET /formats; a mesh at the view's samples per face edge, a grid at the format's default.
+function download(f) {
   if (!state.id) return;
   const a = document.createElement('a');
-  a.href = `/solids/${state.id}?format=${format}&res=${res}`;
-  a.download = `${state.preset || state.template || 'loft'}-${state.id.slice(0, 8)}${{ grid: '.grid.json' }[format] || '.' + format}`;
+  a.href = `/solids/${state.id}?format=${f.name}&res=${f.mesh ? state.res : f.default_res}`;
+  a.download = `${state.preset || state.template || 'loft'}-${state.id.slice(0, 8)}${f.extension}`;
   document.body.appendChild(a);
   a.click();
   a.remove();
@@ -336,7 +340,7 @@ async function loadPreset(name) {
 
 async function main() {
   resize();
-  const list = await (await fetch('/presets')).json();
+  const [list, formats] = await Promise.all([fetch('/presets'), fetch('/formats')].map((p) => p.then((r) => r.json())));
   for (const t of list.templates) ui.templates[t.name] = t;
   ui.presets = list.presets;
   const gallery = el('gallery');
@@ -359,12 +363,10 @@ async function main() {
   ];
   for (const c of toggles) c.domElement.dataset.view = c.property;
   const dl = ui.gui.addFolder('Download');
-  const acts = {
-    glb: () => download('glb', state.res), gltf: () => download('gltf', state.res), stl: () => download('stl', state.res),
-    vts: () => download('vts', 33), grid: () => download('grid', 33),
-  };
-  for (const [fmt, name] of [['glb', '.glb'], ['gltf', '.gltf'], ['stl', '.stl'], ['vts', '.vts (volume, det J)'], ['grid', 'grid (JSON)']])
-    downloads[fmt] = dl.add(acts, fmt).name(name);
+  // The menu is the server's table of formats (GET /formats): a new format appears here without a change.
+  const acts = Object.fromEntries(formats.map((f) => [f.name, () => download(f)]));
+  for (const f of formats)
+    downloads[f.name] = dl.add(acts, f.name).name(`${f.extension} (${f.name}${f.mesh ? ', skin' : ''})`);
   dl.close();
   ui.loft = mountLoftEditor(ui.gui, {
     // Editing the loft makes it the solid shown; a problem found before solving shows as the server's would.

@@ -59,10 +59,12 @@ static inline void fuzz_check_text(const char *s, size_t n, int may_be_empty)
                    (unsigned char)s[i], s);
 }
 
-/* An api_error as a parser or the solver left it: a 4xx status, a JSON pointer ("" or "/..."), a sentence. */
+/* An api_error as a parser or the solver left it: the client's fault (not JSON, over a limit, a bad document),
+ * a JSON pointer ("" or "/..."), a sentence. */
 static inline void fuzz_check_error(const api_error *err)
 {
-    FUZZ_CHECK(err->status == 400 || err->status == 413 || err->status == 422, "status %d", err->status);
+    FUZZ_CHECK(err->status == API_ERR_NOT_JSON || err->status == API_ERR_LIMIT || err->status == API_ERR_DOCUMENT,
+               "status %d", (int)err->status);
     fuzz_check_text(err->pointer, sizeof err->pointer, 1);
     FUZZ_CHECK(err->pointer[0] == '\0' || err->pointer[0] == '/', "pointer \"%s\"", err->pointer);
     fuzz_check_text(err->message, sizeof err->message, 0);

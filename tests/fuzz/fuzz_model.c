@@ -65,10 +65,10 @@ static int stop_after(void *arg)
     return *left >= 0 && (*left)-- == 0;
 }
 
-/* A refusal, or a cancelled call: status API_STATUS_CANCELLED and nothing made. */
+/* A refusal, or a cancelled call: status API_ERR_CANCELLED and nothing made. */
 static void check_refusal(const api_error *err, int may_cancel)
 {
-    if (may_cancel && err->status == API_STATUS_CANCELLED)
+    if (may_cancel && err->status == API_ERR_CANCELLED)
         FUZZ_CHECK(!strcmp(err->message, "cancelled"), "cancelled with \"%s\"", err->message);
     else
         fuzz_check_error(err);

@@ -132,6 +132,17 @@ await check('a download gives the solid as a file', async () => {
   if (head !== 'glTF') throw new Error(`the download ${dl.suggestedFilename()} is not a GLB`);
 });
 
+await check('the download menu is GET /formats: one entry per row, each file named with its extension', async () => {
+  const formats = await (await fetch(`${base}/formats`)).json();
+  const entries = page.locator('.lil-title', { hasText: 'Download' }).locator('xpath=..').locator('.lil-controller');
+  if ((await entries.count()) !== formats.length) throw new Error(`${await entries.count()} entries, ${formats.length} formats`);
+  const grid = formats.find((f) => f.name === 'grid');
+  const [dl] = await Promise.all([page.waitForEvent('download'), entries.filter({ hasText: `(${grid.name})` }).locator('button').click()]);
+  if (!dl.suggestedFilename().endsWith(grid.extension)) throw new Error(`${dl.suggestedFilename()} does not end with ${grid.extension}`);
+  const body = JSON.parse(await (await import('node:fs')).promises.readFile(await dl.path(), 'utf8'));
+  if (body.resolution?.[0] !== grid.default_res) throw new Error(`the grid's resolution ${body.resolution}, not ${grid.default_res}`);
+});
+
 await check('isoparametric lines and slices draw', async () => {
   const before = await snapshot();
   await page.locator('[data-view="skin"] input').uncheck();
