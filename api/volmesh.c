@@ -620,7 +620,7 @@ static int vtu_step(const api_volmesh *m, const pde_props *props, api_volmesh_cu
         uint64_t h = vtu_bytes(m, blk);
         addb(b, &h, 8);
     }
-    for (size_t end = c->k + 4096 < n ? c->k + 4096 : n; c->k < end; c->k++) {
+    for (size_t end = c->k + 512 < n ? c->k + 512 : n; c->k < end; c->k++) {   /* at most 32 KB */
         size_t k = c->k;
         switch (blk) {
         case V_DETJ: addb(b, m->detj + k, 4); break;

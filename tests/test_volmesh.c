@@ -338,6 +338,46 @@ static void files_should_read_back_in_meshio(void **state)
     }
 }
 
+typedef struct {
+    size_t total, pieces, largest;
+} count_ctx;
+
+static int put_count(void *ctx, const void *p, size_t n)
+{
+    (void)p;
+    count_ctx *c = ctx;
+    c->total += n, c->pieces++;
+    c->largest = n > c->largest ? n : c->largest;
+    return 0;
+}
+
+/* A 40^3 fig1a: the vtu's size is its header plus the appended blocks, each with its 8-byte length; the
+ * pieces stay near 1 MB. */
+static void large_files_should_stream_in_pieces_of_about_a_megabyte(void **state)
+{
+    (void)state;
+    pde_solution *s = preset_solution("fig1a");
+    api_volmesh m;
+    build(s, 40, 40, 40, &m);
+    for (int vtu = 0; vtu < 2; vtu++) {
+        count_ctx cc = { 0, 0, 0 };
+        api_volmesh_cursor c = { 0, 0 };
+        int r;
+        while ((r = vtu ? api_volmesh_vtu_piece(&m, NULL, &c, put_count, &cc)
+                        : api_volmesh_msh_piece(&m, NULL, &c, put_count, &cc)) == 0)
+            ;
+        assert_int_equal(r, 1);
+        assert_true(cc.pieces > 2);
+        assert_true(cc.largest <= (1u << 20) + 65536);
+        if (vtu) {
+            size_t blocks = 7 * 8 + m.npoints * (4 + 24) + m.ncells * (1 + 4 + 8 * 8 + 8 + 1);
+            assert_true(cc.total > blocks && cc.total < blocks + 4096);
+        }
+    }
+    api_volmesh_free(&m);
+    pde_solution_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -348,6 +388,7 @@ int main(void)
         cmocka_unit_test(res_should_be_bounded),
         cmocka_unit_test(a_cancelled_build_should_say_so),
         cmocka_unit_test(files_should_read_back_in_meshio),
+        cmocka_unit_test(large_files_should_stream_in_pieces_of_about_a_megabyte),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
