@@ -14,6 +14,11 @@
  *       ;                                  // r == 1: done, r == -1: put failed
  *   api_volmesh_free(&m);
  *
+ * api_volmesh_build reads the solution only and the writers read the mesh only (const): any number
+ * may run at once on different threads. On failure build frees what it made, fills err (422 for a bad
+ * res, 503 "cancelled" when cancel stopped it) and leaves *out untouched. api_volmesh_free accepts a
+ * zeroed mesh and NULL. Writers cannot fail but through put; props NULL writes no metadata.
+ *
  * CHOICES
  * - Samples u_i = i / (res[0] - 1) (likewise v, w), evaluated with pde_eval_d.
  * - Merging uses the grid, not a spatial hash: on each face of the cube, along
