@@ -46,7 +46,7 @@ FUZZ_REPLAYS := $(patsubst %,build/san/fuzz/%,$(FUZZ_NAMES))
 FUZZ_LIB_SRC := $(filter-out server/main.c,$(SRV_SRC)) $(API_SRC) $(CORE_SRC) tests/support.c
 fuzzobj = $(patsubst %.c,build/fuzz/obj/%.o,$(1))
 
-.PHONY: all test check fuzz bench clean deps run tsan install uninstall
+.PHONY: all test check fuzz bench clean deps run tsan install uninstall cluster cluster-stop
 all: build/pdesolid build/pdesolidd
 
 # Installs missing Debian and npm packages (a no-op when all are there).
@@ -197,6 +197,14 @@ bench: $(BENCHES) build/pdesolidd build/bench/mhd_minimal
 
 clean:
 	rm -rf build
+
+# ---- A cluster on this machine (deploy/cluster.sh): Redis, three replicas, nginx on 127.0.0.1:8088
+# (CLUSTER_PORT=N to change); state, logs and pid files in build/cluster/. `make cluster-stop` ends it.
+cluster: all
+	@CLUSTER_PORT=$(or $(CLUSTER_PORT),8088) bash deploy/cluster.sh start
+
+cluster-stop:
+	@CLUSTER_PORT=$(or $(CLUSTER_PORT),8088) bash deploy/cluster.sh stop
 
 # ---- `make install [PREFIX=/usr/local] [DESTDIR=]`: the programs, the front-end, the manual pages and
 # the systemd unit (deploy/README.md). The front-end's files are the file column of server/static.c's
