@@ -1214,7 +1214,16 @@ pde_solution *preset_solution(const char *name)
 static size_t on_body(char *p, size_t size, size_t n, void *cls)
 {
     http_reply *r = cls;
-    r->body = realloc(r->body, r->len + size * n + 1);
+    if (r->len + size * n + 1 > r->cap) {
+        size_t cap = r->cap ? r->cap : 16384;
+        while (cap < r->len + size * n + 1)
+            cap *= 2;
+        char *b = realloc(r->body, cap);
+        if (!b)
+            return 0;   /* libcurl ends the transfer with CURLE_WRITE_ERROR */
+        r->body = b;
+        r->cap = cap;
+    }
     memcpy(r->body + r->len, p, size * n);
     r->len += size * n;
     r->body[r->len] = '\0';

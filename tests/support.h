@@ -171,6 +171,7 @@ typedef struct {
     long status;          /* the HTTP status, or -CURLcode when the exchange failed */
     char *body;           /* NUL-terminated (never NULL), len bytes; the caller frees it */
     size_t len;
+    size_t cap;           /* bytes allocated for body (grown geometrically, so a 20 MB body is read in linear time) */
     char headers[4096];   /* the status line and header lines as received, cut at 4095 bytes */
 } http_reply;
 
