@@ -199,12 +199,17 @@ clean:
 	rm -rf build
 
 # ---- A cluster on this machine (deploy/cluster.sh): Redis, three replicas, nginx on 127.0.0.1:8088
-# (CLUSTER_PORT=N to change); state, logs and pid files in build/cluster/. `make cluster-stop` ends it.
-cluster: all
-	@CLUSTER_PORT=$(or $(CLUSTER_PORT),8088) bash deploy/cluster.sh start
+# (CLUSTER_PORT=N to change); state, logs and pid files in build/cluster/ (CLUSTER_DIR=DIR). The
+# replicas run CLUSTER_DAEMON: build/pdesolidd, or build/san/pdesolidd (tests/test_cluster.c).
+# `make cluster` again restarts whatever died; `make cluster-stop` ends it.
+CLUSTER_DAEMON ?= build/pdesolidd
+CLUSTER_ENV = CLUSTER_PORT=$(or $(CLUSTER_PORT),8088) CLUSTER_DIR=$(or $(CLUSTER_DIR),build/cluster) \
+              CLUSTER_REPLICAS=$(or $(CLUSTER_REPLICAS),3) PDESOLIDD=$(CLUSTER_DAEMON)
+cluster: $(CLUSTER_DAEMON)
+	@$(CLUSTER_ENV) bash deploy/cluster.sh start
 
 cluster-stop:
-	@CLUSTER_PORT=$(or $(CLUSTER_PORT),8088) bash deploy/cluster.sh stop
+	@$(CLUSTER_ENV) bash deploy/cluster.sh stop
 
 # ---- `make install [PREFIX=/usr/local] [DESTDIR=]`: the programs, the front-end, the manual pages and
 # the systemd unit (deploy/README.md). The front-end's files are the file column of server/static.c's
