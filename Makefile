@@ -194,6 +194,7 @@ bench: $(BENCHES) build/pdesolidd build/bench/mhd_minimal
 	@bash bench/bench_413.sh
 	@bash bench/bench_shutdown.sh
 	@bash bench/bench_props_latency.sh
+	@bash bench/bench_cluster.sh
 
 clean:
 	rm -rf build
