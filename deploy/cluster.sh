@@ -195,8 +195,9 @@ start)
     ;;
 stop)
     stop_pid "$DIR/nginx.pid" QUIT 10
-    # Every replica with a pid file, however many this start was asked for.
-    for f in "$DIR"/pdesolidd-*.pid; do stop_pid "$f" TERM 35; done
+    # Every replica with a pid file, however many this start was asked for, all at once.
+    for f in "$DIR"/pdesolidd-*.pid; do stop_pid "$f" TERM 35 & done
+    wait
     stop_pid "$DIR/redis.pid" TERM 10    # Redis flushes its AOF on SIGTERM
     say "stopped"
     ;;

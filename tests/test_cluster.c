@@ -222,10 +222,10 @@ static void need_cluster(void)
 
 /* ---- the cases ---- */
 
-static void a_solve_through_nginx_should_be_found_on_every_replica(void **state)
+/* The first case: a solve through nginx, then its id from every replica (which then holds it). The
+ * other cases use that id, and make it themselves when run alone (make check F=...). */
+static void solve_first(void)
 {
-    (void)state;
-    need_cluster();
     const char *request = "{\"preset\":\"fig4a\",\"params\":{\"p0\":41000}}";
     first_doc = solve(front, request, first_id);
     add_id(first_id);
@@ -236,6 +236,13 @@ static void a_solve_through_nginx_should_be_found_on_every_replica(void **state)
         assert_string_equal(r.body, request);
         free(r.body);
     }
+}
+
+static void a_solve_through_nginx_should_be_found_on_every_replica(void **state)
+{
+    (void)state;
+    need_cluster();
+    solve_first();
 }
 
 typedef struct {
@@ -291,6 +298,8 @@ static void a_replica_killed_under_load_should_cost_no_request(void **state)
 {
     (void)state;
     need_cluster();
+    if (!first_doc)
+        solve_first();
     char name[32];
     snprintf(name, sizeof name, "pdesolidd-%d", VICTIM);
     int victim = pid_of(name);
@@ -352,6 +361,8 @@ static void replicas_should_serve_what_they_hold_while_redis_is_down_and_recover
 {
     (void)state;
     need_cluster();
+    if (!first_doc)
+        solve_first();
     char id[33], late[33];
     char *doc = solve(front, "{\"preset\":\"fig4b\"}", id);   /* in Redis, and in one replica's memory */
     add_id(id);
@@ -400,6 +411,8 @@ static void every_id_should_resolve_after_cluster_stop_and_start(void **state)
 {
     (void)state;
     need_cluster();
+    if (!first_doc)
+        solve_first();
     make_or_fail("cluster-stop");
     for (int i = 0; i <= REPLICAS + 1; i++) {
         int fd = raw_dial(port + i);
@@ -409,7 +422,7 @@ static void every_id_should_resolve_after_cluster_stop_and_start(void **state)
     }
     make_or_fail("cluster");
     int n = atomic_load(&nids);
-    assert_true(n > LOAD / 3 / 2);   /* the load's solves, and the cases' */
+    assert_true(n >= 1);   /* the load's solves and the cases' (only the first when run alone) */
     /* The replicas start empty: each id comes from Redis's AOF. The first on every replica, the others
      * spread over them (as f32: a re-solve without the properties), and every tenth through nginx too. */
     for (int k = 1; k <= REPLICAS; k++)
