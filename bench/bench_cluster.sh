@@ -23,7 +23,7 @@ cluster() {   # start|stop replicas
     CLUSTER_DIR=$DIR CLUSTER_PORT=$PORT CLUSTER_REPLICAS=$2 CLUSTER_RATE=1000000 PDESOLIDD=build/pdesolidd \
         bash deploy/cluster.sh "$1" 2>/dev/null
 }
-trap 'cluster stop 3; rm -rf "$TMP"' EXIT
+trap 'cluster stop 3 || true; rm -rf "$TMP"' EXIT
 U=http://127.0.0.1:$PORT
 
 # The uncached loads: a new p0 each request, random per wrk thread and run, so no two bodies meet.
@@ -105,7 +105,7 @@ REDIS_PORT=$((PORT + 1)) build/bench/bench_store
 # What a new id's put costs: one daemon, no nginx, uncached f32 solves (wrk straight to it) with each
 # store: none, this cluster's Redis, and LMDB in $TMP (a put is a synchronous, fsynced commit).
 D=""
-trap 'kill $D 2>/dev/null; cluster stop 3; rm -rf "$TMP"' EXIT
+trap 'kill $D 2>/dev/null || true; cluster stop 3 || true; rm -rf "$TMP"' EXIT
 echo "one daemon, uncached f32 (POST /solve?format=f32&res=2, a new p0 each), wrk -t2 -c$CONNS -d$DUR, $RUNS rounds, medians:"
 for store in none "redis://127.0.0.1:$((PORT + 1))/8" "$TMP/lmdb"; do
     build/pdesolidd --port $((PORT + 10)) --quiet --store "$store" 2>/dev/null & D=$!

@@ -16,6 +16,7 @@
 #                     same checkout (tests/test_cluster.c) needs a directory and ports of its own
 #   CLUSTER_REPLICAS  how many replicas [3] (bench/bench_cluster.sh runs 1 and 3)
 #   PDESOLIDD         the daemon [build/pdesolidd]; the tests give build/san/pdesolidd
+#   CLUSTER_RATE      nginx's requests a second per address [1000]
 #
 # start starts what is not running and leaves the rest alone, so after a replica or Redis dies,
 # `make cluster` again brings it back. stop stops every process that has a pid file here.
