@@ -7,11 +7,13 @@
  * order on the same cluster:
  *  - a solve through nginx is found on every replica directly;
  *  - one replica SIGKILLed in the middle of 2,000 requests through nginx
- *    costs none of them, and `make cluster` brings it back;
+ *    costs none of them, and `make cluster` brings it back, also while the
+ *    killed process is still a zombie (the test is the cluster's subreaper);
  *  - with Redis stopped, the replicas answer the ids they hold and say
  *    "degraded" on /readyz; with Redis started again, they recover;
  *  - after `make cluster-stop` and `make cluster`, every id resolves.
- * The group's teardown runs `make cluster-stop` whatever happened (and so
+ * A case run alone (make check T=test_cluster F=...) makes the first case's
+ * id itself. The group's teardown runs `make cluster-stop` whatever happened (and so
  * does SIGINT or SIGTERM), then fails the run if a replica's log holds a
  * sanitiser's report. Skipped when nginx or redis-server is absent
  * (.ci/deps installs both).
