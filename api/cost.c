@@ -328,7 +328,7 @@ void api_cost_output(const pde_solution *sol, api_format f, const unsigned res[3
         mesh_cost(st, res, c);
         double nraw = 2.0 * (nv * nw + nu * nw + nu * nv);
         double ntri = 4.0 * ((nv - 1) * (nw - 1) + (nu - 1) * (nw - 1) + (nu - 1) * (nv - 1));
-        double blob = 24.0 * nraw + 12.0 * ntri;
+        double blob = 28.0 * nraw + 12.0 * ntri;
         if (f == API_FMT_STL)
             c->work += K_STL * ntri;
         else

@@ -696,8 +696,8 @@ static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
         o->size = 84 + 50LL * (long long)nt;
         return 0;
     }
-    /* The blob: positions, normals, indices; each a multiple of 4 bytes. */
-    o->blob_len = 24 * nv + 12 * nt;
+    /* The blob: positions, normals, det J, indices; each a multiple of 4 bytes. */
+    o->blob_len = 28 * nv + 12 * nt;
     o->blob = malloc(o->blob_len);
     if (!o->blob)
         return -1;
@@ -709,7 +709,8 @@ static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
         bp[3 * i] = p[0], bp[3 * i + 1] = p[2], bp[3 * i + 2] = -p[1];
         bn[3 * i] = q[0], bn[3 * i + 1] = q[2], bn[3 * i + 2] = -q[1];
     }
-    memcpy(o->blob + 24 * nv, o->mesh.tri, 12 * nt);
+    memcpy(o->blob + 24 * nv, o->mesh.detj, 4 * nv);
+    memcpy(o->blob + 28 * nv, o->mesh.tri, 12 * nt);
     const pde_props *props = props_of(o, cancel, err);
     if (!props)
         return -1;
@@ -732,15 +733,17 @@ static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
         "{\"asset\":{\"version\":\"2.0\",\"generator\":\"pdesolid\",\"extras\":{\"id\":\"%s\",\"units\":\"metres\","
         "\"up\":\"+Y; glTF (X, Y, Z) = the model's (x, z, -y)\",\"properties\":%s}},"
         "\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"name\":\"solid\"}],"
-        "\"meshes\":[{\"name\":\"skin\",\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2,\"mode\":4}]}],"
+        "\"meshes\":[{\"name\":\"skin\",\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"_DETJ\":3},\"indices\":2,\"mode\":4}]}],"
         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\",%s},"
         "{\"bufferView\":1,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\"},"
-        "{\"bufferView\":2,\"componentType\":5125,\"count\":%zu,\"type\":\"SCALAR\"}],"
+        "{\"bufferView\":2,\"componentType\":5125,\"count\":%zu,\"type\":\"SCALAR\"},"
+        "{\"bufferView\":3,\"componentType\":5126,\"count\":%zu,\"type\":\"SCALAR\"}],"
         "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":%zu,\"target\":34962},"
         "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"target\":34962},"
-        "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"target\":34963}],"
+        "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"target\":34963},"
+        "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"target\":34962}],"
         "\"buffers\":[{\"byteLength\":%zu%s",
-        o->id, pj, nv, mm, nv, 3 * nt, 12 * nv, 12 * nv, 12 * nv, 24 * nv, 12 * nt, o->blob_len,
+        o->id, pj, nv, mm, nv, 3 * nt, nv, 12 * nv, 12 * nv, 12 * nv, 28 * nv, 12 * nt, 24 * nv, 4 * nv, o->blob_len,
         gltf ? ",\"uri\":\"data:application/octet-stream;base64," : "}]}");
     free(pj);
     if (n < 0 || (size_t)n >= cap)

@@ -439,6 +439,43 @@ static void gltf_should_stand_the_height_along_plus_y(void **state)
     pde_solution_free(sol);
 }
 
+/* The GLB's _DETJ attribute is the skin's det J (api_mesh.detj), vertex for vertex: a float SCALAR the
+ * front-end colours folds by. */
+static void glb_should_carry_det_j_as_the_detj_attribute(void **state)
+{
+    (void)state;
+    pde_solution *sol = solve_preset("fig4a", NULL);
+    const unsigned res[3] = { 20, 20, 20 };
+    api_mesh m;
+    assert_int_equal(api_mesh_build(sol, res, NULL, &m, NULL), 0);
+    size_t len;
+    unsigned char *glb = render(sol, NULL, API_FMT_GLB, res, &len);
+    uint32_t jlen;
+    memcpy(&jlen, glb + 12, 4);
+    cJSON *g = cJSON_ParseWithLength((const char *)glb + 20, jlen);
+    const cJSON *prim = cJSON_GetArrayItem(cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(g, "meshes"), 0),
+                                                                "primitives"), 0);
+    const cJSON *at = cJSON_GetObjectItem(cJSON_GetObjectItem(prim, "attributes"), "_DETJ");
+    assert_non_null(at);
+    const cJSON *acc = cJSON_GetArrayItem(cJSON_GetObjectItem(g, "accessors"), at->valueint);
+    assert_int_equal(cJSON_GetObjectItem(acc, "componentType")->valueint, 5126);
+    assert_string_equal(cJSON_GetObjectItem(acc, "type")->valuestring, "SCALAR");
+    assert_int_equal(cJSON_GetObjectItem(acc, "count")->valueint, (int)m.nverts);
+    const cJSON *view = cJSON_GetArrayItem(cJSON_GetObjectItem(g, "bufferViews"),
+                                           cJSON_GetObjectItem(acc, "bufferView")->valueint);
+    size_t off = (size_t)cJSON_GetObjectItem(view, "byteOffset")->valuedouble;
+    assert_int_equal((size_t)cJSON_GetObjectItem(view, "byteLength")->valuedouble, 4 * m.nverts);
+    assert_memory_equal(glb + 20 + jlen + 8 + off, m.detj, 4 * m.nverts);
+    int negative = 0;
+    for (size_t i = 0; i < m.nverts; i++)
+        negative += m.detj[i] < 0;
+    assert_true(negative > 0);     /* fig4a folds */
+    cJSON_Delete(g);
+    free(glb);
+    api_mesh_free(&m);
+    pde_solution_free(sol);
+}
+
 static void grid_json_should_read_back_as_the_f32_output(void **state)
 {
     (void)state;
@@ -802,6 +839,7 @@ int main(void)
         cmocka_unit_test(every_preset_should_give_gltf_and_glb_that_the_khronos_validator_passes),
         cmocka_unit_test(gltf_should_carry_the_id_properties_and_exact_bounds),
         cmocka_unit_test(gltf_should_stand_the_height_along_plus_y),
+        cmocka_unit_test(glb_should_carry_det_j_as_the_detj_attribute),
         cmocka_unit_test(grid_json_should_read_back_as_the_f32_output),
         cmocka_unit_test(stl_skin_should_be_closed_and_enclose_the_computed_volume),
         cmocka_unit_test(every_skin_should_be_closed_with_normals_and_det_j_from_the_closed_form),
