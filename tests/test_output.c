@@ -348,7 +348,7 @@ static void every_preset_should_give_gltf_and_glb_that_the_khronos_validator_pas
         pde_solution *sol = solve_preset(name, id);
         for (int g = 0; g < 4; g++) {   /* gltf, glb, and each compressed */
             size_t len;
-            unsigned char *bytes = render_opts(sol, id, NULL, g % 2 ? API_FMT_GLB : API_FMT_GLTF, res, NULL,
+            unsigned char *bytes = render_opts(sol, id, NULL, g % 2 ? API_FMT_GLB : API_FMT_GLTF, res,
                                                g / 2 ? &meshopt : NULL, &len);
             char path[128];
             snprintf(path, sizeof path, "%s/%s%s.%s", dir, name, g / 2 ? "-meshopt" : "", g % 2 ? "glb" : "gltf");
