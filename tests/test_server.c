@@ -707,7 +707,7 @@ static void compress_should_be_checked_like_every_query_parameter(void **state)
     assert_int_equal(plain.status, 200);
     assert_int_equal(small.status, 200);
     assert_true(small.len * 4 <= plain.len);
-    assert_non_null(memmem(small.body, small.len, "EXT_meshopt_compression", 23));
+    assert_non_null(strstr(small.body + 20, "EXT_meshopt_compression"));   /* in the JSON chunk, before any NUL */
     char e1[128], e2[128];
     assert_true(header_value(&plain, "ETag", e1, sizeof e1) && header_value(&small, "ETag", e2, sizeof e2));
     assert_string_not_equal(e1, e2);
