@@ -30,6 +30,9 @@
  *   while ((n = api_output_read(o, buf, sizeof buf)) > 0) fwrite(buf, 1, n, f);
  *   api_output_free(o);
  *
+ *   api_output_opts opts = { .compress = API_COMPRESS_MESHOPT };   // gltf, glb only
+ *   o = api_output_open_ex(sol, id, NULL, API_FMT_GLB, res, &opts, NULL, &err);
+ *
  * The output reads the solution, which must outlive it. Outputs are
  * independent of one another and may be read on different threads.
  */
@@ -119,9 +122,10 @@ long long api_output_size(const api_output *o);
  * Up to max bytes into buf; returns the count, 0 at the end, or -1 out of
  * memory. Each call does at most one bounded piece of work, so a server can
  * poll a deadline between calls: up to 16384 sampled points and about 2^21
- * multiply-adds of sampling (at least one row), 4096 STL triangles, 48 KB of
- * base64 or 1 MB of copying. It may return fewer than max bytes before the
- * end; read until it returns 0.
+ * multiply-adds of sampling (at least one row), 4096 STL triangles or OBJ
+ * lines, 16384 PLY vertices or faces, about 1 MB of a volume mesh (msh, vtu),
+ * 48 KB of base64 or 1 MB of copying. It may return fewer than max bytes
+ * before the end; read until it returns 0.
  */
 long api_output_read(api_output *o, char *buf, size_t max);
 void api_output_free(api_output *o);

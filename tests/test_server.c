@@ -484,7 +484,7 @@ static void bad_requests_should_get_problems_and_the_daemon_should_keep_serving(
     r = post(&d, "/solve?res=100000", "{\"preset\":\"fig4a\"}");
     expect_problem(&r, 422, NULL, "limit of 4096");
     free(r.body);
-    r = post(&d, "/solve?format=obj", "{\"preset\":\"fig4a\"}");
+    r = post(&d, "/solve?format=dae", "{\"preset\":\"fig4a\"}");
     expect_problem(&r, 422, NULL, "is not a format");
     free(r.body);
     char *deep = malloc(5001);
