@@ -377,8 +377,9 @@ void api_cost_volmesh(const pde_solution *sol, const unsigned res[3], double tex
     /* Every point through pde_eval_d (with its derivatives, for det J), each cell's centre too;
      * then the text: about K_FMT_F32 a number printed. */
     c->work = (n + cells) * point_cost(st) + K_FMT_F32 * text_point / 8.0 * n + 50.0 * cells;
-    /* Points (24 + 4), cells (32 + 4 + 2), the faces' quads, a piece of text. */
-    c->bytes = 28.0 * n + 38.0 * cells + 16.0 * 2.0 * (n / fmax(1.0, res[0])) + (2 << 20);
+    /* Points (24 + 4), cells (32 + 4 + 2), the faces' quads; a writer's piece of text (about 1 MB) and the
+     * output's buffer holding it (bench_cost: fig4a at 33^3 peaks at 5.5 MB). */
+    c->bytes = 28.0 * n + 38.0 * cells + 16.0 * 2.0 * (n / fmax(1.0, res[0])) + (4 << 20);
 }
 
 void api_cost_json(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, api_cost *c)
