@@ -13,8 +13,10 @@ import { mountLoftEditor } from './loft.js';
 const RES_CHOICES = [16, 24, 32, 48, 64, 96, 128, 192, 256];
 // Automatic resolution (samplesFor): at least 8 samples per period, 2 per boundary-layer width 1/t,
 // never fewer than MIN_AUTO_RES, and the skin (about 6 n^2 vertices) within VERTEX_BUDGET.
-const MIN_AUTO_RES = 48, VERTEX_BUDGET = 400000;
+const MIN_AUTO_RES = 48, VERTEX_BUDGET = 225000;   // 192 per edge: within the default --max-mem-mb
 const MAX_AUTO_RES = Math.floor(Math.sqrt(VERTEX_BUDGET / 6) / 8) * 8;
+// Each vertex costs a sum over the modes: modes x vertices within WORK_BUDGET (a loft of 99 modes: 80 per edge).
+const WORK_BUDGET = 4e6;
 const NARROW = window.matchMedia('(max-width: 699px)');
 
 // ---- the scene ----
@@ -271,7 +273,7 @@ function schedule() {
 // sin/cos(k pi t) has k/2 periods on [0, 1]: 8 per period is 4k; exp, sinh, cosh(a t) and
 // h(w)'s exp(alpha w) have layers of width 1/|a|: 2 samples per width; t^n: 2n; h's beta: 8 per 2 pi.
 export function samplesFor(json) {
-  let need = 0;
+  let need = 0, modes = 0;
   const factor = (f) => {
     const [k, a] = Object.entries(f || {})[0] || ['pow', 0];
     if (k === 'sin' || k === 'cos') return 4 * Math.abs(+a);
@@ -279,12 +281,14 @@ export function samplesFor(json) {
     return 2 * Math.abs(+a);
   };
   for (const comp of Object.values(json.components || {})) for (const m of comp.modes || []) {
+    modes++;
     need = Math.max(need, factor(m.u), factor(m.v));
     for (const h of m.h || (m.slabs || []).flatMap((s) => s.h || []))
       need = Math.max(need, 8 * Math.abs(h.beta || 0) / (2 * Math.PI), 2 * Math.abs(h.alpha || 0));
   }
-  const n = Math.min(Math.max(Math.ceil(need / 8) * 8, MIN_AUTO_RES), MAX_AUTO_RES);
-  return { n, need: Math.ceil(need), capped: need > MAX_AUTO_RES };
+  const cap = Math.max(MIN_AUTO_RES, Math.min(MAX_AUTO_RES, Math.floor(Math.sqrt(WORK_BUDGET / (6 * Math.max(modes, 1))) / 8) * 8));
+  const n = Math.min(Math.max(Math.ceil(need / 8) * 8, MIN_AUTO_RES), cap);
+  return { n, need: Math.ceil(need), capped: need > cap };
 }
 
 async function fetchGlb(body, res, signal) {
@@ -323,6 +327,13 @@ async function solve({ fresh = false } = {}) {
         state.autoRes = res = want.n;
         resp = await fetchGlb(body, res, ctl.signal);
       }
+    }
+    // Over the server's budgets (--max-mem-mb, --max-work) at auto: fewer samples, down to MIN_AUTO_RES.
+    while (auto && (resp.status === 422 || resp.status === 503) && res > MIN_AUTO_RES &&
+           /--max-mem-mb|--max-work|--job-timeout/.test((await resp.clone().json().catch(() => ({}))).detail || '')) {
+      state.autoRes = res = Math.max(MIN_AUTO_RES, Math.floor(res * 0.75 / 8) * 8);
+      state.autoCapped = true;
+      resp = await fetchGlb(body, res, ctl.signal);
     }
   } catch (e) {
     if (e.name === 'AbortError') return;
@@ -426,7 +437,7 @@ function show(gltf, timing, roundTrip, res, body) {
 function updateResLabel() {
   const c = ui.resCtl;
   if (!c) return;
-  const label = `auto (${state.autoRes}${state.autoCapped ? `, capped: ${state.autoNeed} wanted` : ''})`;
+  const label = `auto (${state.autoRes}${state.autoCapped ? `; ${state.autoNeed} wanted` : ''})`;
   const i = c._values.indexOf('auto');   // (lil-gui keeps the options' order; the label is its name)
   c._names[i] = label;
   c.$select.options[i].textContent = label;
@@ -511,7 +522,7 @@ function updateLink() {
 }
 async function copyLink() {
   if (!state.id) return notice('Nothing to share yet: a solid has an id once it is solved.');
-  const id = state.id, r = await fetch(`/solids/${id}/request`, { method: 'HEAD' }).catch(() => null);
+  const id = state.id, r = await fetch(`/solids/${id}/request`).catch(() => null);
   if (!r || !r.ok) {
     return notice(r?.status === 404
       ? `This server keeps no record of ${id} (its store is off or evicted it): a link would not reopen it. Download the solid instead.`
@@ -627,7 +638,7 @@ function buildParamControls() {
       const v = state.params[p.name], f = state.figure?.[p.name] ?? v;
       const span = Math.max(Math.abs(f) * 10, Math.abs(v), /^n_|^xi$/.test(p.name) ? 40 : 5);
       const c = folder.add(state.params, p.name, Math.min(-span, v), Math.max(span, v))
-        .step(/^n_|^xi$/.test(p.name) ? 1 : span / 200)
+        .step(/^n_|^xi$/.test(p.name) ? 1 : 10 ** Math.floor(Math.log10(span / 1000)))   // lil-gui rounds typed values to it
         .onChange(changed);
       c.domElement.title = p.help;
       c.domElement.dataset.param = p.name;
