@@ -297,63 +297,109 @@ static void mesh_cost(const comp_stats st[3], const unsigned res[3], api_cost *c
     c->bytes = scratch + outb + g;
 }
 
+void api_cost_output_ex(const pde_solution *sol, api_format f, const unsigned res[3], const api_output_opts *opts,
+                        api_cost *c)
+{
+    static const api_output_opts none;
+    c->work = c->bytes = 0.0;
+    const api_format_info *fi = api_format_info_of(f);
+    if (fi)
+        fi->cost(sol, res, opts ? opts : &none, c);
+}
+
 void api_cost_output(const pde_solution *sol, api_format f, const unsigned res[3], api_cost *c)
+{
+    api_cost_output_ex(sol, f, res, NULL, c);
+}
+
+/* Rows per read: the chunk of fmt.c's api_rows (16384 points); the buffers hold them. */
+static double rows_chunk(const unsigned res[3])
+{
+    double nu = res ? res[0] : 0;
+    return nu > 0 ? fmax(1.0, floor(16384.0 / nu)) * nu : 0.0;
+}
+
+void api_cost_f32(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, api_cost *c)
+{
+    (void)opts;
+    comp_stats st[3];
+    stats_of(sol, st);
+    double nu = res[0], nv = res[1], nw = res[2], n = nu * nv * nw, chunk = rows_chunk(res);
+    c->work = sweep_work(st, nu, nv, nw, 1.0, 0) + K_PT_F32 * n;
+    c->bytes = grid_bytes(st, nu, nv) + 2.0 * 12.0 * chunk + 12.0 * chunk;
+}
+
+void api_cost_grid_json(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, api_cost *c)
+{
+    (void)opts;
+    comp_stats st[3];
+    stats_of(sol, st);
+    double nu = res[0], nv = res[1], nw = res[2], n = nu * nv * nw, chunk = rows_chunk(res);
+    /* Three passes, one per component, each sampling all three; every sample printed once. */
+    c->work = grid_create_work(st, nu, nv) + 3.0 * (nw * plane_work(st) + nw * nv * row_work(st, nu, nv, 1.0, 0)) +
+              K_FMT_F32 * 3.0 * n;
+    c->bytes = grid_bytes(st, nu, nv) + 12.0 * chunk + 2.0 * 17.0 * chunk;
+}
+
+void api_cost_vts(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, api_cost *c)
+{
+    (void)opts;
+    comp_stats st[3];
+    stats_of(sol, st);
+    double nu = res[0], nv = res[1], nw = res[2], n = nu * nv * nw, chunk = rows_chunk(res);
+    /* Positions, then positions and the three derivatives again for det J. */
+    c->work = grid_create_work(st, nu, nv) + nw * (2.0 * plane_work(st)) + nw * nv * row_work(st, nu, nv, 5.0, 0) +
+              (K_PT_F32 * 4.0 + K_DET) * n;
+    c->bytes = grid_bytes(st, nu, nv) + 4.0 * 12.0 * chunk + 2.0 * 12.0 * chunk;
+}
+
+void api_cost_skin(const pde_solution *sol, const unsigned res[3], double blob_vertex, double blob_tri,
+                   double work_byte, double out_tri, api_cost *c)
 {
     comp_stats st[3];
     stats_of(sol, st);
-    double nu = res ? res[0] : 0, nv = res ? res[1] : 0, nw = res ? res[2] : 0, n = nu * nv * nw;
-    c->work = c->bytes = 0.0;
-    /* Rows per read: CHUNK_POINTS of output.c; the buffers hold them (4 arrays for vts). */
-    double chunk = nu > 0 ? fmax(1.0, floor(16384.0 / nu)) * nu : 0.0;
-    switch (f) {
-    case API_FMT_F32:
-        c->work = sweep_work(st, nu, nv, nw, 1.0, 0) + K_PT_F32 * n;
-        c->bytes = grid_bytes(st, nu, nv) + 2.0 * 12.0 * chunk + 12.0 * chunk;
-        return;
-    case API_FMT_GRID:
-        /* Three passes, one per component, each sampling all three; every sample printed once. */
-        c->work = grid_create_work(st, nu, nv) + 3.0 * (nw * plane_work(st) + nw * nv * row_work(st, nu, nv, 1.0, 0)) +
-                  K_FMT_F32 * 3.0 * n;
-        c->bytes = grid_bytes(st, nu, nv) + 12.0 * chunk + 2.0 * 17.0 * chunk;
-        return;
-    case API_FMT_VTS:
-        /* Positions, then positions and the three derivatives again for det J. */
-        c->work = grid_create_work(st, nu, nv) + nw * (2.0 * plane_work(st)) + nw * nv * row_work(st, nu, nv, 5.0, 0) +
-                  (K_PT_F32 * 4.0 + K_DET) * n;
-        c->bytes = grid_bytes(st, nu, nv) + 4.0 * 12.0 * chunk + 2.0 * 12.0 * chunk;
-        return;
-    case API_FMT_GLTF:
-    case API_FMT_GLB:
-    case API_FMT_STL: {
-        mesh_cost(st, res, c);
-        double nraw = 2.0 * (nv * nw + nu * nw + nu * nv);
-        double ntri = 4.0 * ((nv - 1) * (nw - 1) + (nu - 1) * (nw - 1) + (nu - 1) * (nv - 1));
-        double blob = 24.0 * nraw + 12.0 * ntri;
-        if (f == API_FMT_STL)
-            c->work += K_STL * ntri;
-        else
-            c->work += (f == API_FMT_GLTF ? K_B64 * blob : 0.1 * blob) + K_TOUCH * blob;
-        /* After the build the mesh, the blob and a read buffer remain; the build's peak is larger. */
-        c->bytes = fmax(c->bytes, (nraw * 28.0 + ntri * 12.0) + (f == API_FMT_STL ? 0.0 : blob) + (2 << 20));
-        return;
+    double nu = res[0], nv = res[1], nw = res[2];
+    mesh_cost(st, res, c);
+    double nraw = 2.0 * (nv * nw + nu * nw + nu * nv);
+    double ntri = 4.0 * ((nv - 1) * (nw - 1) + (nu - 1) * (nw - 1) + (nu - 1) * (nv - 1));
+    double blob = blob_vertex * nraw + blob_tri * ntri;
+    c->work += work_byte * blob + K_TOUCH * blob + out_tri * ntri;
+    /* After the build the mesh, the blob and a read buffer remain; the build's peak is larger. */
+    c->bytes = fmax(c->bytes, (nraw * 28.0 + ntri * 12.0) + blob + (2 << 20));
+}
+
+void api_cost_volmesh(const pde_solution *sol, const unsigned res[3], double text_point, api_cost *c)
+{
+    double n = (double)res[0] * res[1] * res[2];
+    double cells = (double)(res[0] - 1) * (res[1] - 1) * (res[2] - 1);
+    comp_stats st[3];
+    stats_of(sol, st);
+    /* Every point through pde_eval_d (with its derivatives, for det J), each cell's centre too;
+     * then the text: about K_FMT_F32 a number printed. */
+    c->work = (n + cells) * point_cost(st) + K_FMT_F32 * text_point / 8.0 * n + 50.0 * cells;
+    /* Points (24 + 4), cells (32 + 4 + 2), the faces' quads, a piece of text. */
+    c->bytes = 28.0 * n + 38.0 * cells + 16.0 * 2.0 * (n / fmax(1.0, res[0])) + (2 << 20);
+}
+
+void api_cost_json(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, api_cost *c)
+{
+    (void)res;
+    (void)opts;
+    comp_stats st[3];
+    stats_of(sol, st);
+    /* A cJSON tree of every mode and coefficient, printed, and the closed form as text. */
+    double nodes = 0.0, nums = 0.0;
+    for (int i = 0; i < 3; i++) {
+        nodes += 8.0 * st[i].nm + 6.0 * st[i].wterms + st[i].coefs;
+        nums += st[i].nm + 3.0 * st[i].wterms + st[i].coefs;
     }
-    case API_FMT_JSON: {
-        /* A cJSON tree of every mode and coefficient, printed, and the closed form as text. */
-        double nodes = 0.0, nums = 0.0;
-        for (int i = 0; i < 3; i++) {
-            nodes += 8.0 * st[i].nm + 6.0 * st[i].wterms + st[i].coefs;
-            nums += st[i].nm + 3.0 * st[i].wterms + st[i].coefs;
-        }
-        c->work = K_JMODE * (st[0].nm + st[1].nm + st[2].nm) + K_JNODE * nodes + K_JNUM * nums + K_DESC * (st[0].coefs + st[1].coefs + st[2].coefs) / 2.0 +
-                  30000.0;
-        /* The tree and cJSON's doubling print buffer; then the text and its copy into the output's
-         * doubling buffer; the closed form's text (about 14 bytes a coefficient) beside them. */
-        double text = 24.0 * nums + 8.0 * nodes;
-        c->bytes = fmax(80.0 * nodes + 2.0 * text, 3.0 * text) +
-                   14.0 * (st[0].coefs + st[1].coefs + st[2].coefs) / 2.0 + 65536.0;
-        return;
-    }
-    }
+    c->work = K_JMODE * (st[0].nm + st[1].nm + st[2].nm) + K_JNODE * nodes + K_JNUM * nums +
+              K_DESC * (st[0].coefs + st[1].coefs + st[2].coefs) / 2.0 + 30000.0;
+    /* The tree and cJSON's doubling print buffer; then the text and its copy into the output's
+     * doubling buffer; the closed form's text (about 14 bytes a coefficient) beside them. */
+    double text = 24.0 * nums + 8.0 * nodes;
+    c->bytes = fmax(80.0 * nodes + 2.0 * text, 3.0 * text) + 14.0 * (st[0].coefs + st[1].coefs + st[2].coefs) / 2.0 +
+               65536.0;
 }
 
 /* ---- eval ---- */

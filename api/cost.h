@@ -34,7 +34,7 @@
 #include "output.h"
 #include "pde.h"
 
-typedef struct {
+typedef struct api_cost {
     double work;    /* units of about 1 ns of one core of the reference machine */
     double bytes;   /* peak scratch memory, in bytes */
 } api_cost;
@@ -49,8 +49,24 @@ void api_cost_loft(const pde_loft *l, api_cost *c);
 void api_cost_model(const api_model *m, api_cost *c);
 /* pde_properties() with the default options. */
 void api_cost_props(const pde_solution *sol, api_cost *c);
-/* api_output_open() and reading the whole output, excluding the properties (api_cost_props). */
+/* api_output_open() and reading the whole output, excluding the properties (api_cost_props): the
+ * format's own estimate (api_format_info.cost). */
 void api_cost_output(const pde_solution *sol, api_format f, const unsigned res[3], api_cost *c);
+/* The same with api_output_open_ex()'s options (NULL: the defaults). */
+void api_cost_output_ex(const pde_solution *sol, api_format f, const unsigned res[3], const api_output_opts *opts,
+                        api_cost *c);
+
+/* The estimates the formats' cost callbacks are made of (api/fmt_*.c). */
+void api_cost_json(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, api_cost *c);
+void api_cost_grid_json(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, api_cost *c);
+void api_cost_f32(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, api_cost *c);
+void api_cost_vts(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, api_cost *c);
+/* A skin written from a blob of blob_vertex bytes a vertex and blob_tri a triangle (0, 0: written from the
+ * mesh itself), at work_byte units a byte of output, and out_tri units a triangle. */
+void api_cost_skin(const pde_solution *sol, const unsigned res[3], double blob_vertex, double blob_tri,
+                   double work_byte, double out_tri, api_cost *c);
+/* A volume mesh (api/volmesh.h) of res points, written as text of about text_point bytes a point. */
+void api_cost_volmesh(const pde_solution *sol, const unsigned res[3], double text_point, api_cost *c);
 /* pde_eval_d() at npoints points and api_eval_json() of the answer (with derivatives or not). */
 void api_cost_eval(const pde_solution *sol, size_t npoints, int derivatives, api_cost *c);
 

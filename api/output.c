@@ -1,9 +1,10 @@
 /*
- * output.c: the formats of output.h, each as a little state machine that
- * refills a buffer with the next piece: a header, a chunk of rows, a run of
- * base64. Grids are sampled a few rows at a time, so a 256^3 f32 grid
- * (200 MB) streams through a buffer of about 1 MB; meshes are built whole
- * (their welding needs every face) and streamed from one binary blob.
+ * output.c: the stream of output.h over the format table. formats.def lists
+ * the formats; each api/fmt_*.c defines its entry (api/fmt.h). Here: the
+ * table and what reads it (names, resolutions, compression, GET /formats),
+ * the properties as JSON (shared by json, glTF's extras and the VTK files),
+ * eval answers, and api_output_open/read/free, which call the entry's
+ * open, fill and close.
  */
 #include <math.h>
 #include <stddef.h>
@@ -14,25 +15,17 @@
 
 #include <cJSON.h>
 
-#include "describe.h"
-#include "id.h"
-#include "mesh.h"
-#include "numfmt.h"
+#include "fmt.h"
 #include "output.h"
 
-/* One call of api_output_read() samples at most CHUNK_POINTS points, or rows worth about CHUNK_WORK
- * multiply-adds (about 1 ms), whichever is fewer, but at least one row. */
-#define CHUNK_POINTS 16384
-#define CHUNK_WORK (1u << 21)
+#define API_FORMAT(id, entry) extern const api_format_info entry;
+#include "formats.def"
+#undef API_FORMAT
 
-static const api_format_info formats[API_FMT_COUNT] = {
-    { "json", "application/json", ".json", 0, 1, 0 },
-    { "grid", "application/json", ".grid.json", 0, 0, 0 },
-    { "f32", "application/octet-stream", ".f32", 0, 0, 1 },
-    { "gltf", "model/gltf+json", ".gltf", 1, 1, 0 },
-    { "glb", "model/gltf-binary", ".glb", 1, 1, 1 },
-    { "vts", "application/xml", ".vts", 0, 1, 1 },   /* XML around raw appended float32 */
-    { "stl", "model/stl", ".stl", 1, 0, 1 },
+static const api_format_info *const formats[API_FMT_COUNT] = {
+#define API_FORMAT(id, entry) &entry,
+#include "formats.def"
+#undef API_FORMAT
 };
 
 char *api_formats_json(void)
@@ -40,13 +33,16 @@ char *api_formats_json(void)
     cJSON *a = cJSON_CreateArray();
     int ok = a != NULL;
     for (int i = 0; ok && i < API_FMT_COUNT; i++) {
-        const api_format_info *f = &formats[i];
+        const api_format_info *f = formats[i];
         cJSON *o = cJSON_CreateObject();
         ok = o && cJSON_AddItemToArray(a, o) && cJSON_AddStringToObject(o, "name", f->name) &&
              cJSON_AddStringToObject(o, "media_type", f->mime) && cJSON_AddStringToObject(o, "extension", f->ext) &&
              cJSON_AddBoolToObject(o, "binary", f->binary) && cJSON_AddBoolToObject(o, "mesh", f->mesh) &&
              cJSON_AddBoolToObject(o, "properties", f->props) &&
              cJSON_AddNumberToObject(o, "default_res", f->mesh ? API_RES_MESH_DEFAULT : API_RES_GRID_DEFAULT);
+        cJSON *c = ok ? cJSON_AddArrayToObject(o, "compress") : NULL;
+        ok = c && cJSON_AddItemToArray(c, cJSON_CreateString("none")) &&
+             (!f->compress || cJSON_AddItemToArray(c, cJSON_CreateString("meshopt")));
         if (!o)
             break;
     }
@@ -57,26 +53,56 @@ char *api_formats_json(void)
 
 const api_format_info *api_format_info_of(api_format f)
 {
-    return (unsigned)f < API_FMT_COUNT ? &formats[f] : NULL;
+    return (unsigned)f < API_FMT_COUNT ? formats[f] : NULL;
+}
+
+/* The names of the formats with flag set (every one when want is 0), "a, b, c", into list. */
+static void names(char *list, size_t size, int want)
+{
+    size_t n = 0;
+    list[0] = '\0';
+    for (int i = 0; i < API_FMT_COUNT && n < size; i++)
+        if (!want || formats[i]->compress)
+            n += (size_t)snprintf(list + n, size - n, "%s%s", n ? ", " : "", formats[i]->name);
 }
 
 int api_format_parse(const char *name, api_format *f, api_error *err)
 {
     for (int i = 0; i < API_FMT_COUNT; i++)
-        if (strcmp(formats[i].name, name) == 0) {
+        if (strcmp(formats[i]->name, name) == 0) {
             *f = (api_format)i;
             return 0;
         }
     char list[256];
-    size_t n = 0;
-    for (int i = 0; i < API_FMT_COUNT && n < sizeof list; i++)   /* the list from the table */
-        n += (size_t)snprintf(list + n, sizeof list - n, "%s%s", i ? ", " : "", formats[i].name);
+    names(list, sizeof list, 0);
     return api_fail(err, API_ERR_DOCUMENT, "", "format: \"%.40s\" is not a format; the formats are %s", name, list);
+}
+
+const char *api_compress_name(api_compress c)
+{
+    return c == API_COMPRESS_MESHOPT ? "meshopt" : "none";
+}
+
+int api_compress_parse(const char *text, api_format f, api_compress *c, api_error *err)
+{
+    *c = API_COMPRESS_NONE;
+    if (!text || !*text || !strcmp(text, "none"))
+        return 0;
+    if (strcmp(text, "meshopt"))
+        return api_fail(err, API_ERR_DOCUMENT, "", "compress: \"%.40s\" is not a compression; it is none or meshopt",
+                        text);
+    if (!formats[f]->compress) {
+        char list[128];
+        names(list, sizeof list, 1);
+        return api_fail(err, API_ERR_DOCUMENT, "", "compress: meshopt applies to %s, not to %s", list, formats[f]->name);
+    }
+    *c = API_COMPRESS_MESHOPT;
+    return 0;
 }
 
 int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *err)
 {
-    int mesh = formats[f].mesh;
+    int mesh = formats[f]->mesh;
     unsigned dflt = mesh ? API_RES_MESH_DEFAULT : API_RES_GRID_DEFAULT;
     unsigned max = mesh ? API_RES_MESH_MAX : API_RES_GRID_MAX;
     const char *what = mesh ? "samples per face edge" : "samples per axis";
@@ -106,7 +132,7 @@ int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *er
             return api_fail(err, API_ERR_DOCUMENT, "", "res: %llu is too few; at least 2 %s", v[i], what);
         if (v[i] > max)
             return api_fail(err, API_ERR_DOCUMENT, "", "res: %llu is more than the limit of %u %s for %s", v[i], max, what,
-                            formats[f].name);
+                            formats[f]->name);
         total *= v[i];
     }
     if (!mesh && total > API_RES_GRID_POINTS)
@@ -116,93 +142,7 @@ int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *er
     return 0;
 }
 
-struct api_output {
-    api_format fmt;
-    const pde_solution *sol;
-    char id[API_ID_LEN + 1];
-    unsigned res[3];
-    long long size;
-    char *buf;
-    size_t len, pos, cap;
-    int phase;
-    size_t c, k, j, chunk;
-    int first;
-    pde_grid *grid;
-    float *xyz, *xu, *xv, *xw;
-    api_mesh mesh;
-    unsigned char *blob;
-    size_t blob_len, blob_pos;
-    pde_props props;
-    int have_props;
-    char *text;           /* mesh formats: the JSON (glTF, GLB) */
-    size_t text_len, split;   /* gltf: the base64 goes at text[split] */
-};
-
-static int reserve(api_output *o, size_t n)
-{
-    if (o->cap - o->len >= n)
-        return 0;
-    size_t cap = o->cap ? o->cap : 4096;
-    while (cap - o->len < n)
-        cap *= 2;
-    char *b = realloc(o->buf, cap);
-    if (!b)
-        return -1;
-    o->buf = b;
-    o->cap = cap;
-    return 0;
-}
-
-static int put(api_output *o, const void *p, size_t n)
-{
-    if (reserve(o, n))
-        return -1;
-    memcpy(o->buf + o->len, p, n);
-    o->len += n;
-    return 0;
-}
-
-static int puts_(api_output *o, const char *s)
-{
-    return put(o, s, strlen(s));
-}
-
-static void le32(unsigned char *p, uint32_t v)
-{
-    for (int i = 0; i < 4; i++)
-        p[i] = (unsigned char)(v >> (8 * i));
-}
-
-static void le64(unsigned char *p, uint64_t v)
-{
-    for (int i = 0; i < 8; i++)
-        p[i] = (unsigned char)(v >> (8 * i));
-}
-
-/* n floats as little-endian bytes. */
-static int put_f32(api_output *o, const float *f, size_t n)
-{
-    if (reserve(o, 4 * n))
-        return -1;
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-    memcpy(o->buf + o->len, f, 4 * n);
-#else
-    for (size_t i = 0; i < n; i++) {
-        uint32_t u;
-        memcpy(&u, &f[i], 4);
-        le32((unsigned char *)o->buf + o->len + 4 * i, u);
-    }
-#endif
-    o->len += 4 * n;
-    return 0;
-}
-
-static double axis(size_t i, size_t n)
-{
-    return n > 1 ? (double)i / (double)(n - 1) : 0.5;
-}
-
-/* ---- the properties, and the json format ---- */
+/* ---- the properties ---- */
 
 /*
  * The properties, one row each: the object they sit in under "properties" (NULL: at its top), their
@@ -387,221 +327,15 @@ char *api_eval_json(const char *id, const double *values, const double *du, cons
     return buf;
 }
 
-static cJSON *numbers(const double *v, int n)
-{
-    cJSON *a = cJSON_CreateArray();
-    for (int i = 0; a && i < n; i++)
-        cJSON_AddItemToArray(a, cJSON_CreateNumber(v[i]));
-    return a;
-}
-
-/* -1 with err set to the cancellation of api_error (model.h). */
-static int cancelled(api_error *err)
-{
-    return api_fail(err, API_ERR_CANCELLED, "", "cancelled");
-}
-
-static int stopped(const pde_cancel *c)
-{
-    return c && c->stop && c->stop(c->arg);
-}
-
-/* The caller's properties, or computed now; NULL with err when cancelled, NULL alone otherwise. */
-static const pde_props *props_of(api_output *o, const pde_cancel *cancel, api_error *err)
-{
-    pde_props_opts opts = { .cancel = cancel };
-    if (!o->have_props) {
-        pde_status st = pde_properties(o->sol, &opts, &o->props);
-        if (st == PDE_ERR_CANCELLED)
-            cancelled(err);
-        if (st != PDE_OK)
-            return NULL;
-    }
-    o->have_props = 1;
-    return &o->props;
-}
-
-static int json_document(api_output *o, const pde_cancel *cancel, api_error *err)
-{
-    const pde_props *props = props_of(o, cancel, err);
-    if (!props)
-        return -1;
-    cJSON *root = cJSON_CreateObject(), *comps = cJSON_AddObjectToObject(root, "components");
-    if (o->id[0])
-        cJSON_AddStringToObject(root, "id", o->id);
-    static const char *const names[3] = { "x", "y", "z" };
-    for (int c = 0; comps && c < 3; c++) {
-        cJSON *comp = cJSON_AddObjectToObject(comps, names[c]), *modes = cJSON_AddArrayToObject(comp, "modes");
-        size_t nm;
-        const pde_mode *md = pde_solution_modes(o->sol, c, &nm);
-        for (size_t m = 0; modes && m < nm; m++) {
-            if (m % 64 == 63 && stopped(cancel)) {
-                cJSON_Delete(root);
-                return cancelled(err);
-            }
-            cJSON *mo = cJSON_CreateObject(), *terms;
-            cJSON_AddItemToArray(modes, mo);
-            cJSON_AddItemToObject(mo, "u", api_factor_tree(md[m].u));
-            cJSON_AddItemToObject(mo, "v", api_factor_tree(md[m].v));
-            cJSON_AddNumberToObject(mo, "e", md[m].e);
-            /* A loft's mode is piecewise: "slabs": [{"w": [w0, w1], "h": [...]}] instead of "h". */
-            cJSON *slabs = md[m].nslabs > 1 ? cJSON_AddArrayToObject(mo, "slabs") : NULL;
-            for (size_t sl = 0; sl < (slabs ? md[m].nslabs : 1); sl++) {
-                cJSON *holder = mo;
-                if (slabs) {
-                    holder = cJSON_CreateObject();
-                    cJSON_AddItemToArray(slabs, holder);
-                    cJSON_AddItemToObject(holder, "w", numbers(md[m].breaks + sl, 2));
-                }
-                if (!(terms = cJSON_AddArrayToObject(holder, "h")))
-                    continue;
-                size_t t0 = slabs ? md[m].first[sl] : 0, t1 = slabs ? md[m].first[sl + 1] : md[m].nterms;
-                for (size_t t = t0; t < t1; t++) {
-                    const pde_wterm *w = &md[m].terms[t];
-                    cJSON *to = cJSON_CreateObject();
-                    cJSON_AddItemToArray(terms, to);
-                    cJSON_AddNumberToObject(to, "alpha", w->alpha);
-                    cJSON_AddNumberToObject(to, "beta", w->beta);
-                    cJSON_AddNumberToObject(to, "shift", w->shift);
-                    cJSON_AddItemToObject(to, "A", numbers(w->A, w->deg + 1));
-                    cJSON_AddItemToObject(to, "B", numbers(w->B, w->deg + 1));
-                }
-            }
-        }
-    }
-    /* The closed form as text, as `pdesolid solve` prints it. */
-    char *text = NULL;
-    size_t tlen = 0;
-    FILE *f = open_memstream(&text, &tlen);
-    if (f) {
-        api_describe(f, o->sol, NULL);
-        fclose(f);
-        cJSON_AddStringToObject(root, "closed_form", text ? text : "");
-        free(text);
-    }
-    cJSON_AddItemToObject(root, "properties", props_tree(props));
-    char *s = cJSON_PrintUnformatted(root);
-    cJSON_Delete(root);
-    if (!s)
-        return -1;
-    int rc = puts_(o, s) || puts_(o, "\n");
-    free(s);
-    return rc ? -1 : 0;
-}
-
-/* ---- grids ---- */
-
-static int grid_open(api_output *o)
-{
-    size_t nu = o->res[0], nv = o->res[1];
-    double *us = malloc((nu + nv) * sizeof *us);
-    if (!us)
-        return -1;
-    for (size_t i = 0; i < nu; i++)
-        us[i] = axis(i, nu);
-    for (size_t j = 0; j < nv; j++)
-        us[nu + j] = axis(j, nv);
-    pde_status st = pde_grid_create(o->sol, us, nu, us + nu, nv, &o->grid);
-    free(us);
-    if (st != PDE_OK)
-        return -1;
-    /* A row costs about (3 + nu) multiply-adds per mode and component (nu per distinct u-factor). */
-    double row = 0.0;
-    for (int c = 0; c < 3; c++) {
-        size_t nm;
-        pde_solution_modes(o->sol, c, &nm);
-        row += (double)nm * (3.0 + (double)nu) * (o->fmt == API_FMT_VTS ? 4.0 : 1.0);
-    }
-    o->chunk = CHUNK_POINTS / nu;
-    if (row > 0 && (double)o->chunk * row > CHUNK_WORK)
-        o->chunk = (size_t)(CHUNK_WORK / row);
-    if (o->chunk == 0)
-        o->chunk = 1;
-    size_t n = 3 * nu * o->chunk;
-    o->xyz = malloc(n * sizeof(float));
-    if (o->fmt == API_FMT_VTS) {
-        o->xu = malloc(n * sizeof(float));
-        o->xv = malloc(n * sizeof(float));
-        o->xw = malloc(n * sizeof(float));
-        if (!o->xu || !o->xv || !o->xw)
-            return -1;
-    }
-    return o->xyz ? 0 : -1;
-}
-
-/* The next chunk of rows of plane k from row j; returns the number of points, advancing j and k. */
-static size_t next_rows(api_output *o, int derivs)
-{
-    size_t nu = o->res[0], nv = o->res[1], j1 = o->j + o->chunk < nv ? o->j + o->chunk : nv;
-    double w = axis(o->k, o->res[2]);
-    pde_grid_rows(o->grid, w, o->j, j1, o->xyz, derivs ? o->xu : NULL, derivs ? o->xv : NULL,
-                  derivs ? o->xw : NULL);
-    size_t n = nu * (j1 - o->j);
-    o->j = j1;
-    if (o->j == nv) {
-        o->j = 0;
-        o->k++;
-    }
-    return n;
-}
-
-static int fill_grid_json(api_output *o)
-{
-    static const char *const open[3] = { "],\"x\":[", "],\"y\":[", "],\"z\":[" };
-    if (o->phase == 0) {
-        char head[96];
-        snprintf(head, sizeof head, "{\"resolution\":[%u,%u,%u],\"x\":[", o->res[0], o->res[1], o->res[2]);
-        o->phase = 1;
-        o->first = 1;
-        return puts_(o, head);
-    }
-    if (o->phase == 2)
-        return 1;
-    if (o->k == o->res[2]) {
-        o->k = o->j = 0;
-        o->first = 1;
-        if (++o->c == 3) {
-            o->phase = 2;
-            return puts_(o, "]}\n");
-        }
-        return puts_(o, open[o->c]);
-    }
-    size_t n = next_rows(o, 0);
-    if (reserve(o, n * (API_F32_MAX + 1)))
-        return -1;
-    char *p = o->buf + o->len;
-    for (size_t i = 0; i < n; i++) {
-        if (!o->first)
-            *p++ = ',';
-        o->first = 0;
-        p += api_fmt_f32(p, o->xyz[3 * i + o->c]);
-    }
-    o->len = (size_t)(p - o->buf);
-    return 0;
-}
-
-static int fill_f32(api_output *o)
-{
-    if (o->k == o->res[2])
-        return 1;
-    size_t n = next_rows(o, 0);
-    return put_f32(o, o->xyz, 3 * n);
-}
-
-static long long points(const api_output *o)
-{
-    return (long long)o->res[0] * o->res[1] * o->res[2];
-}
-
 /* The properties as VTK field data, one array per row of prop_rows named group_name ("detJ_min_at"),
  * in ascii at 17 digits, so ParaView lists them with the dataset. */
-static int vts_field_data(api_output *o)
+int api_out_vtk_field_data(api_output *o, const pde_props *props)
 {
-    if (puts_(o, "    <FieldData>\n"))
+    if (api_out_puts(o, "    <FieldData>\n"))
         return -1;
     for (size_t i = 0; i < PROP_ROWS; i++) {
         const prop_row *r = &prop_rows[i];
-        const double *v = prop_at(&o->props, r);
+        const double *v = prop_at(props, r);
         int n = r->rows * r->cols;
         char line[1024], *p = line;
         p += sprintf(p, "      <DataArray type=\"%s\" Name=\"%s%s%s\" NumberOfComponents=\"%d\" NumberOfTuples=\"1\" "
@@ -612,281 +346,38 @@ static int vts_field_data(api_output *o)
         for (int k = 0; !r->flag && k < n; k++)
             p += sprintf(p, "%s%.17g", k ? " " : "", v[k]);
         p += sprintf(p, "</DataArray>\n");
-        if (put(o, line, (size_t)(p - line)))
+        if (api_out_put(o, line, (size_t)(p - line)))
             return -1;
     }
-    return puts_(o, "    </FieldData>\n");
-}
-
-static int vts_header(api_output *o)
-{
-    unsigned a = o->res[0] - 1, b = o->res[1] - 1, c = o->res[2] - 1;
-    char h[1024];
-    int n = snprintf(h, sizeof h,
-                     "<?xml version=\"1.0\"?>\n"
-                     "<!-- pdesolid: the solid %s, x(u,v,w) at u, v, w = i/(n-1); detJ = det d(x,y,z)/d(u,v,w); "
-                     "the field data are its properties (docs/API.md) -->\n"
-                     "<VTKFile type=\"StructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-                     "  <StructuredGrid WholeExtent=\"0 %u 0 %u 0 %u\">\n",
-                     o->id[0] ? o->id : "(no id)", a, b, c);
-    if (put(o, h, (size_t)n) || vts_field_data(o))
-        return -1;
-    n = snprintf(h, sizeof h,
-                 "    <Piece Extent=\"0 %u 0 %u 0 %u\">\n"
-                 "      <PointData Scalars=\"detJ\">\n"
-                 "        <DataArray type=\"Float32\" Name=\"detJ\" NumberOfComponents=\"1\" format=\"appended\" offset=\"%lld\"/>\n"
-                 "      </PointData>\n"
-                 "      <Points>\n"
-                 "        <DataArray type=\"Float32\" Name=\"Points\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/>\n"
-                 "      </Points>\n"
-                 "    </Piece>\n"
-                 "  </StructuredGrid>\n"
-                 "  <AppendedData encoding=\"raw\">\n   _",
-                 a, b, c, 8 + 12 * points(o));
-    return put(o, h, (size_t)n);
-}
-
-static const char vts_footer[] = "\n  </AppendedData>\n</VTKFile>\n";
-
-static int fill_vts(api_output *o)
-{
-    unsigned char len8[8];
-    switch (o->phase) {
-    case 0:
-        o->phase = 1;
-        le64(len8, (uint64_t)(12 * points(o)));
-        return vts_header(o) || put(o, len8, 8);
-    case 1:
-        if (o->k < o->res[2])
-            return put_f32(o, o->xyz, 3 * next_rows(o, 0));
-        o->k = o->j = 0;
-        o->phase = 2;
-        le64(len8, (uint64_t)(4 * points(o)));
-        return put(o, len8, 8);
-    case 2:
-        if (o->k < o->res[2]) {
-            size_t n = next_rows(o, 1);
-            for (size_t i = 0; i < n; i++) {
-                const float *a = o->xu + 3 * i, *b = o->xv + 3 * i, *c = o->xw + 3 * i;
-                double d = (double)a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) -
-                           (double)a[1] * ((double)b[0] * c[2] - (double)b[2] * c[0]) +
-                           (double)a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0]);
-                o->xyz[i] = (float)d;
-            }
-            return put_f32(o, o->xyz, n);
-        }
-        o->phase = 3;
-        return puts_(o, vts_footer);
-    }
-    return 1;
-}
-
-/* ---- meshes ---- */
-
-static int mesh_open(api_output *o, const pde_cancel *cancel, api_error *err)
-{
-    if (api_mesh_build(o->sol, o->res, cancel, &o->mesh, err))
-        return -1;
-    if (o->mesh.ntris == 0) {
-        api_fail(err, API_ERR_DOCUMENT, "", "the solid has no skin: every face collapses to a line or a point");
-        return -1;
-    }
-    size_t nv = o->mesh.nverts, nt = o->mesh.ntris;
-    if (o->fmt == API_FMT_STL) {
-        o->size = 84 + 50LL * (long long)nt;
-        return 0;
-    }
-    /* The blob: positions, normals, indices; each a multiple of 4 bytes. */
-    o->blob_len = 24 * nv + 12 * nt;
-    o->blob = malloc(o->blob_len);
-    if (!o->blob)
-        return -1;
-    /* glTF is +Y up: (X, Y, Z) = (x, z, -y), a rotation (x and the solid's handedness kept); the paper's
-     * height w, along z, stands along +Y. Negation is exact, so min and max stay the float32 values. */
-    float *bp = (float *)o->blob, *bn = bp + 3 * nv;
-    for (size_t i = 0; i < nv; i++) {
-        const float *p = o->mesh.pos + 3 * i, *q = o->mesh.nrm + 3 * i;
-        bp[3 * i] = p[0], bp[3 * i + 1] = p[2], bp[3 * i + 2] = -p[1];
-        bn[3 * i] = q[0], bn[3 * i + 1] = q[2], bn[3 * i + 2] = -q[1];
-    }
-    memcpy(o->blob + 24 * nv, o->mesh.tri, 12 * nt);
-    const pde_props *props = props_of(o, cancel, err);
-    if (!props)
-        return -1;
-    char *pj = api_props_json(props);
-    if (!pj)
-        return -1;
-    /* min and max as the exact float32 values (17 digits of the double they widen to). */
-    char mm[256];
-    snprintf(mm, sizeof mm, "\"min\":[%.17g,%.17g,%.17g],\"max\":[%.17g,%.17g,%.17g]", o->mesh.min[0],
-             o->mesh.min[2], -o->mesh.max[1], o->mesh.max[0], o->mesh.max[2], -o->mesh.min[1]);
-    int gltf = o->fmt == API_FMT_GLTF;
-    size_t cap = 2048 + strlen(pj);
-    o->text = malloc(cap);
-    if (!o->text) {
-        free(pj);
-        return -1;
-    }
-    int n = snprintf(
-        o->text, cap,
-        "{\"asset\":{\"version\":\"2.0\",\"generator\":\"pdesolid\",\"extras\":{\"id\":\"%s\",\"units\":\"metres\","
-        "\"up\":\"+Y; glTF (X, Y, Z) = the model's (x, z, -y)\",\"properties\":%s}},"
-        "\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"name\":\"solid\"}],"
-        "\"meshes\":[{\"name\":\"skin\",\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2,\"mode\":4}]}],"
-        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\",%s},"
-        "{\"bufferView\":1,\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\"},"
-        "{\"bufferView\":2,\"componentType\":5125,\"count\":%zu,\"type\":\"SCALAR\"}],"
-        "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":%zu,\"target\":34962},"
-        "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"target\":34962},"
-        "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu,\"target\":34963}],"
-        "\"buffers\":[{\"byteLength\":%zu%s",
-        o->id, pj, nv, mm, nv, 3 * nt, 12 * nv, 12 * nv, 12 * nv, 24 * nv, 12 * nt, o->blob_len,
-        gltf ? ",\"uri\":\"data:application/octet-stream;base64," : "}]}");
-    free(pj);
-    if (n < 0 || (size_t)n >= cap)
-        return -1;
-    o->text_len = (size_t)n;
-    size_t b64 = (o->blob_len + 2) / 3 * 4;
-    if (gltf) {
-        o->size = (long long)(n + b64 + 5);    /* "}]}\n" */
-    } else {
-        size_t jlen = (o->text_len + 3) & ~(size_t)3;
-        o->size = (long long)(12 + 8 + jlen + 8 + o->blob_len);
-    }
-    return 0;
-}
-
-static const char b64chars[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-
-static int fill_gltf(api_output *o)
-{
-    switch (o->phase) {
-    case 0:
-        o->phase = 1;
-        return put(o, o->text, o->text_len);
-    case 1: {
-        if (o->blob_pos == o->blob_len) {
-            o->phase = 2;
-            return puts_(o, "\"}]}\n");
-        }
-        size_t n = o->blob_len - o->blob_pos;
-        if (n > 49152)
-            n = 49152;       /* a multiple of 3, so runs join without padding */
-        if (reserve(o, n / 3 * 4 + 4))
-            return -1;
-        const unsigned char *s = o->blob + o->blob_pos;
-        char *d = o->buf + o->len;
-        size_t i = 0;
-        for (; i + 3 <= n; i += 3) {
-            uint32_t v = (uint32_t)s[i] << 16 | (uint32_t)s[i + 1] << 8 | s[i + 2];
-            *d++ = b64chars[v >> 18];
-            *d++ = b64chars[(v >> 12) & 63];
-            *d++ = b64chars[(v >> 6) & 63];
-            *d++ = b64chars[v & 63];
-        }
-        if (i < n) {
-            uint32_t v = (uint32_t)s[i] << 16 | (i + 1 < n ? (uint32_t)s[i + 1] << 8 : 0);
-            *d++ = b64chars[v >> 18];
-            *d++ = b64chars[(v >> 12) & 63];
-            *d++ = i + 1 < n ? b64chars[(v >> 6) & 63] : '=';
-            *d++ = '=';
-        }
-        o->len = (size_t)(d - o->buf);
-        o->blob_pos += n;
-        return 0;
-    }
-    }
-    return 1;
-}
-
-static int fill_glb(api_output *o)
-{
-    unsigned char h[20];
-    switch (o->phase) {
-    case 0: {
-        size_t jlen = (o->text_len + 3) & ~(size_t)3;
-        memcpy(h, "glTF", 4);
-        le32(h + 4, 2);
-        le32(h + 8, (uint32_t)o->size);
-        le32(h + 12, (uint32_t)jlen);
-        memcpy(h + 16, "JSON", 4);
-        o->phase = 1;
-        if (put(o, h, 20) || put(o, o->text, o->text_len) || put(o, "   ", jlen - o->text_len))
-            return -1;
-        le32(h, (uint32_t)o->blob_len);
-        memcpy(h + 4, "BIN\0", 4);
-        return put(o, h, 8);
-    }
-    case 1: {
-        if (o->blob_pos == o->blob_len)
-            return 1;
-        size_t n = o->blob_len - o->blob_pos;
-        if (n > 1 << 20)
-            n = 1 << 20;
-        if (put(o, o->blob + o->blob_pos, n))
-            return -1;
-        o->blob_pos += n;
-        return 0;
-    }
-    }
-    return 1;
-}
-
-static int fill_stl(api_output *o)
-{
-    const api_mesh *m = &o->mesh;
-    if (o->phase == 0) {
-        unsigned char h[84];
-        memset(h, ' ', 80);
-        int n = snprintf((char *)h, 80, "pdesolid binary STL of the solid %s", o->id[0] ? o->id : "");
-        if (n > 0 && n < 80)
-            h[n] = ' ';
-        le32(h + 80, (uint32_t)m->ntris);
-        o->phase = 1;
-        return put(o, h, 84);
-    }
-    if (o->j == m->ntris)
-        return 1;
-    size_t n = m->ntris - o->j < 4096 ? m->ntris - o->j : 4096;
-    if (reserve(o, 50 * n))
-        return -1;
-    for (size_t t = o->j; t < o->j + n; t++) {
-        const float *p[3];
-        for (int i = 0; i < 3; i++)
-            p[i] = m->pos + 3 * m->tri[3 * t + i];
-        double a[3], b[3], c[3];
-        for (int k = 0; k < 3; k++)
-            a[k] = (double)p[1][k] - p[0][k], b[k] = (double)p[2][k] - p[0][k];
-        c[0] = a[1] * b[2] - a[2] * b[1];
-        c[1] = a[2] * b[0] - a[0] * b[2];
-        c[2] = a[0] * b[1] - a[1] * b[0];
-        double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-        float rec[12];
-        for (int k = 0; k < 3; k++)
-            rec[k] = len > 0 ? (float)(c[k] / len) : 0.0f;
-        for (int i = 0; i < 3; i++)
-            memcpy(rec + 3 + 3 * i, p[i], 3 * sizeof(float));
-        if (put_f32(o, rec, 12) || put(o, "\0\0", 2))
-            return -1;
-    }
-    o->j += n;
-    return 0;
+    return api_out_puts(o, "    </FieldData>\n");
 }
 
 /* ---- the stream ---- */
 
-api_output *api_output_open(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
-                            const unsigned res[3], const pde_cancel *cancel, api_error *err)
+api_output *api_output_open_ex(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
+                               const unsigned res[3], const api_output_opts *opts, const pde_cancel *cancel,
+                               api_error *err)
 {
     api_error local;
     if (!err)
         err = &local;
-    api_output *o = calloc(1, sizeof *o);
-    if (!o) {
-        api_fail(err, API_ERR_NOMEM, "", "out of memory");
+    const api_format_info *fi = api_format_info_of(f);
+    if (!fi) {
+        api_fail(err, API_ERR_DOCUMENT, "", "format: %d is not a format", (int)f);
         return NULL;
     }
-    o->fmt = f;
+    if (opts && opts->compress != API_COMPRESS_NONE && !fi->compress) {
+        api_compress_parse(api_compress_name(opts->compress), f, &(api_compress){ 0 }, err);
+        return NULL;
+    }
+    api_output *o = calloc(1, sizeof *o);
+    if (!o) {
+        api_fail_nomem(err);
+        return NULL;
+    }
+    o->fmt = fi;
+    if (opts)
+        o->opts = *opts;
     o->sol = sol;
     if (props) {
         o->props = *props;
@@ -895,61 +386,25 @@ api_output *api_output_open(const pde_solution *sol, const char *id, const pde_p
     o->size = -1;
     snprintf(o->id, sizeof o->id, "%s", id ? id : "");
     memcpy(o->res, res, sizeof o->res);
-    int rc = 0;
     err->message[0] = '\0';
-    switch (f) {
-    case API_FMT_GRID:
-        rc = grid_open(o);
-        break;
-    case API_FMT_F32:
-        rc = grid_open(o);
-        o->size = 12 * points(o);
-        break;
-    case API_FMT_VTS: {
-        rc = props_of(o, cancel, err) ? grid_open(o) : -1;
-        if (!rc && !vts_header(o)) {  /* measure the header once for the size */
-            o->size = (long long)o->len + 8 + 12 * points(o) + 8 + 4 * points(o) + (long long)strlen(vts_footer);
-            o->len = 0;
-        }
-        break;
-    }
-    case API_FMT_GLTF:
-    case API_FMT_GLB:
-    case API_FMT_STL:
-        rc = mesh_open(o, cancel, err);
-        break;
-    case API_FMT_JSON:
-        rc = json_document(o, cancel, err);
-        o->size = (long long)o->len;
-        o->phase = 1;
-        break;
-    }
-    if (rc) {
+    if (fi->open(o, cancel, err)) {
         if (!err->message[0])
-            api_fail(err, API_ERR_NOMEM, "", "out of memory");
+            api_fail_nomem(err);
         api_output_free(o);
         return NULL;
     }
     return o;
 }
 
+api_output *api_output_open(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
+                            const unsigned res[3], const pde_cancel *cancel, api_error *err)
+{
+    return api_output_open_ex(sol, id, props, f, res, NULL, cancel, err);
+}
+
 long long api_output_size(const api_output *o)
 {
     return o->size;
-}
-
-static int fill(api_output *o)
-{
-    switch (o->fmt) {
-    case API_FMT_JSON: return 1;
-    case API_FMT_GRID: return fill_grid_json(o);
-    case API_FMT_F32: return fill_f32(o);
-    case API_FMT_VTS: return fill_vts(o);
-    case API_FMT_GLTF: return fill_gltf(o);
-    case API_FMT_GLB: return fill_glb(o);
-    case API_FMT_STL: return fill_stl(o);
-    }
-    return 1;
 }
 
 long api_output_read(api_output *o, char *buf, size_t max)
@@ -959,9 +414,8 @@ long api_output_read(api_output *o, char *buf, size_t max)
         if (o->pos == o->len) {
             if (done)
                 break;      /* one piece of work per call: a caller can poll between calls */
-            if (o->fmt != API_FMT_JSON)
-                o->pos = o->len = 0;
-            int r = fill(o);
+            o->pos = o->len = 0;
+            int r = o->fmt->fill(o);
             if (r < 0)
                 return -1;
             if (r > 0 && o->pos == o->len)
@@ -979,14 +433,8 @@ void api_output_free(api_output *o)
 {
     if (!o)
         return;
-    pde_grid_free(o->grid);
+    if (o->fmt->close)
+        o->fmt->close(o->st);
     free(o->buf);
-    free(o->xyz);
-    free(o->xu);
-    free(o->xv);
-    free(o->xw);
-    api_mesh_free(&o->mesh);
-    free(o->blob);
-    free(o->text);
     free(o);
 }

@@ -3,15 +3,25 @@
  * stream that is read in pieces of any size in bounded memory (the server
  * hands it to libmicrohttpd's content callback; the CLI to a file).
  *
+ * The formats are a table: formats.def lists them, one row each, and each
+ * is defined in its own file, api/fmt_NAME.c (docs/API.md describes them):
+ *
  *   json  the closed form per component and mode, the properties and the id
  *   grid  {"resolution": [nu, nv, nw], "x": [...], "y": [...], "z": [...]},
  *         u fastest, then v, then w, sampled at i/(n-1), float32 digits
  *   f32   little-endian float32 x, y, z per point, in the same order
- *   gltf  glTF 2.0 of the closed skin, the buffer in a base64 data URI
+ *   gltf  glTF 2.0 of the closed skin (+Y up), the buffer in a base64 data URI
  *   glb   the same as binary glTF
  *   vts   the volume as a VTK XML StructuredGrid with det J as a point field,
  *         the properties as field data
  *   stl   binary STL of the closed skin
+ *   obj   Wavefront OBJ text of the closed skin, with normals
+ *   ply   binary little-endian PLY of the closed skin: normals and det J per vertex
+ *   msh   Gmsh 4.1 hexahedral volume mesh (api/volmesh.h)
+ *   vtu   the same as a VTK XML UnstructuredGrid
+ *
+ * A new format is one file that defines its api_format_info and one row in
+ * formats.def; the server, the CLI and GET /formats read the table.
  *
  * USAGE
  *
@@ -19,6 +29,9 @@
  *   long n;
  *   while ((n = api_output_read(o, buf, sizeof buf)) > 0) fwrite(buf, 1, n, f);
  *   api_output_free(o);
+ *
+ *   api_output_opts opts = { .compress = API_COMPRESS_MESHOPT };   // gltf, glb only
+ *   o = api_output_open_ex(sol, id, NULL, API_FMT_GLB, res, &opts, NULL, &err);
  *
  * The output reads the solution, which must outlive it. Outputs are
  * independent of one another and may be read on different threads.
@@ -32,19 +45,47 @@
 #include "model.h"
 #include "pde.h"
 
-typedef enum { API_FMT_JSON, API_FMT_GRID, API_FMT_F32, API_FMT_GLTF, API_FMT_GLB, API_FMT_VTS, API_FMT_STL } api_format;
-#define API_FMT_COUNT 7
+/* API_FMT_JSON, API_FMT_GLB, ... in formats.def's order, and API_FMT_COUNT, counted by the list. */
+typedef enum {
+#define API_FORMAT(id, entry) API_FMT_##id,
+#include "formats.def"
+#undef API_FORMAT
+    API_FMT_COUNT
+} api_format;
 
+/* Compression of a format that takes it (api_format_info.compress). */
+typedef enum {
+    API_COMPRESS_NONE = 0,  /* as the format is */
+    API_COMPRESS_MESHOPT,   /* gltf, glb: EXT_meshopt_compression with KHR_mesh_quantization */
+} api_compress;
+
+/* Options of api_output_open_ex(); a zeroed struct (or NULL) is every default. */
 typedef struct {
+    api_compress compress;
+} api_output_opts;
+
+typedef struct api_output api_output;
+struct api_cost;
+
+typedef struct api_format_info {
     const char *name;      /* as in ?format= and --format */
     const char *mime;
     const char *ext;       /* file extension, with the dot */
     int mesh;              /* resolution per face edge rather than per volume axis */
     int props;             /* carries the properties: api_output_open() computes them when not given */
     int binary;            /* bytes that are not text: not written to a terminal */
+    int compress;          /* takes compress=meshopt */
+    /* The stream (api/fmt.h says what each does). */
+    int (*open)(api_output *o, const pde_cancel *cancel, api_error *err);
+    int (*fill)(api_output *o);
+    void (*close)(void *st);
+    void (*cost)(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, struct api_cost *c);
 } api_format_info;
 
 const api_format_info *api_format_info_of(api_format f);
+/* "none" or "meshopt" (NULL or "": none) for format f; 0, or -1 with err naming compress and what f takes. */
+int api_compress_parse(const char *text, api_format f, api_compress *c, api_error *err);
+const char *api_compress_name(api_compress c);
 /* The table as GET /formats serves it: [{"name", "media_type", "extension", "binary", "mesh", "properties",
  * "default_res"}, ...] in the table's order (malloc'd; NULL if out of memory). */
 char *api_formats_json(void);
@@ -60,28 +101,31 @@ int api_format_parse(const char *name, api_format *f, api_error *err);
 /* "N" or "NU,NV,NW"; NULL or "" gives the format's default. Returns 0, or -1 with err naming the limit. */
 int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *err);
 
-typedef struct api_output api_output;
-
 /*
  * id: the model's id (id.h), or NULL. props: the solution's properties if the
  * caller has them (the formats with props set carry them), or NULL to compute them.
  * NULL and err on failure (out of memory, a mesh out of range). The long work
- * happens here: the properties it computes, the mesh (gltf, glb, stl), the
+ * happens here: the properties it computes, the mesh (gltf, glb, stl, obj, ply, msh, vtu), the
  * whole json document; cancel (NULL: never) is polled through it, and when
  * it stops the call frees everything and err has status API_ERR_CANCELLED.
  * Grid formats only set up their sampling tables here (api/cost.h's bytes).
  */
 api_output *api_output_open(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
                             const unsigned res[3], const pde_cancel *cancel, api_error *err);
-/* The total size in bytes, or -1 when it is known only at the end (json, grid). */
+/* The same with options (NULL: the defaults); a compression the format does not take is a document error. */
+api_output *api_output_open_ex(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
+                               const unsigned res[3], const api_output_opts *opts, const pde_cancel *cancel,
+                               api_error *err);
+/* The total size in bytes, or -1 when it is known only at the end (grid, obj, msh, vtu). */
 long long api_output_size(const api_output *o);
 /*
  * Up to max bytes into buf; returns the count, 0 at the end, or -1 out of
  * memory. Each call does at most one bounded piece of work, so a server can
  * poll a deadline between calls: up to 16384 sampled points and about 2^21
- * multiply-adds of sampling (at least one row), 4096 STL triangles, 48 KB of
- * base64 or 1 MB of copying. It may return fewer than max bytes before the
- * end; read until it returns 0.
+ * multiply-adds of sampling (at least one row), 4096 STL triangles or OBJ
+ * lines, 16384 PLY vertices or faces, about 1 MB of a volume mesh (msh, vtu),
+ * 48 KB of base64 or 1 MB of copying. It may return fewer than max bytes
+ * before the end; read until it returns 0.
  */
 long api_output_read(api_output *o, char *buf, size_t max);
 void api_output_free(api_output *o);

@@ -39,14 +39,14 @@
 
 /* ---- the request's key for the response cache ---- */
 
-/* Route, format, res, then the body or the path's argument: the whole request, nothing cut. */
+/* Route, format, res, compress, then the body or the path's argument: the whole request, nothing cut. */
 static void make_key(srv_req *r)
 {
     const char *tail = r->body ? r->body : r->arg;
     size_t tl = r->body ? r->len : strlen(r->arg);
     if (tl > SRV_RCACHE_MAX_KEY)
         return;
-    size_t cap = tl + sizeof r->q.format + sizeof r->q.res + 16;
+    size_t cap = tl + sizeof r->q.format + sizeof r->q.res + sizeof r->q.compress + 16;
     if (!(r->key = malloc(cap)))
         return;
     char *k = r->key;
@@ -58,6 +58,10 @@ static void make_key(srv_req *r)
     *k++ = '\n';
     memcpy(k, r->q.res, rl);
     k += rl;
+    *k++ = '\n';
+    const char *cn = api_compress_name(r->q.comp);   /* as parsed: "" and "none" are one answer */
+    memcpy(k, cn, strlen(cn));
+    k += strlen(cn);
     *k++ = '\n';
     memcpy(k, tail, tl);
     r->klen = (size_t)(k - r->key) + tl;

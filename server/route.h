@@ -32,7 +32,7 @@ enum {
     SRV_RT_BODY = 1 << 0,    /* takes a request body (POST) */
     SRV_RT_JOB = 1 << 1,     /* runs on a solver thread; else answers on the polling thread */
     SRV_RT_CACHE = 1 << 2,   /* its 200s may be kept in the response cache */
-    SRV_RT_OUTPUT = 1 << 3,  /* takes ?format= and ?res= */
+    SRV_RT_OUTPUT = 1 << 3,  /* takes ?format=, ?res= and ?compress= */
 };
 
 typedef struct {
@@ -57,9 +57,10 @@ int srv_route_find(const char *method, const char *path, char *arg, size_t argn,
 
 /* A request's query, checked against its row. */
 typedef struct {
-    char format[32], res[256];  /* as given, "" when absent */
-    int seen;                   /* bits: 1 format, 2 res */
+    char format[32], res[256], compress[16];  /* as given, "" when absent */
+    int seen;                   /* bits: 1 format, 2 res, 4 compress */
     api_format fmt;             /* after srv_query_done */
+    api_compress comp;          /* after srv_query_done */
     unsigned res3[3];
 } srv_query;
 
@@ -71,7 +72,8 @@ void srv_query_init(srv_query *q);
  */
 int srv_query_arg(const srv_route *rt, srv_query *q, const char *key, size_t klen, const char *value, size_t vlen,
                   char *msg, size_t n);
-/* Parses format and res (with the format's defaults); 0, or -1 with msg (a value the format does not take: 422). */
+/* Parses format, res and compress (with the format's defaults); 0, or -1 with msg (a value the format does not
+ * take: 422; the message names the parameter). */
 int srv_query_done(const srv_route *rt, srv_query *q, char *msg, size_t n);
 
 #endif

@@ -174,7 +174,9 @@ static void answer_entry(srv_req *r, srv_entry *e)
     api_format f = r->q.fmt;
     const unsigned *res = r->q.res3;
     snprintf(r->id, sizeof r->id, "%s", srv_entry_id(e));
-    snprintf(r->etag, sizeof r->etag, "\"%s.%s.%ux%ux%u\"", r->id, api_format_info_of(f)->name, res[0], res[1], res[2]);
+    api_output_opts opts = { .compress = r->q.comp };
+    snprintf(r->etag, sizeof r->etag, "\"%s.%s%s%s.%ux%ux%u\"", r->id, api_format_info_of(f)->name,
+             opts.compress ? "." : "", opts.compress ? api_compress_name(opts.compress) : "", res[0], res[1], res[2]);
     const char *inm = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
     if (inm && (strstr(inm, r->etag) || !strcmp(inm, "*"))) {
         r->status = 304;
@@ -185,7 +187,7 @@ static void answer_entry(srv_req *r, srv_entry *e)
     const pde_solution *sol = srv_entry_solution(e);
     int with_props = api_format_info_of(f)->props;
     api_cost part;
-    api_cost_output(sol, f, res, &part);
+    api_cost_output_ex(sol, f, res, &opts, &part);
     int over = over_budget(r, &part);
     if (!over && with_props && !srv_entry_has_props(e)) {
         api_cost_props(sol, &part);
@@ -208,7 +210,7 @@ static void answer_entry(srv_req *r, srv_entry *e)
     }
     api_error err;
     t0 = srv_now();
-    api_output *o = api_output_open(sol, r->id, props, f, res, &r->cancel, &err);
+    api_output *o = api_output_open_ex(sol, r->id, props, f, res, &opts, &r->cancel, &err);
     r->tm.output = srv_now() - t0;
     if (!o) {
         srv_cache_release(s->cache, e);
@@ -571,6 +573,7 @@ static const struct {
 } params[] = {
     { "format", 1, offsetof(srv_query, format), sizeof ((srv_query *)0)->format },
     { "res", 2, offsetof(srv_query, res), sizeof ((srv_query *)0)->res },
+    { "compress", 4, offsetof(srv_query, compress), sizeof ((srv_query *)0)->compress },
 };
 #define NPARAMS (sizeof params / sizeof *params)
 
@@ -598,8 +601,10 @@ int srv_query_arg(const srv_route *rt, srv_query *q, const char *key, size_t kle
     if (!(rt->flags & SRV_RT_OUTPUT) || i == NPARAMS) {
         char shown[64];
         api_text_clean(shown, sizeof shown, key, klen);
-        snprintf(msg, n, "unknown query parameter \"%s\"; %s takes %s", shown, rt->path,
-                 rt->flags & SRV_RT_OUTPUT ? "format and res" : "none");
+        char known[64] = "none";
+        for (size_t k = 0, used = 0; (rt->flags & SRV_RT_OUTPUT) && k < NPARAMS; k++)   /* from the table */
+            used += (size_t)snprintf(known + used, sizeof known - used, "%s%s", k ? ", " : "", params[k].name);
+        snprintf(msg, n, "unknown query parameter \"%s\"; %s takes %s", shown, rt->path, known);
         return -1;
     }
     if (q->seen & params[i].bit) {
@@ -629,7 +634,8 @@ int srv_query_done(const srv_route *rt, srv_query *q, char *msg, size_t n)
         return 0;
     api_error err;
     if (api_format_parse(q->format[0] ? q->format : "json", &q->fmt, &err) ||
-        api_res_parse(q->res[0] ? q->res : NULL, q->fmt, q->res3, &err)) {
+        api_res_parse(q->res[0] ? q->res : NULL, q->fmt, q->res3, &err) ||
+        api_compress_parse(q->compress, q->fmt, &q->comp, &err)) {
         snprintf(msg, n, "%s", err.message);
         return -1;
     }

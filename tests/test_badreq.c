@@ -275,7 +275,7 @@ static const row rows[] = {
     /* -- query -- */
     POST(400, "an unknown query parameter", "/solve?fromat=glb", FIG4A),
     POST(ANY_4XX, "an empty format", "/solve?format=", FIG4A),
-    POST(ANY_4XX, "an unknown format", "/solve?format=obj", FIG4A),
+    POST(ANY_4XX, "an unknown format", "/solve?format=dae", FIG4A),
     POST(ANY_4XX, "res=0", "/solve?format=f32&res=0", FIG4A),
     POST(ANY_4XX, "res=1", "/solve?format=f32&res=1", FIG4A),
     POST(ANY_4XX, "res=-5", "/solve?format=f32&res=-5", FIG4A),

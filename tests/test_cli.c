@@ -169,7 +169,7 @@ static void bad_input_should_exit_2_and_name_the_field(void **state)
         { "solve --preset fig4a --param p0=lots", "\"lots\" is not a number" },
         { "solve --preset fig4a --param q=1", "/params/q: example4 has no parameter \"q\"" },
         { "solve --preset fig4a --param c=-1,-1,0", "/params/c/2: c of component z is 0" },
-        { "solve --preset fig4a --format obj -o x", "\"obj\" is not a format" },
+        { "solve --preset fig4a --format dae -o x", "\"dae\" is not a format" },
         { "solve --preset fig4a --format grid --res 9999", "limit of 4096" },
         { "solve fig4a.json --param p0=1", "--param goes with --preset or --template" },
         { "solve --res", "--res needs a value" },
@@ -201,7 +201,7 @@ static void output_file_should_never_be_ignored(void **state)
     (void)state;
     char *out, *err, path[256];
     size_t len;
-    const char *exts[] = { "json", "grid.json", "glb", "stl" };
+    const char *exts[] = { "json", "grid.json", "glb", "stl", "obj", "ply", "msh", "vtu" };
     for (size_t i = 0; i < sizeof exts / sizeof *exts; i++) {
         char args[128];
         snprintf(args, sizeof args, "solve --preset fig3d --res 8 -o byext.%s", exts[i]);
@@ -220,10 +220,35 @@ static void output_file_should_never_be_ignored(void **state)
             assert_int_equal((len - 84) % 50, 0);
         else if (!strcmp(exts[i], "grid.json"))
             assert_non_null(strstr((char *)got, "\"resolution\""));
+        else if (!strcmp(exts[i], "obj"))
+            assert_memory_equal(got, "# pdesolid", 10);
+        else if (!strcmp(exts[i], "ply"))
+            assert_memory_equal(got, "ply\nformat binary_little_endian", 31);
+        else if (!strcmp(exts[i], "msh"))
+            assert_memory_equal(got, "$MeshFormat\n4.1", 15);
+        else if (!strcmp(exts[i], "vtu"))
+            assert_non_null(strstr((char *)got, "UnstructuredGrid"));
         else
             assert_non_null(strstr((char *)got, "\"properties\""));
         free(got);
     }
+    /* --compress meshopt: gltf and glb only, named when refused. */
+    assert_int_equal(run(1, "solve --preset fig3d --res 8 --compress meshopt -o small.glb", &out, &err), 0);
+    free(out);
+    free(err);
+    snprintf(path, sizeof path, "%s/small.glb", dir);
+    unsigned char *glb = (unsigned char *)read_file(path, &len);
+    assert_non_null(glb);
+    assert_non_null(strstr((char *)glb + 20, "\"extensionsRequired\":[\"EXT_meshopt_compression\""));
+    free(glb);
+    assert_int_equal(run(1, "solve --preset fig3d --compress meshopt -o x.stl", &out, &err), 2);
+    assert_non_null(strstr(err, "compress: meshopt applies to gltf, glb, not to stl"));
+    free(out);
+    free(err);
+    assert_int_equal(run(1, "solve --preset fig3d --compress meshopt", &out, &err), 2);
+    assert_non_null(strstr(err, "--compress"));
+    free(out);
+    free(err);
     assert_int_equal(run(1, "solve --preset fig3d -o solid.txt", &out, &err), 2);
     assert_non_null(strstr(err, "solid.txt"));
     assert_non_null(strstr(err, ".glb"));

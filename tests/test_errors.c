@@ -108,13 +108,17 @@ static void output_open_out_of_memory_should_be_a_500_in_every_format(void **sta
     if (api_solve(m, &sol, &err))
         fail_msg("fig4a: %s", err.message);
     api_model_free(m);
-    for (int f = 0; f < API_FMT_COUNT; f++) {
+    for (int run = 0; run < 2 * API_FMT_COUNT; run++) {   /* every format, and compressed where it takes it */
+        int f = run / 2;
+        api_output_opts opts = { .compress = run % 2 ? API_COMPRESS_MESHOPT : API_COMPRESS_NONE };
+        if (opts.compress && !api_format_info_of((api_format)f)->compress)
+            continue;
         unsigned res[3];
         assert_int_equal(api_res_parse("5", (api_format)f, res, NULL), 0);
         long k = 0, failures = 0;
         for (;; k++) {
             fail_after = k;
-            api_output *o = api_output_open(sol, "id", NULL, (api_format)f, res, NULL, &err);
+            api_output *o = api_output_open_ex(sol, "id", NULL, (api_format)f, res, &opts, NULL, &err);
             fail_after = -1;
             if (o) {
                 api_output_free(o);

@@ -24,6 +24,7 @@
 #include "output.h"
 #include "support.h"
 #include "template.h"
+#include "volmesh.h"
 
 static char dir[] = "/tmp/pdesolid-out-XXXXXX";
 
@@ -53,11 +54,11 @@ static pde_solution *solve_preset(const char *name, char id[API_ID_LEN + 1])
 }
 
 /* The whole output in memory, with the caller's properties (NULL: computed); checks the declared size. */
-static unsigned char *render_props(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
-                                   const unsigned res[3], size_t *len)
+static unsigned char *render_opts(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
+                                  const unsigned res[3], const api_output_opts *opts, size_t *len)
 {
     api_error err;
-    api_output *o = api_output_open(sol, id, props, f, res, NULL, &err);
+    api_output *o = api_output_open_ex(sol, id, props, f, res, opts, NULL, &err);
     if (!o)
         fail_msg("%s: %s", api_format_info_of(f)->name, err.message);
     size_t cap = 1 << 16, n = 0;
@@ -77,10 +78,18 @@ static unsigned char *render_props(const pde_solution *sol, const char *id, cons
     return buf;
 }
 
+static unsigned char *render_props(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
+                                   const unsigned res[3], size_t *len)
+{
+    return render_opts(sol, id, props, f, res, NULL, len);
+}
+
 static unsigned char *render(const pde_solution *sol, const char *id, api_format f, const unsigned res[3], size_t *len)
 {
     return render_props(sol, id, NULL, f, res, len);
 }
+
+static const api_output_opts meshopt = { .compress = API_COMPRESS_MESHOPT };
 
 /*
  * The properties by their names in docs/API.md, the tests' own transcription: the object under
@@ -330,18 +339,19 @@ static void presets_should_be_the_tests_own_transcription(void **state)
 static void every_preset_should_give_gltf_and_glb_that_the_khronos_validator_passes(void **state)
 {
     (void)state;
-    char cmd[16384];
+    char cmd[32768];
     int n = snprintf(cmd, sizeof cmd, "node tests/node/validate_gltf.mjs");
     const unsigned res[3] = { 24, 24, 24 };
     for (size_t i = 0; i < api_preset_count(); i++) {
         const char *name = api_preset_at(i)->name;
         char id[API_ID_LEN + 1];
         pde_solution *sol = solve_preset(name, id);
-        for (int g = 0; g < 2; g++) {
+        for (int g = 0; g < 4; g++) {   /* gltf, glb, and each compressed */
             size_t len;
-            unsigned char *bytes = render(sol, id, g ? API_FMT_GLB : API_FMT_GLTF, res, &len);
+            unsigned char *bytes = render_opts(sol, id, NULL, g % 2 ? API_FMT_GLB : API_FMT_GLTF, res,
+                                               g / 2 ? &meshopt : NULL, &len);
             char path[128];
-            snprintf(path, sizeof path, "%s/%s.%s", dir, name, g ? "glb" : "gltf");
+            snprintf(path, sizeof path, "%s/%s%s.%s", dir, name, g / 2 ? "-meshopt" : "", g % 2 ? "glb" : "gltf");
             FILE *f = fopen(path, "wb");
             assert_non_null(f);
             fwrite(bytes, 1, len, f);
@@ -436,6 +446,91 @@ static void gltf_should_stand_the_height_along_plus_y(void **state)
     free(json);
     free(glb);
     free(stl);
+    pde_solution_free(sol);
+}
+
+/* The GLB's _DETJ attribute is the skin's det J (api_mesh.detj), vertex for vertex: a float SCALAR the
+ * front-end colours folds by. */
+static void glb_should_carry_det_j_as_the_detj_attribute(void **state)
+{
+    (void)state;
+    pde_solution *sol = solve_preset("fig4a", NULL);
+    const unsigned res[3] = { 20, 20, 20 };
+    api_mesh m;
+    assert_int_equal(api_mesh_build(sol, res, NULL, &m, NULL), 0);
+    size_t len;
+    unsigned char *glb = render(sol, NULL, API_FMT_GLB, res, &len);
+    uint32_t jlen;
+    memcpy(&jlen, glb + 12, 4);
+    cJSON *g = cJSON_ParseWithLength((const char *)glb + 20, jlen);
+    const cJSON *prim = cJSON_GetArrayItem(cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(g, "meshes"), 0),
+                                                                "primitives"), 0);
+    const cJSON *at = cJSON_GetObjectItem(cJSON_GetObjectItem(prim, "attributes"), "_DETJ");
+    assert_non_null(at);
+    const cJSON *acc = cJSON_GetArrayItem(cJSON_GetObjectItem(g, "accessors"), at->valueint);
+    assert_int_equal(cJSON_GetObjectItem(acc, "componentType")->valueint, 5126);
+    assert_string_equal(cJSON_GetObjectItem(acc, "type")->valuestring, "SCALAR");
+    assert_int_equal(cJSON_GetObjectItem(acc, "count")->valueint, (int)m.nverts);
+    const cJSON *view = cJSON_GetArrayItem(cJSON_GetObjectItem(g, "bufferViews"),
+                                           cJSON_GetObjectItem(acc, "bufferView")->valueint);
+    size_t off = (size_t)cJSON_GetObjectItem(view, "byteOffset")->valuedouble;
+    assert_int_equal((size_t)cJSON_GetObjectItem(view, "byteLength")->valuedouble, 4 * m.nverts);
+    assert_memory_equal(glb + 20 + jlen + 8 + off, m.detj, 4 * m.nverts);
+    int negative = 0;
+    for (size_t i = 0; i < m.nverts; i++)
+        negative += m.detj[i] < 0;
+    assert_true(negative > 0);     /* fig4a folds */
+    cJSON_Delete(g);
+    free(glb);
+    api_mesh_free(&m);
+    pde_solution_free(sol);
+}
+
+/* compress=meshopt: fig4a at res 64 in at most a quarter of the plain GLB's bytes; the same skin, +Y up (its
+ * POSITION bounds within the stated tolerance of the plain one's), the extensions required as the
+ * EXT_meshopt_compression spec asks of a fallback buffer without data. */
+static void meshopt_glb_should_be_a_quarter_of_the_plain_one_and_stand_along_plus_y(void **state)
+{
+    (void)state;
+    pde_solution *sol = solve_preset("fig4a", NULL);
+    const unsigned res[3] = { 64, 64, 64 };
+    size_t plen, zlen;
+    unsigned char *plain = render(sol, NULL, API_FMT_GLB, res, &plen);
+    unsigned char *z = render_opts(sol, NULL, NULL, API_FMT_GLB, res, &meshopt, &zlen);
+    print_message("fig4a res 64: glb %zu bytes, meshopt glb %zu (%.3f)\n", plen, zlen, (double)zlen / (double)plen);
+    assert_true(4 * zlen <= plen);
+    cJSON *g[2];
+    for (int k = 0; k < 2; k++) {
+        const unsigned char *b = k ? z : plain;
+        uint32_t jlen;
+        memcpy(&jlen, b + 12, 4);
+        g[k] = cJSON_ParseWithLength((const char *)b + 20, jlen);
+        assert_non_null(g[k]);
+    }
+    for (int r = 0; r < 2; r++) {
+        const cJSON *list = cJSON_GetObjectItem(g[1], r ? "extensionsRequired" : "extensionsUsed");
+        assert_int_equal(cJSON_GetArraySize(list), 2);
+        assert_string_equal(cJSON_GetArrayItem(list, 0)->valuestring, "EXT_meshopt_compression");
+        assert_string_equal(cJSON_GetArrayItem(list, 1)->valuestring, "KHR_mesh_quantization");
+    }
+    const cJSON *extras = cJSON_GetObjectItem(cJSON_GetObjectItem(g[1], "asset"), "extras");
+    double tol = cJSON_GetObjectItem(extras, "position_error")->valuedouble;
+    assert_true(tol > 0 && tol < 1e-6);    /* docs/API.md: positions within 1 micrometre */
+    assert_non_null(cJSON_GetObjectItem(cJSON_GetObjectItem(extras, "properties"), "volume"));
+    const cJSON *p0 = cJSON_GetArrayItem(cJSON_GetObjectItem(g[0], "accessors"), 0);
+    const cJSON *p1 = cJSON_GetArrayItem(cJSON_GetObjectItem(g[1], "accessors"), 0);
+    for (int c = 0; c < 3; c++)
+        for (int mx = 0; mx < 2; mx++) {
+            double a = cJSON_GetArrayItem(cJSON_GetObjectItem(p0, mx ? "max" : "min"), c)->valuedouble;
+            double b = cJSON_GetArrayItem(cJSON_GetObjectItem(p1, mx ? "max" : "min"), c)->valuedouble;
+            if (fabs(a - b) > 2 * tol + 1e-7)
+                fail_msg("axis %d %s: plain %.9g, meshopt %.9g", c, mx ? "max" : "min", a, b);
+        }
+    assert_float_equal(cJSON_GetArrayItem(cJSON_GetObjectItem(p1, "max"), 1)->valuedouble, 3.0, 1e-6);   /* height along +Y */
+    cJSON_Delete(g[0]);
+    cJSON_Delete(g[1]);
+    free(plain);
+    free(z);
     pde_solution_free(sol);
 }
 
@@ -785,13 +880,144 @@ static void bad_formats_and_resolutions_should_name_the_limit(void **state)
     api_format f;
     api_error err;
     unsigned res[3];
-    assert_int_equal(api_format_parse("obj", &f, &err), -1);
-    assert_non_null(strstr(err.message, "json, grid, f32, gltf, glb, vts, stl"));
+    assert_int_equal(api_format_parse("dae", &f, &err), -1);
+    assert_non_null(strstr(err.message, "json, grid, f32, gltf, glb, vts, stl, obj, ply, msh, vtu"));
+    api_compress c;
+    assert_int_equal(api_compress_parse("meshopt", API_FMT_STL, &c, &err), -1);
+    assert_non_null(strstr(err.message, "compress: meshopt applies to gltf, glb, not to stl"));
+    assert_int_equal(api_compress_parse("draco", API_FMT_GLB, &c, &err), -1);
+    assert_non_null(strstr(err.message, "compress: \"draco\" is not a compression"));
+    assert_int_equal(api_compress_parse("meshopt", API_FMT_GLTF, &c, &err), 0);
+    assert_int_equal(c, API_COMPRESS_MESHOPT);
+    assert_int_equal(api_compress_parse(NULL, API_FMT_STL, &c, &err), 0);
+    assert_int_equal(c, API_COMPRESS_NONE);
     assert_int_equal(api_format_parse("glb", &f, &err), 0);
     assert_int_equal(api_res_parse(NULL, f, res, &err), 0);
     assert_int_equal(res[0], API_RES_MESH_DEFAULT);
     assert_int_equal(api_res_parse("8,16,32", f, res, &err), 0);
     assert_true(res[0] == 8 && res[1] == 16 && res[2] == 32);
+}
+
+/* Writes the output of f to path. */
+static void render_to(const pde_solution *sol, api_format f, const unsigned res[3], const char *path)
+{
+    size_t len;
+    unsigned char *b = render(sol, "abc", f, res, &len);
+    FILE *fp = fopen(path, "wb");
+    assert_non_null(fp);
+    assert_int_equal(fwrite(b, 1, len, fp), len);
+    fclose(fp);
+    free(b);
+}
+
+/* det J from core's derivatives at (u, v, w), and x there. */
+static double detj_at(const pde_solution *sol, const double uvw[3], double x[3])
+{
+    double xu[3], xv[3], xw[3];
+    pde_eval_d(sol, uvw[0], uvw[1], uvw[2], x, xu, xv, xw);
+    return xu[0] * (xv[1] * xw[2] - xv[2] * xw[1]) - xu[1] * (xv[0] * xw[2] - xv[2] * xw[0]) +
+           xu[2] * (xv[0] * xw[1] - xv[1] * xw[0]);
+}
+
+/*
+ * obj, ply, msh and vtu, written through the format table, read back by Debian's python3-meshio: the
+ * point and cell counts of the skin (api_mesh) and of the volume mesh (api_volmesh); the volume the skin
+ * encloses (divergence theorem) and the sum of the cells' volumes (6 tetrahedra a hexahedron, 3 a wedge;
+ * unsigned: the orientation is test_volmesh's)
+ * near the solid's; det J in ply (detj), msh and vtu at sample points equal to core's closed form; msh's
+ * physical groups. Solids that do not fold, so that the volume is the cells' sum.
+ */
+static void obj_ply_msh_and_vtu_should_read_back_in_meshio(void **state)
+{
+    (void)state;
+    if (access("/usr/bin/python3", X_OK) || system("/usr/bin/python3 -c 'import meshio' 2>/dev/null"))
+        fail_msg("python3-meshio is missing: apt-get install python3-meshio");
+    const char *names[] = { "fig1a", "fig2b" };
+    for (size_t i = 0; i < 2; i++) {
+        pde_solution *sol = solve_preset(names[i], NULL);
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        assert_false(p.folds);
+        const unsigned sres[3] = { 41, 81, 41 }, vres[3] = { 17, 33, 17 };
+        api_mesh m;
+        api_volmesh vm;
+        assert_int_equal(api_mesh_build(sol, sres, NULL, &m, NULL), 0);
+        assert_int_equal(api_volmesh_build(sol, vres, NULL, &vm, NULL), 0);
+        char obj[96], ply[96], msh[96], vtu[96], py[96];
+        snprintf(obj, sizeof obj, "%s/%s.obj", dir, names[i]);
+        snprintf(ply, sizeof ply, "%s/%s.ply", dir, names[i]);
+        snprintf(msh, sizeof msh, "%s/%s.msh", dir, names[i]);
+        snprintf(vtu, sizeof vtu, "%s/%s.vtu", dir, names[i]);
+        snprintf(py, sizeof py, "%s/%s.py", dir, names[i]);
+        render_to(sol, API_FMT_OBJ, sres, obj);
+        render_to(sol, API_FMT_PLY, sres, ply);
+        render_to(sol, API_FMT_MSH, vres, msh);
+        render_to(sol, API_FMT_VTU, vres, vtu);
+        FILE *f = fopen(py, "w");
+        fprintf(f,
+                "import meshio, numpy as np\n"
+                "def skin(path, nv, nt):\n"
+                "    m = meshio.read(path)\n"
+                "    assert len(m.points) == nv, (path, len(m.points), nv)\n"
+                "    t = m.cells_dict['triangle']\n"
+                "    assert len(t) == nt, (path, len(t), nt)\n"
+                "    p = m.points[t]\n"
+                "    v = np.sum(np.einsum('ij,ij->i', p[:, 0], np.cross(p[:, 1], p[:, 2]))) / 6\n"
+                "    assert abs(v - %.17g) <= 5e-3 * %.17g, (path, v)\n"
+                "    return m\n"
+                "def tets(p, q):\n"
+                "    a, b, c, d = (p[:, k] for k in q)\n"
+                "    return np.sum(np.abs(np.einsum('ij,ij->i', b - a, np.cross(c - a, d - a)))) / 6\n"
+                "def vol(path, hexes, wedges):\n"
+                "    m = meshio.read(path)\n"
+                "    assert len(m.points) == %zu, (path, len(m.points))\n"
+                "    h, w = m.cells_dict.get('hexahedron', []), m.cells_dict.get('wedge', [])\n"
+                "    assert len(h) == hexes and len(w) == wedges, (path, len(h), len(w))\n"
+                "    v = 0\n"
+                "    if len(h):\n"
+                "        p = m.points[h]\n"
+                "        for q in ((0,1,2,6), (0,2,3,6), (0,3,7,6), (0,7,4,6), (0,4,5,6), (0,5,1,6)):\n"
+                "            v += tets(p, q)\n"
+                "    if len(w):\n"
+                "        p = m.points[w]\n"
+                "        for q in ((0,1,2,3), (1,2,3,4), (2,3,4,5)):\n"
+                "            v += tets(p, q)\n"
+                "    assert abs(abs(v) - %.17g) <= 2e-2 * %.17g, (path, v)\n"
+                "    return m\n"
+                "def near(m, x):\n"
+                "    return np.argmin(np.sum((m.points - x)**2, axis=1))\n"
+                "skin('%s', %zu, %zu)\n"
+                "P = skin('%s', %zu, %zu)\n"
+                "assert P.point_data['detj'].dtype == np.float32\n"
+                "M = vol('%s', %zu, %zu)\n"
+                "assert {'u0', 'u1', 'v0', 'v1', 'w0', 'w1', 'solid'} <= set(M.field_data), M.field_data\n"
+                "V = vol('%s', %zu, %zu)\n",
+                fabs(p.signed_volume), fabs(p.signed_volume), vm.npoints, fabs(p.signed_volume),
+                fabs(p.signed_volume), obj, m.nverts, m.ntris, ply, m.nverts, m.ntris, msh, vm.nhex, vm.nwedge, vtu,
+                vm.nhex, vm.nwedge);
+        /* Samples on the skin (w = 0 and 1) and inside, on both grids. */
+        const double uvw[4][3] = { { 0.5, 0.25, 0 }, { 0.75, 0.5, 1 }, { 0.25, 0.75, 0 }, { 0.5, 0.5, 0.5 } };
+        for (int k = 0; k < 4; k++) {
+            double x[3], dj = detj_at(sol, uvw[k], x);
+            if (k < 3)
+                fprintf(f, "i = near(P, [%.17g, %.17g, %.17g])\n"
+                           "assert abs(P.point_data['detj'][i] - %.17g) <= 1e-5 * (1 + abs(%.17g)), ('ply', %d)\n",
+                        x[0], x[1], x[2], dj, dj, k);
+            fprintf(f, "for X, key in ((M, 'det J'), (V, 'detJ')):\n"
+                       "    i = near(X, [%.17g, %.17g, %.17g])\n"
+                       "    assert abs(X.point_data[key][i] - %.17g) <= 1e-5 * (1 + abs(%.17g)), (key, %d)\n",
+                    x[0], x[1], x[2], dj, dj, k);
+        }
+        fprintf(f, "print('ok')\n");
+        fclose(f);
+        char cmd[256];
+        snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s", py);
+        if (system(cmd) != 0)
+            fail_msg("%s: meshio's reading failed (%s)", names[i], py);
+        api_mesh_free(&m);
+        api_volmesh_free(&vm);
+        pde_solution_free(sol);
+    }
 }
 
 int main(void)
@@ -802,6 +1028,8 @@ int main(void)
         cmocka_unit_test(every_preset_should_give_gltf_and_glb_that_the_khronos_validator_passes),
         cmocka_unit_test(gltf_should_carry_the_id_properties_and_exact_bounds),
         cmocka_unit_test(gltf_should_stand_the_height_along_plus_y),
+        cmocka_unit_test(glb_should_carry_det_j_as_the_detj_attribute),
+        cmocka_unit_test(meshopt_glb_should_be_a_quarter_of_the_plain_one_and_stand_along_plus_y),
         cmocka_unit_test(grid_json_should_read_back_as_the_f32_output),
         cmocka_unit_test(stl_skin_should_be_closed_and_enclose_the_computed_volume),
         cmocka_unit_test(every_skin_should_be_closed_with_normals_and_det_j_from_the_closed_form),
@@ -811,6 +1039,7 @@ int main(void)
         cmocka_unit_test(properties_should_read_back_from_their_tree),
         cmocka_unit_test(id_should_not_depend_on_how_the_model_is_spelled),
         cmocka_unit_test(bad_formats_and_resolutions_should_name_the_limit),
+        cmocka_unit_test(obj_ply_msh_and_vtu_should_read_back_in_meshio),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("output", tests, setup, teardown);

@@ -484,7 +484,7 @@ static void bad_requests_should_get_problems_and_the_daemon_should_keep_serving(
     r = post(&d, "/solve?res=100000", "{\"preset\":\"fig4a\"}");
     expect_problem(&r, 422, NULL, "limit of 4096");
     free(r.body);
-    r = post(&d, "/solve?format=obj", "{\"preset\":\"fig4a\"}");
+    r = post(&d, "/solve?format=dae", "{\"preset\":\"fig4a\"}");
     expect_problem(&r, 422, NULL, "is not a format");
     free(r.body);
     char *deep = malloc(5001);
@@ -680,6 +680,49 @@ static void formats_should_list_the_table_and_each_row_should_hold(void **state)
     stop(&d);
 }
 
+/* compress=meshopt on the formats whose row takes it (GET /formats' "compress"); any other value, or on a
+ * format that does not take it, is a 422 that names compress. */
+static void compress_should_be_checked_like_every_query_parameter(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    reply r = http(&d, "GET", "/formats", NULL, 0, NULL);
+    cJSON *j = cJSON_Parse(r.body);
+    for (int i = 0; i < API_FMT_COUNT; i++) {
+        const api_format_info *f = api_format_info_of((api_format)i);
+        const cJSON *c = cJSON_GetObjectItem(cJSON_GetArrayItem(j, i), "compress");
+        assert_int_equal(cJSON_GetArraySize(c), 1 + f->compress);
+        char path[96];
+        snprintf(path, sizeof path, "/solve?format=%s&res=8&compress=meshopt", f->name);
+        reply s = post(&d, path, "{\"preset\":\"fig4a\"}");
+        if (s.status != (f->compress ? 200 : 422) || (!f->compress && !strstr(s.body, "compress")))
+            fail_msg("%s: %d %.300s", f->name, s.status, s.body);
+        free(s.body);
+    }
+    cJSON_Delete(j);
+    free(r.body);
+    reply plain = post(&d, "/solve?format=glb&res=32", "{\"preset\":\"fig4a\"}");
+    reply small = post(&d, "/solve?format=glb&res=32&compress=meshopt", "{\"preset\":\"fig4a\"}");
+    assert_int_equal(plain.status, 200);
+    assert_int_equal(small.status, 200);
+    assert_true(small.len * 4 <= plain.len);
+    assert_non_null(strstr(small.body + 20, "EXT_meshopt_compression"));   /* in the JSON chunk, before any NUL */
+    char e1[128], e2[128];
+    assert_true(header_value(&plain, "ETag", e1, sizeof e1) && header_value(&small, "ETag", e2, sizeof e2));
+    assert_string_not_equal(e1, e2);
+    free(plain.body);
+    free(small.body);
+    reply bad = post(&d, "/solve?format=glb&compress=zip", "{\"preset\":\"fig4a\"}");
+    assert_int_equal(bad.status, 422);
+    assert_non_null(strstr(bad.body, "compress"));
+    free(bad.body);
+    reply twice = post(&d, "/solve?format=glb&compress=meshopt&compress=meshopt", "{\"preset\":\"fig4a\"}");
+    assert_int_equal(twice.status, 400);
+    free(twice.body);
+    stop(&d);
+}
+
 static void presets_version_health_metrics_and_cors_should_answer(void **state)
 {
     (void)state;
@@ -833,6 +876,7 @@ int main(void)
         cmocka_unit_test(sigterm_should_let_a_request_in_flight_complete),
         cmocka_unit_test(presets_version_health_metrics_and_cors_should_answer),
         cmocka_unit_test(formats_should_list_the_table_and_each_row_should_hold),
+        cmocka_unit_test(compress_should_be_checked_like_every_query_parameter),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("server", tests, setup, teardown);

@@ -45,8 +45,9 @@ static const char usage[] =
     "  --param NAME=VALUE   with --preset or --template, a parameter; VALUE is a number, or x,y,z for\n"
     "                       a, b and c; repeatable\n"
     "  --format F           solve: one of the formats below\n"
-    "  --res N|NU,NV,NW     samples per axis (grid, f32, vts; default 33) or per face\n"
-    "                       edge (gltf, glb, stl; default 64)\n"
+    "  --res N|NU,NV,NW     samples per axis, or per face edge for the formats that\n"
+    "                       mesh the skin (the defaults below)\n"
+    "  --compress meshopt   gltf, glb: EXT_meshopt_compression with KHR_mesh_quantization\n"
     "  -o FILE              write to FILE instead of standard output; solve without\n"
     "                       --format takes the format from FILE's extension\n"
     "  --server URL         solve and eval on a pdesolidd (e.g. http://127.0.0.1:8080)\n"
@@ -58,7 +59,7 @@ static const char usage[] =
     "pointer), 1 anything else.\n";
 
 typedef struct {
-    const char *preset, *template, *format, *res, *out, *server;
+    const char *preset, *template, *format, *res, *compress, *out, *server;
     const char *params[64];
     int nparams;
     const char *args[3];
@@ -207,7 +208,9 @@ static int write_output(const options *o, const pde_solution *sol, const char *i
     api_error err;
     api_format f;
     unsigned res[3];
-    if (api_format_parse(o->format, &f, &err) || api_res_parse(o->res, f, res, &err))
+    api_output_opts opts = { 0 };
+    if (api_format_parse(o->format, &f, &err) || api_res_parse(o->res, f, res, &err) ||
+        api_compress_parse(o->compress, f, &opts.compress, &err))
         return report("option", &err);
     if (!o->out && isatty(STDOUT_FILENO) && api_format_info_of(f)->binary) {
         fprintf(stderr, "pdesolid: %s is binary; give -o FILE, or redirect standard output\n", o->format);
@@ -218,7 +221,7 @@ static int write_output(const options *o, const pde_solution *sol, const char *i
         fprintf(stderr, "pdesolid: %s: %s\n", o->out, strerror(errno));
         return 1;
     }
-    api_output *w = api_output_open(sol, id, NULL, f, res, NULL, &err);
+    api_output *w = api_output_open_ex(sol, id, NULL, f, res, &opts, NULL, &err);
     if (!w) {
         if (out != stdout)
             fclose(out);
@@ -293,7 +296,7 @@ static int remote(const options *o, int eval)
             fprintf(stderr, "pdesolid: %s: %s\n", o->out, strerror(errno));
             rc = 1;
         } else {
-            rc = remote_solve(o->server, body, len, o->format, o->res, out);
+            rc = remote_solve(o->server, body, len, o->format, o->res, o->compress, out);
             if (out != stdout && fclose(out) != 0)
                 rc = 1;
         }
@@ -332,6 +335,10 @@ static int cmd_solve(const options *oo)
     options copy = *oo, *o = &copy;
     if (o->out && !o->format && format_from_extension(o))
         return 2;
+    if (o->compress && !o->format) {
+        fprintf(stderr, "pdesolid: --compress needs a format that takes it (--format glb, or -o FILE.glb)\n");
+        return 2;
+    }
     if (o->server)
         return remote(o, 0);
     pde_solution *sol;
@@ -414,7 +421,9 @@ static void print_usage(FILE *f)
     fputs("\nformats (--format NAME, or -o FILE ending with the extension):\n", f);
     for (int i = 0; i < API_FMT_COUNT; i++) {
         const api_format_info *fi = api_format_info_of((api_format)i);
-        fprintf(f, "  %-6s %-11s %s%s\n", fi->name, fi->ext, fi->mime, fi->mesh ? " (a mesh of the skin)" : "");
+        fprintf(f, "  %-6s %-11s %-26s res %u %s%s%s\n", fi->name, fi->ext, fi->mime,
+                fi->mesh ? API_RES_MESH_DEFAULT : API_RES_GRID_DEFAULT, fi->mesh ? "per face edge" : "per axis",
+                fi->props ? ", with the properties" : "", fi->compress ? ", --compress meshopt" : "");
     }
 }
 
@@ -439,6 +448,8 @@ int main(int argc, char **argv)
             val = &o.format;
         } else if (strcmp(a, "--res") == 0) {
             val = &o.res;
+        } else if (strcmp(a, "--compress") == 0) {
+            val = &o.compress;
         } else if (strcmp(a, "-o") == 0) {
             val = &o.out;
         } else if (strcmp(a, "--server") == 0) {

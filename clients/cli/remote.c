@@ -108,11 +108,12 @@ static int print_solve(const char *json, FILE *out)
     return 0;
 }
 
-int remote_solve(const char *server, const char *body, size_t len, const char *format, const char *res, FILE *out)
+int remote_solve(const char *server, const char *body, size_t len, const char *format, const char *res,
+                 const char *compress, FILE *out)
 {
     char url[2048];
-    snprintf(url, sizeof url, "%s/solve?format=%s%s%s", server, format ? format : "json", res ? "&res=" : "",
-             res ? res : "");
+    snprintf(url, sizeof url, "%s/solve?format=%s%s%s%s%s", server, format ? format : "json", res ? "&res=" : "",
+             res ? res : "", compress ? "&compress=" : "", compress ? compress : "");
     reply r;
     if (post(url, body, len, &r))
         return 1;

@@ -8,9 +8,10 @@
 #include <stddef.h>
 #include <stdio.h>
 
-/* POSTs body to URL/solve?format=..&res=.. and writes the answer to out (format NULL: the text of
+/* POSTs body to URL/solve?format=..&res=..&compress=.. (each only when given) and writes the answer to out (format NULL: the text of
  * `pdesolid solve`). Returns the exit status: 0, 2 for a request the server refused, 1 otherwise. */
-int remote_solve(const char *server, const char *body, size_t len, const char *format, const char *res, FILE *out);
+int remote_solve(const char *server, const char *body, size_t len, const char *format, const char *res,
+                 const char *compress, FILE *out);
 
 /* Solves body, then evaluates the points (a JSON array) there; prints [[x,y,z], ...] as offline. */
 int remote_eval(const char *server, const char *body, size_t len, const char *points, size_t plen, FILE *out);

@@ -114,6 +114,29 @@ static void check_output(api_format f, const unsigned res[3], const char *b, siz
         FUZZ_CHECK(memmem(b + tail, n - tail, "</VTKFile>", 10), "vts: does not end in </VTKFile>");
         break;
     }
+    case API_FMT_OBJ:
+        FUZZ_CHECK(n > 2 && b[0] == '#' && b[n - 1] == '\n' && utf8_valid(b, n), "obj: not lines of text");
+        break;
+    case API_FMT_PLY: {
+        static const char end[] = "end_header\n";
+        const char *h = memmem(b, n, end, sizeof end - 1);
+        FUZZ_CHECK(n > 4 && !memcmp(b, "ply\n", 4) && h, "ply: no header");
+        unsigned long nv = 0, nf = 0;
+        const char *ev = memmem(b, (size_t)(h - b), "element vertex ", 15), *ef = memmem(b, (size_t)(h - b), "element face ", 13);
+        FUZZ_CHECK(ev && ef && sscanf(ev, "element vertex %lu", &nv) == 1 && sscanf(ef, "element face %lu", &nf) == 1,
+                   "ply: no element counts");
+        FUZZ_CHECK(n == (size_t)(h - b) + sizeof end - 1 + 28 * nv + 13 * nf, "ply: %zu bytes for %lu vertices, %lu faces",
+                   n, nv, nf);
+        break;
+    }
+    case API_FMT_MSH:
+        FUZZ_CHECK(n > 12 && !memcmp(b, "$MeshFormat\n", 12) && memmem(b, n, "$EndElements", 12), "msh: no sections");
+        break;
+    case API_FMT_VTU:
+        FUZZ_CHECK(n > 5 && !memcmp(b, "<?xml", 5) && memmem(b, n, "</VTKFile>", 10), "vtu: not a VTK XML file");
+        break;
+    case API_FMT_COUNT:
+        break;
     }
 }
 
@@ -166,13 +189,19 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         pde_props props;
         pde_props_opts opts = { .res = 5, .cancel = &cancel };
         pde_status ps = pick & 2 ? PDE_ERR_CANCELLED : pde_properties(sol, &opts, &props);
-        for (int f = 0; f < API_FMT_COUNT; f++) {
+        /* Every format, and those that take it compressed too. */
+        for (int run = 0; run < 2 * API_FMT_COUNT; run++) {
+            int f = run / 2;
             unsigned res[3] = { 2, 2 + (pick & 1), 2 };
             const api_format_info *fi = api_format_info_of((api_format)f);
-            api_cost_output(sol, (api_format)f, res, &cost);
+            api_output_opts oo = { .compress = run % 2 ? API_COMPRESS_MESHOPT : API_COMPRESS_NONE };
+            if (oo.compress && !fi->compress)
+                continue;
+            api_cost_output_ex(sol, (api_format)f, res, &oo, &cost);
             check_cost(&cost, fi->name);
             memset(&err, 'X', sizeof err);
-            api_output *o = api_output_open(sol, id, ps == PDE_OK ? &props : NULL, (api_format)f, res, &cancel, &err);
+            api_output *o = api_output_open_ex(sol, id, ps == PDE_OK ? &props : NULL, (api_format)f, res, &oo, &cancel,
+                                               &err);
             if (!o) {
                 check_refusal(&err, 1);
                 continue;

@@ -157,6 +157,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             total *= q.res3[k];
         }
         FUZZ_CHECK(fi->mesh || total <= API_RES_GRID_POINTS, "%llu grid points", total);
+        FUZZ_CHECK(q.comp == API_COMPRESS_NONE || (q.comp == API_COMPRESS_MESHOPT && fi->compress &&
+                                                   !strcmp(q.compress, "meshopt")),
+                   "compress %d (\"%s\") for %s", (int)q.comp, q.compress, fi->name);
     } else {
         FUZZ_CHECK(!q.seen, "a route without a query took one");
     }
