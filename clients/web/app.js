@@ -313,6 +313,8 @@ async function solve({ fresh = false } = {}) {
     return true;
   };
   let resp, res = auto ? state.autoRes : state.res, json = null;
+  // A control moved: a coarse grid (f32, no properties to compute) draws the new shape first, then the glb replaces it.
+  if (inputAt !== null && state.skin) preview(body, ctl, inputAt);
   try {
     // At auto resolution the modes (json) come beside the mesh; if they ask for another res, the mesh again.
     const [g, j] = await Promise.all([fetchGlb(body, res, ctl.signal),
@@ -351,12 +353,55 @@ async function solve({ fresh = false } = {}) {
   loader.parse(bytes, '', (gltf) => {
     if (inflight !== ctl) return;
     show(gltf, timing, performance.now() - t0, res, body);
-    if (inputAt !== null) requestAnimationFrame(() => {
-      const m = performance.measure('pdesolid:input-to-frame', { start: inputAt, end: performance.now() });
-      latencies.push(m.duration);
-    });
+    if (inputAt !== null) shown(ctl, inputAt);
     done();
   }, (e) => { if (done()) fail({ detail: `the mesh could not be read: ${e.message || e}` }); });
+}
+
+// The first frame that shows the solid of an input (the preview's or the glb's): its latency, once.
+const measured = new WeakSet();
+function shown(ctl, inputAt) {
+  if (measured.has(ctl)) return;
+  measured.add(ctl);
+  requestAnimationFrame(() => {
+    const m = performance.measure('pdesolid:input-to-frame', { start: inputAt, end: performance.now() });
+    latencies.push(m.duration);
+  });
+}
+
+// The skin's six faces from a PREVIEW_RES^3 grid of points (format f32): drawn until the glb comes.
+const PREVIEW_RES = 33;
+async function preview(body, ctl, inputAt) {
+  const n = PREVIEW_RES;
+  const r = await fetch(`/solve?format=f32&res=${n}`, { method: 'POST', body, signal: ctl.signal }).catch(() => null);
+  if (!r?.ok || inflight !== ctl) return;
+  const buf = await r.arrayBuffer().catch(() => null);
+  if (!buf || inflight !== ctl || buf.byteLength !== 12 * n * n * n) return;
+  const p = toGltfFrame(new Float32Array(buf)), at = (i, j, k) => (k * n + j) * n + i;
+  const pos = new Float32Array(6 * n * n * 3), idx = [];
+  let v = 0;
+  for (const [face, e] of [[0, 0], [0, n - 1], [1, 0], [1, n - 1], [2, 0], [2, n - 1]]) {
+    const base = v;
+    for (let b = 0; b < n; b++) for (let a = 0; a < n; a++) {
+      const g = 3 * (face === 0 ? at(e, a, b) : face === 1 ? at(a, e, b) : at(a, b, e));
+      pos.set(p.subarray(g, g + 3), 3 * v++);
+    }
+    for (let b = 0; b < n - 1; b++) for (let a = 0; a < n - 1; a++) {
+      const q = base + b * n + a;
+      idx.push(q, q + 1, q + n + 1, q, q + n + 1, q + n);
+    }
+  }
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+  g.setIndex(idx);
+  g.computeVertexNormals();
+  if (skin) { solid.remove(skin); skin.geometry.dispose(); }
+  skin = new THREE.Mesh(g, material);
+  applySkinColour();
+  solid.add(skin);
+  setStatus('solving… (a coarse preview)');
+  render();
+  shown(ctl, inputAt);
 }
 
 function fail(problem) {
