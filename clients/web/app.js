@@ -421,6 +421,10 @@ function serverTimes(header, roundTrip) {
 
 // ---- det J on the skin: _DETJ per vertex (glTF), red where the solid folds ----
 const DETJ_BAD = new THREE.Color(0xd01c1c), DETJ_LO = new THREE.Color(0xf2e3b3), DETJ_HI = new THREE.Color(0x2c5fa8);
+function detjColour(d, hi, tiny, c) {
+  if (d < -tiny) return c.copy(DETJ_BAD);
+  return c.lerpColors(DETJ_LO, DETJ_HI, Math.min(Math.max(d / hi, 0), 1) ** 0.6);
+}
 function colourByDetJ(geometry, props) {
   const dj = geometry.attributes._detj;
   el('legend').hidden = !(dj && state.detj);
@@ -430,9 +434,7 @@ function colourByDetJ(geometry, props) {
   // Rounding at a collapsed axis (det J = 0, not a fold) is not painted as a fold.
   const tiny = 1e-9 * Math.max(hi, Math.abs(props?.detJ?.min_found ?? 0));
   for (let i = 0; i < n; i++) {
-    const d = dj.getX(i);
-    if (d < -tiny) c.copy(DETJ_BAD);
-    else c.lerpColors(DETJ_LO, DETJ_HI, Math.min(Math.max(d / hi, 0), 1) ** 0.6);
+    detjColour(dj.getX(i), hi, tiny, c);
     col[3 * i] = c.r; col[3 * i + 1] = c.g; col[3 * i + 2] = c.b;
   }
   geometry.setAttribute('color', new THREE.BufferAttribute(col, 3));
@@ -541,7 +543,135 @@ function toGltfFrame(raw) {
 }
 
 // ---- the section view (a plane of space, or a surface u, v or w = s) ----
-const section = { refresh() {} };
+// The solid is sampled on a SECTION_RES^3 grid with det J (format vts). A plane x, y or z = const
+// clips the skin, and its cap is cut from the grid's cells (each split into 6 tetrahedra, det J
+// interpolated linearly): where the solid folds, the caps of both sheets show. A surface u, v or w = s
+// is the grid's surface between its two nearest samples, the skin ghosted around it.
+const SECTION_RES = 33;
+const clipPlane = new THREE.Plane(new THREE.Vector3(0, -1, 0), 0);
+const capMaterial = new THREE.MeshBasicMaterial({ vertexColors: true, side: THREE.DoubleSide });
+const section = {
+  opts: { axis: 'off', at: 0.5 }, grid: null, gridId: '', mesh: null, triangles: 0,
+  mount(gui) {
+    const f = gui.addFolder('Section view');
+    const a = f.add(this.opts, 'axis', ['off', 'x', 'y', 'z', 'u', 'v', 'w']).name('section across').onChange(() => this.refresh());
+    const s = f.add(this.opts, 'at', 0, 1, 0.005).name('where (0 to 1)').onChange(() => this.update());
+    a.domElement.dataset.view = 'section-axis';
+    s.domElement.dataset.view = 'section-at';
+    f.close();
+  },
+  // A new solid or axis: the grid (once per solid), then the picture.
+  async refresh() {
+    if (this.opts.axis === 'off') return this.update();
+    const id = state.id;
+    if (id && this.gridId !== id) {
+      const r = await fetch(`/solids/${id}?format=vts&res=${SECTION_RES}`).catch(() => null);
+      if (!r?.ok || id !== state.id) return;
+      this.grid = parseVts(await r.arrayBuffer(), SECTION_RES);
+      this.gridId = id;
+    }
+    this.update();
+    render();
+  },
+  update() {
+    if (this.mesh) { solid.remove(this.mesh); this.mesh.geometry.dispose(); this.mesh = null; }
+    const { axis, at } = this.opts, g = this.grid;
+    material.clippingPlanes = [];
+    material.opacity = 1;
+    material.transparent = false;
+    material.depthWrite = true;
+    this.triangles = 0;
+    if (axis !== 'off' && g && this.gridId === state.id) {
+      const geo = 'xyz'.includes(axis) ? this.cap(axis, at) : this.surface('uvw'.indexOf(axis), at);
+      this.mesh = new THREE.Mesh(geo, capMaterial);
+      this.triangles = geo.index ? geo.index.count / 3 : geo.attributes.position.count / 3;
+      solid.add(this.mesh);
+    }
+    material.needsUpdate = true;
+    render();
+  },
+  // The plane model-axis = lo + at (hi - lo), keeping the part below it; its cap from the grid.
+  cap(axis, at) {
+    const g = this.grid, k = 'xyz'.indexOf(axis), bb = state.props?.bbox;
+    const lo = bb ? bb.min[k] : g.min[k], hi = bb ? bb.max[k] : g.max[k], d = lo + at * (hi - lo);
+    // In glTF's frame: model x -> X, y -> -Z, z -> Y. Keep model coordinate <= d.
+    const n = [new THREE.Vector3(-1, 0, 0), new THREE.Vector3(0, 0, 1), new THREE.Vector3(0, -1, 0)][k];
+    clipPlane.set(n, d);
+    material.clippingPlanes = [clipPlane];
+    const N = g.n, P = g.points, D = g.detj, f = new Float32Array(N * N * N);
+    for (let i = 0; i < f.length; i++) f[i] = P[3 * i + k] - d;
+    const pos = [], col = [], c = new THREE.Color();
+    const hiJ = Math.max(state.props?.detJ?.max_found ?? 1, 1e-300), tiny = 1e-9 * hiJ;
+    const put = (a, b) => {   // the point where f = 0 on the edge a-b
+      const t = f[a] / (f[a] - f[b]);
+      for (let q = 0; q < 3; q++) pos.push(P[3 * a + q] + t * (P[3 * b + q] - P[3 * a + q]));
+      detjColour(D[a] + t * (D[b] - D[a]), hiJ, tiny, c);
+      col.push(c.r, c.g, c.b);
+    };
+    const TETS = [[0, 1, 3, 7], [0, 1, 5, 7], [0, 2, 3, 7], [0, 2, 6, 7], [0, 4, 5, 7], [0, 4, 6, 7]];
+    const id = (i, j, l) => (l * N + j) * N + i, v = new Array(8);
+    for (let l = 0; l < N - 1; l++) for (let j = 0; j < N - 1; j++) for (let i = 0; i < N - 1; i++) {
+      let neg = 0;
+      for (let q = 0; q < 8; q++) { v[q] = id(i + (q & 1), j + (q >> 1 & 1), l + (q >> 2)); if (f[v[q]] < 0) neg++; }
+      if (neg === 0 || neg === 8) continue;
+      for (const t of TETS) {
+        const below = t.filter((q) => f[v[q]] < 0).map((q) => v[q]), above = t.filter((q) => f[v[q]] >= 0).map((q) => v[q]);
+        if (below.length === 1 || below.length === 3) {
+          const [one, rest] = below.length === 1 ? [below[0], above] : [above[0], below];
+          for (const r of rest) put(one, r);
+        } else if (below.length === 2) {
+          const [a0, a1] = below, [b0, b1] = above;
+          put(a0, b0); put(a0, b1); put(a1, b1);
+          put(a0, b0); put(a1, b1); put(a1, b0);
+        }
+      }
+    }
+    const geo = new THREE.BufferGeometry();
+    geo.setAttribute('position', new THREE.BufferAttribute(toGltfFrame(new Float32Array(pos)), 3));
+    geo.setAttribute('color', new THREE.Float32BufferAttribute(col, 3));
+    return geo;
+  },
+  // The surface parameter[axis] = at, linear between the grid's two nearest samples; the skin ghosted.
+  surface(axis, at) {
+    const g = this.grid, N = g.n, x = at * (N - 1), s0 = Math.min(Math.floor(x), N - 2), t = x - s0;
+    const id = (a, b, s) => axis === 0 ? (b * N + a) * N + s : axis === 1 ? (b * N + s) * N + a : (s * N + b) * N + a;
+    const pos = new Float32Array(N * N * 3), col = new Float32Array(N * N * 3), idx = [], c = new THREE.Color();
+    const hiJ = Math.max(state.props?.detJ?.max_found ?? 1, 1e-300), tiny = 1e-9 * hiJ;
+    for (let b = 0; b < N; b++) for (let a = 0; a < N; a++) {
+      const p = id(a, b, s0), q = id(a, b, s0 + 1), o = b * N + a;
+      for (let k = 0; k < 3; k++) pos[3 * o + k] = g.points[3 * p + k] * (1 - t) + g.points[3 * q + k] * t;
+      detjColour(g.detj[p] * (1 - t) + g.detj[q] * t, hiJ, tiny, c);
+      col.set([c.r, c.g, c.b], 3 * o);
+    }
+    for (let b = 0; b < N - 1; b++) for (let a = 0; a < N - 1; a++) {
+      const o = b * N + a;
+      idx.push(o, o + 1, o + N + 1, o, o + N + 1, o + N);
+    }
+    material.transparent = true;
+    material.opacity = 0.25;
+    material.depthWrite = false;
+    const geo = new THREE.BufferGeometry();
+    geo.setAttribute('position', new THREE.BufferAttribute(toGltfFrame(pos), 3));
+    geo.setAttribute('color', new THREE.BufferAttribute(col, 3));
+    geo.setIndex(idx);
+    return geo;
+  },
+};
+
+// The points (model frame) and det J of a vts StructuredGrid of n^3 (raw appended, UInt64 block headers).
+function parseVts(buf, n) {
+  const bytes = new Uint8Array(buf), head = new TextDecoder().decode(bytes.subarray(0, Math.min(bytes.length, 1 << 16)));
+  const start = head.indexOf('_', head.indexOf('<AppendedData')) + 1;
+  const off = (name) => +new RegExp(`Name="${name}"[^>]*offset="(\\d+)"`).exec(head)[1];
+  const block = (o, count) => {
+    const at = start + o + 8, copy = bytes.slice(at, at + 4 * count);
+    return new Float32Array(copy.buffer);
+  };
+  const points = block(off('Points'), 3 * n * n * n), detj = block(off('detJ'), n * n * n);
+  const min = [Infinity, Infinity, Infinity], max = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < points.length; i++) { min[i % 3] = Math.min(min[i % 3], points[i]); max[i % 3] = Math.max(max[i % 3], points[i]); }
+  return { n, points, detj, min, max };
+}
 
 // ---- downloads ----
 const downloads = {};
@@ -881,7 +1011,7 @@ window.pdesolid = {
       mode: state.mode, phase: state.phase, solves: state.solves, id: state.id, preset: state.preset, error: state.error,
       res: state.res, autoRes: state.autoRes, shownRes: state.shownRes, meshopt, link: share.link,
       vertices: skin?.geometry.attributes.position.count ?? 0, detj: Boolean(skin?.geometry.attributes._detj),
-      history: history.at, steps: history.steps.length, foldAt: state.foldAt ?? null, target: controls.target.toArray(),
+      history: history.at, steps: history.steps.length, section: { ...section.opts, triangles: section.triangles }, foldAt: state.foldAt ?? null, target: controls.target.toArray(),
     };
   },
   latencies,

@@ -482,6 +482,29 @@ await check('at 390x844 the panel is a drawer, the info box folds, and the solid
   await small.close();
 });
 
+await check('the section plane cuts the solid, its cap coloured by det J, and moves with its slider', async () => {
+  await gallery('fig4a');
+  if (!(await page.locator('[data-view="section-axis"]').isVisible())) await page.locator('.lil-title', { hasText: /^Section view$/ }).click();
+  await page.locator('[data-view="section-axis"] select').selectOption('z');
+  await page.waitForFunction(() => window.pdesolid.state.section.triangles > 0, null, { timeout: 30000 });
+  const a = await snapshot();
+  await page.screenshot({ path: `${out}/section-z-0.5.png` });
+  const at = page.locator('[data-view="section-at"] input');
+  await at.fill('0.25');
+  await at.press('Enter');
+  await page.waitForFunction(() => window.pdesolid.state.section.at === 0.25, null, { timeout: 10000 });
+  const b = await snapshot();
+  if ((await state()).section.triangles === 0 || b.hash === a.hash) throw new Error('the plane did not move');
+  await page.screenshot({ path: `${out}/section-z-0.25.png` });
+  await page.locator('[data-view="section-axis"] select').selectOption('w');
+  await page.waitForFunction(() => window.pdesolid.state.section.axis === 'w' && window.pdesolid.state.section.triangles > 0);
+  const c = await snapshot();
+  if (c.hash === b.hash) throw new Error('the w section looks like the z section');
+  await page.screenshot({ path: `${out}/section-w-0.25.png` });
+  await page.locator('[data-view="section-axis"] select').selectOption('off');
+  if ((await state()).section.triangles !== 0) throw new Error('the section stayed');
+});
+
 await check('responsiveness: from a slider input to the frame that shows the new solid, 30 moves of p0 on fig4a', async () => {
   await gallery('fig4a');
   await page.evaluate(() => { window.pdesolid.latencies.length = 0; });
