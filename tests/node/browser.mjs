@@ -421,6 +421,15 @@ await check('folds: fig4a is red where det J < 0, with a legend; the warning fli
   await page.locator('[data-view="frame"] button').click();
 });
 
+await check('the page asks for meshopt glb when GET /formats says glb takes compress=meshopt', async () => {
+  const glb = (await (await fetch(`${base}/formats`)).json()).find((f) => f.name === 'glb');
+  const want = Array.isArray(glb.compress) && glb.compress.includes('meshopt');
+  const [req] = await Promise.all([page.waitForRequest((r) => /\/solve\?format=glb/.test(r.url())), gallery('fig3a')]);
+  if (/compress=meshopt/.test(req.url()) !== want) throw new Error(`asked ${req.url()}; the server's glb takes ${glb.compress}`);
+  if ((await state()).meshopt !== want) throw new Error('state.meshopt disagrees');
+  if (want && !(await state()).detj) throw new Error('the compressed glb lost _DETJ');
+});
+
 await check('the gallery scrolls: End reaches the last figure, arrows move, Enter opens', async () => {
   await page.locator('#gallery button[aria-pressed="true"]').focus();
   await page.keyboard.press('End');
