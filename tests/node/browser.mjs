@@ -6,6 +6,7 @@ import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
 import { defaultLoft, loftDocument, newSection } from '../../clients/web/loft.js';
 
+// With --responsiveness: only the responsiveness figure (below).
 // With --reopen FILE (after test_web.c restarted the daemon on the same --store): opens the share link
 // whose id the first run wrote to FILE, checks that it draws that solid, and stops.
 const [base, out, flag, reopenFile] = process.argv.slice(2);
@@ -53,6 +54,37 @@ async function gallery(name) {
   const n = (await state()).solves;
   await page.click(`#gallery button[data-preset="${name}"]`);
   await solved(n);
+}
+
+const RESPONSIVENESS = 'responsiveness: from a slider input to the frame that shows the new solid, 30 moves of p0 on fig4a';
+async function responsiveness() {
+  await gallery('fig4a');
+  await page.evaluate(() => { window.pdesolid.latencies.length = 0; });
+  const slider = page.locator('[data-param="p0"] .lil-slider');
+  await slider.scrollIntoViewIfNeeded();
+  const box = await slider.boundingBox();
+  for (let i = 0; i < 30; i++) {
+    const n = (await state()).solves;
+    // Alternately left and right of the middle, each click a new value.
+    const f = i % 2 ? 0.85 - 0.005 * i : 0.15 + 0.005 * i;
+    await page.mouse.click(box.x + box.width * f, box.y + box.height / 2);
+    await solved(n);
+    await page.waitForFunction((k) => window.pdesolid.latencies.length >= k, i + 1);
+  }
+  const ms = await page.evaluate(() => window.pdesolid.latencies.slice());
+  const fig = { moves: ms.length, median_ms: +median(ms).toFixed(1), p95_ms: +quantile(ms, 0.95).toFixed(1), base };
+  writeFileSync(`${out}/responsiveness.json`, JSON.stringify(fig));
+  console.log(`# responsiveness: ${JSON.stringify(fig)}`);
+  if (ms.length < 30) throw new Error(`${ms.length} measurements`);
+}
+
+// --responsiveness: only the figure for docs/BENCHMARKS.md (the page opens on fig4a).
+if (flag === '--responsiveness') {
+  await page.goto(base + '/', { waitUntil: 'load' });
+  await solved(0);
+  await check(RESPONSIVENESS, responsiveness);
+  await browser.close();
+  process.exit(0);
 }
 
 if (flag === '--reopen') {
@@ -514,26 +546,7 @@ await check('the section plane cuts the solid, its cap coloured by det J, and mo
   if ((await state()).section.triangles !== 0) throw new Error('the section stayed');
 });
 
-await check('responsiveness: from a slider input to the frame that shows the new solid, 30 moves of p0 on fig4a', async () => {
-  await gallery('fig4a');
-  await page.evaluate(() => { window.pdesolid.latencies.length = 0; });
-  const slider = page.locator('[data-param="p0"] .lil-slider');
-  await slider.scrollIntoViewIfNeeded();
-  const box = await slider.boundingBox();
-  for (let i = 0; i < 30; i++) {
-    const n = (await state()).solves;
-    // Alternately left and right of the middle, each click a new value.
-    const f = i % 2 ? 0.85 - 0.005 * i : 0.15 + 0.005 * i;
-    await page.mouse.click(box.x + box.width * f, box.y + box.height / 2);
-    await solved(n);
-    await page.waitForFunction((k) => window.pdesolid.latencies.length >= k, i + 1);
-  }
-  const ms = await page.evaluate(() => window.pdesolid.latencies.slice());
-  const fig = { moves: ms.length, median_ms: +median(ms).toFixed(1), p95_ms: +quantile(ms, 0.95).toFixed(1), base };
-  writeFileSync(`${out}/responsiveness.json`, JSON.stringify(fig));
-  console.log(`# responsiveness: ${JSON.stringify(fig)}`);
-  if (ms.length < 30) throw new Error(`${ms.length} measurements`);
-});
+await check(RESPONSIVENESS, responsiveness);
 
 await browser.close();
 console.log(`all ${step} checks passed`);
