@@ -397,6 +397,7 @@ async function preview(body, ctl, inputAt) {
   g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
   g.setIndex(idx);
   g.computeVertexNormals();
+  g.computeBoundingBox();
   if (skin) { solid.remove(skin); skin.geometry.dispose(); }
   skin = new THREE.Mesh(g, material);
   applySkinColour();

@@ -328,6 +328,18 @@ if (loftProbe.status !== 200) {
     }
     if (problems.length) throw new Error(problems.join('; '));
   });
+
+  await check("a loft's share link reopens it in the loft editor", async () => {
+    const s = await state();
+    const other = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+    await other.goto(s.link || `${base}/#solid=${s.id}`, { waitUntil: 'load' });
+    await other.waitForFunction(() => window.pdesolid?.state.phase === 'ready', null, { timeout: 60000 });
+    const t = await other.evaluate(() => window.pdesolid.state);
+    if (t.id !== s.id || t.mode !== 'loft') throw new Error(`the link of the loft ${s.id} opened ${t.id} (${t.mode})`);
+    if (!(await other.locator('[data-section]').count())) throw new Error('the loft editor has no sections');
+    await other.screenshot({ path: `${out}/share-loft.png` });
+    await other.close();
+  });
 }
 
 // ---- share links, undo, resolution, framing, folds, layout, accessibility, responsiveness ----
