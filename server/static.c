@@ -29,6 +29,7 @@ static const struct {
     { "/vendor/three/addons/utils/SkeletonUtils.js", "node_modules/three/examples/jsm/utils/SkeletonUtils.js", JS },
     { "/vendor/three/addons/controls/OrbitControls.js", "node_modules/three/examples/jsm/controls/OrbitControls.js",
       JS },
+    { "/vendor/three/addons/libs/meshopt_decoder.module.js", "node_modules/three/examples/jsm/libs/meshopt_decoder.module.js", JS },
     { "/vendor/lil-gui/lil-gui.esm.js", "node_modules/lil-gui/dist/lil-gui.esm.js", JS },
 };
 #define NFILES (sizeof files / sizeof *files)

@@ -7,7 +7,11 @@
  * the panel shows the centroid, surface area, moments and inertia the server
  * computed; the loft editor builds, uploads and solves lofts and shows a bad
  * section's error beside it, and the loft presets draw (while the daemon
- * refuses lofts, browser.mjs says so and skips those). The loft editor's shape
+ * refuses lofts, browser.mjs says so and skips those); share links reopen a
+ * solid, also after the daemon restarts on the same --store; undo and redo;
+ * the automatic resolution; framing clear of the panels; det J on the skin;
+ * the gallery by keyboard; axe-core; the 390x844 drawer; the responsiveness
+ * figure (input to frame, printed and saved). The loft editor's shape
  * generators are checked in node against their curves (tests/node/shapes.mjs).
  * Screenshots go to build/artifacts/web/.
  */
@@ -31,18 +35,32 @@ static void the_front_end_should_work_in_a_real_browser(void **state)
     (void)state;
     assert_int_equal(tmpdir_make(dir), 0);
     daemon_t d;
-    daemon_start(&d, dir, "--web clients/web --quiet");
-    char cmd[512];
+    char args[256], cmd[768], path[128];
+    /* A durable store, so that share links (GET /solids/{id}/request) work, and still work after a restart. */
+    snprintf(args, sizeof args, "--web clients/web --quiet --store %s/store", dir);
+    daemon_start(&d, dir, args);
     snprintf(cmd, sizeof cmd, "node tests/node/browser.mjs %s build/artifacts/web > %s/browser.txt 2>&1", d.base, dir);
     int st = system(cmd);
-    char path[128];
     snprintf(path, sizeof path, "%s/browser.txt", dir);
     char *report = read_file(path, NULL);
     printf("%s", report ? report : "");
     daemon_stop(&d);
+    free(report);
     if (st != 0)
         fail_msg("the browser checks failed (screenshots in build/artifacts/web)");
+    /* The same store after a restart (on another port): the share link the first run took still opens its solid. */
+    daemon_start(&d, dir, args);
+    snprintf(cmd, sizeof cmd,
+             "node tests/node/browser.mjs %s build/artifacts/web --reopen build/artifacts/web/share-id.txt > %s/reopen.txt 2>&1",
+             d.base, dir);
+    st = system(cmd);
+    snprintf(path, sizeof path, "%s/reopen.txt", dir);
+    report = read_file(path, NULL);
+    printf("%s", report ? report : "");
+    daemon_stop(&d);
     free(report);
+    if (st != 0)
+        fail_msg("the share link did not survive a restart (screenshots in build/artifacts/web)");
     assert_int_equal(tmpdir_remove(dir), 0);
 }
 
