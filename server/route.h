@@ -33,6 +33,7 @@ enum {
     SRV_RT_JOB = 1 << 1,     /* runs on a solver thread; else answers on the polling thread */
     SRV_RT_CACHE = 1 << 2,   /* its 200s may be kept in the response cache */
     SRV_RT_OUTPUT = 1 << 3,  /* takes ?format=, ?res= and ?compress= */
+    SRV_RT_PAGE = 1 << 4,    /* a page whose query is its script's own (/?solid=ID): any names, no control characters */
 };
 
 typedef struct {

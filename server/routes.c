@@ -498,7 +498,7 @@ const srv_route srv_routes[] = {
     { "readyz", "GET", "/readyz", get_readyz, 0 },
     { "version", "GET", "/version", get_version, 0 },
     { "metrics", "GET", "/metrics", get_metrics, 0 },
-    { "static", "GET", "*", srv_static_get, 0 },
+    { "static", "GET", "*", srv_static_get, SRV_RT_PAGE },
 };
 const int srv_nroutes = (int)(sizeof srv_routes / sizeof *srv_routes);
 
@@ -594,6 +594,13 @@ int srv_query_arg(const srv_route *rt, srv_query *q, const char *key, size_t kle
                   char *msg, size_t n)
 {
     size_t i = 0;
+    if (rt->flags & SRV_RT_PAGE) {
+        if (bad_text(key, klen) || (value && (bad_text(value, vlen) || strlen(value) != vlen))) {
+            snprintf(msg, n, "the query holds a control character or a NUL");
+            return -1;
+        }
+        return 0;
+    }
     if (rt->flags & SRV_RT_OUTPUT)
         for (; i < NPARAMS; i++)
             if (strlen(params[i].name) == klen && !memcmp(params[i].name, key, klen))

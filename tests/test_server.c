@@ -774,6 +774,32 @@ static void presets_version_health_metrics_and_cors_should_answer(void **state)
     stop(&d);
 }
 
+/* A share link (/?solid=ID, README "In the browser") is the page with a query of its own: the page's script
+ * reads it, so the server serves the page whatever the names; control characters are still refused. */
+static void the_page_should_take_a_query_of_its_own(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    const char *ok[] = { "/?solid=99268af08d93209af6cac24a6617fc90", "/?preset=fig4c", "/index.html?solid=x&y" };
+    for (size_t i = 0; i < sizeof ok / sizeof *ok; i++) {
+        reply r = http(&d, "GET", ok[i], NULL, 0, NULL);
+        char type[64] = "";
+        header_value(&r, "Content-Type", type, sizeof type);
+        if (r.status != 200 || !strstr(type, "text/html"))
+            fail_msg("GET %s: %ld %s", ok[i], r.status, type);
+        free(r.body);
+    }
+    reply r = http(&d, "GET", "/?solid=a%01b", NULL, 0, NULL);
+    expect_problem(&r, 400, NULL, "control character");
+    free(r.body);
+    /* The API's routes still refuse what they do not know. */
+    r = http(&d, "GET", "/presets?solid=1", NULL, 0, NULL);
+    expect_problem(&r, 400, NULL, "solid");
+    free(r.body);
+    stop(&d);
+}
+
 static void openapi_should_be_valid_and_name_every_route(void **state)
 {
     (void)state;
@@ -862,6 +888,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(the_cli_should_give_the_same_answers_through_the_server),
+        cmocka_unit_test(the_page_should_take_a_query_of_its_own),
         cmocka_unit_test(openapi_should_be_valid_and_name_every_route),
         cmocka_unit_test(solve_should_give_every_format_as_the_core_computes_it),
         cmocka_unit_test(eval_should_agree_with_the_cli),

@@ -692,10 +692,10 @@ function download(f) {
   a.remove();
 }
 
-// ---- share links: /#solid=ID reopens a solid from the request it came from ----
+// ---- share links: /?solid=ID reopens a solid from the request it came from ----
 const share = { link: '' };
 function updateLink() {
-  share.link = state.id ? `${location.origin}/#solid=${state.id}` : '';
+  share.link = state.id ? `${location.origin}/?solid=${state.id}` : '';
   ui.linkCtl?.updateDisplay();
 }
 async function copyLink() {
@@ -978,7 +978,7 @@ async function main() {
   });
   setupDrawer();
   el('fold').addEventListener('click', showFold);
-  // #solid=ID (or ?solid=ID, once pdesolidd lets a query reach its pages; today it answers 400) and #preset=NAME.
+  // ?solid=ID (the share link) and ?preset=NAME; the same after # too (a page's hash needs no reload to change).
   const q = new URLSearchParams(location.hash.slice(1) || location.search);
   window.addEventListener('hashchange', () => {
     const h = new URLSearchParams(location.hash.slice(1));

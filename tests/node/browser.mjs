@@ -90,7 +90,7 @@ if (flag === '--responsiveness') {
 if (flag === '--reopen') {
   const id = readFileSync(reopenFile, 'utf8').trim();
   await check('after a restart on the same store, the share link still opens the solid with its parameters', async () => {
-    await page.goto(`${base}/#solid=${id}`, { waitUntil: 'load' });
+    await page.goto(`${base}/?solid=${id}`, { waitUntil: 'load' });
     await solved(0);
     const s = await state();
     if (s.id !== id) throw new Error(`the link of ${id} opened ${s.id}`);
@@ -351,7 +351,7 @@ await check('a share link reopens the solid with its parameters; an unknown id s
   await p0.press('Enter');
   await solved(n);
   const s = await state();
-  if (!s.link.endsWith(`#solid=${s.id}`)) throw new Error(`link ${s.link} for ${s.id}`);
+  if (!s.link.endsWith(`/?solid=${s.id}`)) throw new Error(`link ${s.link} for ${s.id}`);
   await page.locator('[data-act="copy"] button').click();
   await page.waitForFunction(() => !document.getElementById('notice').hidden);
   const said = await page.textContent('#notice');
@@ -366,7 +366,7 @@ await check('a share link reopens the solid with its parameters; an unknown id s
   await other.screenshot({ path: `${out}/share-link.png` });
   await other.close();
   other = await browser.newPage({ viewport: { width: 1280, height: 800 } });
-  await other.goto(`${base}/#solid=00000000000000000000000000000000`, { waitUntil: 'load' });
+  await other.goto(`${base}/?solid=00000000000000000000000000000000`, { waitUntil: 'load' });
   await other.waitForFunction(() => window.pdesolid?.state.phase === 'ready', null, { timeout: 30000 });
   const unknown = await other.textContent('#notice');
   if (!/unknown to this server/.test(unknown)) throw new Error(`an unknown id said: ${unknown}`);
