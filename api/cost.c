@@ -246,6 +246,10 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
     double panels = 1.0, panel_n[3];
     for (int a = 0; a < 3; a++)
         panels *= panel_n[a] = fmax(1.0, (double)nq[a] / 12.0);
+    /* Where det J separates, the solid's integrals are over one face (core/quad.c). */
+    const int flat = pde_properties_flat_axis(sol);
+    if (flat >= 0)
+        nodes /= (double)nq[flat], panels /= panel_n[flat];
     double base = K_LINE_PT * nodes, refined = fmin(1.0, 96.0 / panels);
     double evals = base + fmin(K_REFINE * refined * base, QUAD_REFINE_WORK / (modes + 1.0));
     /* The skin: six faces of nodes, and the refinement of its first 256 panels, about

@@ -350,8 +350,8 @@ static int split_axis(const obj_model *m, const pbox *b)
     return best;
 }
 
-pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], double tol,
-                       size_t budget, const pde_cancel *cancel, bb_result *out)
+pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], const pbox *within,
+                       double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
 {
     bb_result r = { .lower = DBL_MAX, .boxes = 0 };
     pbox p0 = { { start[0], start[1], start[2] }, { start[0], start[1], start[2] } };
@@ -368,6 +368,12 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
     double val, at[3];
     for (size_t k = 0; k < nslabs; k++) {
         bb_node n = { { { 0, 0, br[k] }, { 1, 1, br[k + 1] } }, 0, -1 };
+        if (within) {
+            for (int a = 0; a < 3; a++)
+                n.b.lo[a] = fmax(n.b.lo[a], within->lo[a]), n.b.hi[a] = fmin(n.b.hi[a], within->hi[a]);
+            if (n.b.lo[2] > n.b.hi[2] || (n.b.lo[2] == n.b.hi[2] && within->lo[2] < within->hi[2]))
+                continue;   /* a slab outside within, or only touching it */
+        }
         obj_model m;
         n.lb = lower_model(s, what, sign, &n.b, &val, at, &m);
         n.axis = split_axis(&m, &n.b);
