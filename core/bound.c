@@ -95,25 +95,32 @@ static void series_mul(const double *a, const double *b, double *out, int K)
  */
 static void detj_series(const xjet *j, int K, int bound, double *out)
 {
-    static const double fact[4] = { 1, 1, 2, 6 };
+    /* For q < MI3: the index of q + e_a (mi), and n_u! n_v! n_w! of q. */
+    static const unsigned char up[3][MI3] = {
+        { 1, 4, 5, 6, 10, 11, 12, 13, 14, 15, 20, 21, 22, 23, 24, 25, 26, 27, 28, 29 },
+        { 2, 5, 7, 8, 11, 13, 14, 16, 17, 18, 21, 23, 24, 26, 27, 28, 30, 31, 32, 33 },
+        { 3, 6, 8, 9, 12, 14, 15, 17, 18, 19, 22, 24, 25, 27, 28, 29, 31, 32, 33, 34 }
+    };
+    static const double fact[MI3] = { 1, 1, 1, 1, 2, 1, 1, 2, 1, 2, 6, 2, 2, 2, 1, 2, 6, 2, 2, 6 };
     double e[3][3][MI3], t[MI3], p[MI3];
     for (int r = 0; r < 3; r++)
         for (int a = 0; a < 3; a++)
-            for (int q = 0; q < mi_count[K]; q++) {
-                int n[3] = { mi_u[q], mi_v[q], mi_w[q] };
-                double f = fact[n[0]] * fact[n[1]] * fact[n[2]];
-                n[a]++;
-                e[r][a][q] = j->d[r][mi(n)] / f;
-            }
+            for (int q = 0; q < mi_count[K]; q++)
+                e[r][a][q] = j->d[r][up[a][q]] / fact[q];
+    /* By cofactors along the first row: nine products of series, not twelve. */
+    const double sg = bound ? 1.0 : -1.0;
     for (int q = 0; q < mi_count[K]; q++)
         out[q] = 0.0;
-    static const int perm[6][3] = { { 0, 1, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 0, 2, 1 }, { 2, 1, 0 }, { 1, 0, 2 } };
-    for (int s = 0; s < 6; s++) {
-        series_mul(e[0][perm[s][0]], e[1][perm[s][1]], t, K);
-        series_mul(t, e[2][perm[s][2]], p, K);
-        const double sign = (bound || s < 3) ? 1.0 : -1.0;
+    for (int a = 0; a < 3; a++) {
+        const int b = (a + 1) % 3, c = (a + 2) % 3;
+        double minor[MI3];
+        series_mul(e[1][b], e[2][c], t, K);
+        series_mul(e[1][c], e[2][b], p, K);
         for (int q = 0; q < mi_count[K]; q++)
-            out[q] += sign * p[q];
+            minor[q] = t[q] + sg * p[q];
+        series_mul(e[0][a], minor, p, K);
+        for (int q = 0; q < mi_count[K]; q++)
+            out[q] += p[q];
     }
 }
 
