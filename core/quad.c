@@ -943,6 +943,7 @@ typedef struct {
     double tol;                  /* of a panel's refinement, absolute */
     const pde_cancel *cancel;
     int refined;                 /* panels refined so far */
+    int flat;                    /* the face parameter (0, 1) fixed at 1 where the face separates, or -1 */
     int stopped;
 } face_ctx;
 
@@ -994,8 +995,10 @@ static double face_panel(face_ctx *c, const double lo[2], const double h[2], dou
             cross[0] += sign_changes(sd[j][i], sd[j + 1][i], f->tol);
             cross[1] += sign_changes(sd[i][j], sd[i][j + 1], f->tol);
         }
-    f->la = cross[1] > cross[0];
-    const int lb = 1 - f->la, na = rule_points(c->f[f->la] * h[f->la]), nb = rule_points(c->f[lb] * h[lb]);
+    f->la = c->flat >= 0 ? 1 - c->flat : cross[1] > cross[0];
+    const int lb = 1 - f->la, na = rule_points(c->f[f->la] * h[f->la]);
+    const int nb = lb == c->flat ? 1 : rule_points(c->f[lb] * h[lb]);
+    const double hb = lb == c->flat ? 1.0 : h[lb];   /* a flat parameter: one point, weight 1 */
     const int ka = f->o[f->la], kb = f->o[lb];
     q->tab_ok = 0;
     tab_fill(q, f->axis, f->side, f->side, 0);
@@ -1008,8 +1011,8 @@ static double face_panel(face_ctx *c, const double lo[2], const double h[2], dou
     for (int i = 0; i < nb; i++) {
         idx[kb] = i + 1;
         line_set(q, ka, idx);
-        total += h[lb] * q->gw[nb][i] * face_line_integral(f, lo[f->la], lo[f->la] + h[f->la], na, q->gw[na], &fl);
-        *flux += h[lb] * q->gw[nb][i] * fl;
+        total += hb * q->gw[nb][i] * face_line_integral(f, lo[f->la], lo[f->la] + h[f->la], na, q->gw[na], &fl);
+        *flux += hb * q->gw[nb][i] * fl;
     }
     return total;
 }
@@ -1019,9 +1022,12 @@ static double face_refine(face_ctx *c, const double lo[2], const double h[2], do
 {
     if (!c->stopped && pde_stopped(c->cancel))
         c->stopped = 1;
-    double q[4], ql[4][2], hh[2] = { 0.5 * h[0], 0.5 * h[1] }, fine = 0.0;
+    double q[4] = { 0, 0, 0, 0 }, ql[4][2], fine = 0.0;
+    const double hh[2] = { c->flat == 0 ? h[0] : 0.5 * h[0], c->flat == 1 ? h[1] : 0.5 * h[1] };
     for (int k = 0; k < 4; k++) {
         ql[k][0] = lo[0] + (k & 1) * hh[0], ql[k][1] = lo[1] + (k >> 1) * hh[1];
+        if (c->flat >= 0 && (k >> c->flat & 1))
+            continue;   /* halves, not quarters, of a separable face */
         double fl;
         fine += q[k] = face_panel(c, ql[k], hh, &fl);
     }
@@ -1030,8 +1036,40 @@ static double face_refine(face_ctx *c, const double lo[2], const double h[2], do
         return fine;
     double sum = 0.0;
     for (int k = 0; k < 4; k++)
-        sum += face_refine(c, ql[k], hh, q[k], depth + 1);
+        if (c->flat < 0 || !(k >> c->flat & 1))
+            sum += face_refine(c, ql[k], hh, q[k], depth + 1);
     return sum;
+}
+
+/*
+ * Where det J separates along t (quad_separate), a face of another axis has the parameters t and p,
+ * and x_t x x_p = n t^(n-1) (t^n A(p) + B(p)): A from pairs of components with in = 1, B from
+ * pairs of one with in = 1 and one without, whose p-partials make it. With ns = 1, A = 0; with
+ * ns >= 2, B = 0 when every component with in = 0 is constant along p (p is u or v and its
+ * modes' factors of p are 1). Then the face's area is the integral along its line t = 1 times
+ * ascale (1/n: the integral of n t^(n-1); 1/(2n): of n t^(2n-1), each over n at t = 1), and its
+ * flux x . (x_t x x_p) the same times fscale (x_e adds t^n when e has in = 1: ns = 3).
+ * Returns the index (0, 1) of t among the face's parameters, or -1.
+ */
+static int face_separates(const pde_solution *s, const quad_sep *sp, int axis, double *ascale, double *fscale)
+{
+    if (sp->axis < 0 || axis == sp->axis)
+        return -1;
+    const int p = 3 - axis - sp->axis;   /* the face's other parameter */
+    const double n = sp->n;
+    if (sp->ns == 1) {
+        *ascale = *fscale = 1.0 / n;
+    } else {
+        for (int c = 0; c < 3; c++)
+            for (size_t m = 0; !sp->in[c] && m < s->comp[c].nmodes; m++) {
+                const pde_mode *md = &s->comp[c].modes[m];
+                if (p == 2 || (p == 0 ? md->u : md->v).kind != PDE_POW || (p == 0 ? md->u : md->v).p != 0)
+                    return -1;
+            }
+        *ascale = 1.0 / (2.0 * n);
+        *fscale = 1.0 / ((sp->ns == 2 ? 2.0 : 3.0) * n);
+    }
+    return sp->axis < p ? 0 : 1;
 }
 
 /*
@@ -1074,18 +1112,25 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
             if (axis == sp.axis && side == 0 && sp.ns >= 2)
                 continue;
             c->line = (face_line){ .q = q, .axis = axis, .side = side, .o = { o[0], o[1] } };
-            for (int pa = 0; pa < p.np[o[0]] && !c->stopped; pa++)
-                for (int pb = 0; pb < p.np[o[1]] && !c->stopped; pb++) {
+            double ascale = 1.0, fscale = 1.0, face = 0.0, fflux = 0.0;
+            c->flat = face_separates(s, &sp, axis, &ascale, &fscale);
+            const int npa = c->flat == 0 ? 1 : p.np[o[0]], npb = c->flat == 1 ? 1 : p.np[o[1]];
+            for (int pa = 0; pa < npa && !c->stopped; pa++)
+                for (int pb = 0; pb < npb && !c->stopped; pb++) {
                     const double *ea = p.edge[o[0]], *eb = p.edge[o[1]];
-                    const double lo[2] = { ea[pa], eb[pb] }, h[2] = { ea[pa + 1] - ea[pa], eb[pb + 1] - eb[pb] };
+                    double lo[2] = { ea[pa], eb[pb] }, h[2] = { ea[pa + 1] - ea[pa], eb[pb + 1] - eb[pb] };
+                    if (c->flat >= 0)   /* the line t = 1 of the face */
+                        lo[c->flat] = 1.0, h[c->flat] = 0.0;
                     if (pde_stopped(cancel))   /* a panel of a face */
                         c->stopped = 1;
                     double fl, a = face_panel(c, lo, h, &fl);
-                    /* Outward: side 1 along +axis; (o0, o1, axis) is odd for axis 1. */
-                    flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fl;
-                    total += c->refined++ >= FACE_REFINE || q->r.evals * q->modes >= REFINE_WORK
-                                 ? a : face_refine(c, lo, h, a, 0);
+                    fflux += fl;
+                    face += c->refined++ >= FACE_REFINE || q->r.evals * q->modes >= REFINE_WORK
+                                ? a : face_refine(c, lo, h, a, 0);
                 }
+            /* Outward: side 1 along +axis; (o0, o1, axis) is odd for axis 1. */
+            flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fscale * fflux;
+            total += ascale * face;
         }
     }
     pde_status st = c->stopped ? PDE_ERR_CANCELLED : PDE_OK;
