@@ -21,6 +21,11 @@
  *    figures (fig. 4a: 8.15592346144658 against 8.15592346144647 computed
  *    with 160 digits).
  *
+ * Where det J separates along u or v (quad_separate: det J = n t^p G), all of
+ * this runs on the face t = 1 alone, the flat axis (n 0: one point, weight 1),
+ * and the integrals over t are exact (separable_moments); so do the skin's
+ * faces whose element separates too (face_separates).
+ *
  * Each panel tabulates every mode's factor of each axis at its rules' points
  * once (axis_tab), so a point on a line is four multiply-adds per mode; only
  * roots, dips and the rules of pieces between roots evaluate factors afresh.
