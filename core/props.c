@@ -445,6 +445,7 @@ static double integral_error(const quad_result *q, const quad_result *qa)
     double e = fabs(q->acc[Q_SIGNED] - qa->acc[Q_SIGNED]) / vol;
     if (q->lined)
         e += 1e-12;   /* the refinement's tolerance where det J may change sign */
+    e += q->refine_left / vol;   /* boxes whose last refinement still changed their volume */
     if (q->unrefined)
         e += q->refined ? q->unrefined * q->refine_change / q->refined / vol : 1e-4;
     if (q->roots_skipped || qa->roots_skipped)

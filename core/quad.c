@@ -52,6 +52,11 @@
 #define OFF_WORK MAX_WORK   /* points off the tables times (modes + 1), at most */
 #define REFINE_WORK (2 * MAX_WORK)   /* points times modes after which no panel is refined */
 #define REFINE_PANELS 96      /* panels refined, at most: fig. 4's 24 to 72, not fig. 3's 1024 */
+/* The same where det J separates (quad_separate): a face's quadrants cost a quarter of a box's
+ * octants, so every panel is refined, deeper: fig. 3b's volume came within 1e-11 of the reference
+ * at four halvings (7e-7 at two, within 96 panels). */
+#define FLAT_DEPTH 4
+#define FLAT_PANELS ((size_t)-1)
 
 /* The panels: their edges along each axis, the points of each axis's rule, and its estimated error. */
 typedef struct {
@@ -78,6 +83,8 @@ typedef struct {
     double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];   /* n-point rules on [0, 1] */
     int n[3];                    /* the current panel's points per axis (0: the flat axis) */
     int flat;                    /* the axis fixed at 1 (quad_separate), or -1 */
+    int max_depth;               /* OUTER_DEPTH, or FLAT_DEPTH with a flat axis */
+    size_t max_panels;           /* REFINE_PANELS, or FLAT_PANELS */
     size_t off[3], mt;           /* modes of the components before c; modes in all */
     axis_tab tab[3];             /* the current panel's factors */
     pbox tab_box;                /* the box of the tables when tab_ok (tabs_for) */
@@ -505,10 +512,10 @@ static void panel_lines(qctx *q, const pbox *b, int k, int definite, double acc[
  * set tangentially. So the box's result is checked against the sum over its eight octants, each
  * with lines along its own best axis (in a small box the zero set is nearly flat, and the lines
  * cross it rather than touch it) and a rule sized to it; octants are refined the same way where
- * the two differ by more than 1e-12 of the solid's volume, down to OUTER_DEPTH halvings. Lines
+ * the two differ by more than 1e-12 of the solid's volume, down to OUTER_DEPTH halvings (FLAT_DEPTH). Lines
  * that all cross the zero set the same number of times do not show that nothing was missed: a
  * narrow lobe of det J near tangency can lie between samples (fig. 4b), so every such panel is
- * refined, within REFINE_PANELS.
+ * refined, within REFINE_PANELS (FLAT_PANELS).
  */
 static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int depth, double out[Q_N])
 {
@@ -541,7 +548,10 @@ static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int dep
         for (int e = 0; e < Q_N; e++)
             fine[e] += part[s][e];
     }
-    if (depth + 1 >= OUTER_DEPTH || q->stopped || q->r.evals * q->modes >= REFINE_WORK || fabs(fine[Q_VOL] - coarse[Q_VOL]) <= 1e-12 * q->vscale) {
+    const int agreed = fabs(fine[Q_VOL] - coarse[Q_VOL]) <= 1e-12 * q->vscale;
+    if (depth + 1 >= q->max_depth || q->stopped || q->r.evals * q->modes >= REFINE_WORK || agreed) {
+        if (!agreed)
+            q->r.refine_left += fabs(fine[Q_VOL] - coarse[Q_VOL]);
         memcpy(out, fine, sizeof fine);
         memcpy(q->n, saved_n, sizeof saved_n);
         return;
@@ -577,7 +587,7 @@ static void panel(qctx *q, const pbox *b)
     double acc[Q_N];
     panel_lines(q, b, k, definite, acc);
     /* Refined within a budget: the first REFINE_PANELS panels where det J may change sign. */
-    if (!definite && q->r.lined <= REFINE_PANELS && q->r.evals * q->modes < REFINE_WORK) {
+    if (!definite && q->r.lined <= q->max_panels && q->r.evals * q->modes < REFINE_WORK) {
         double refined[Q_N];
         box_refine(q, b, acc, 0, refined);
         q->r.refined++;
@@ -718,6 +728,8 @@ static qctx *qctx_new(const pde_solution *s, const pde_cancel *cancel)
     q->s = s;
     q->cancel = cancel;
     q->flat = -1;
+    q->max_depth = OUTER_DEPTH;
+    q->max_panels = REFINE_PANELS;
     q->modes = q->mt + 1;
     for (int k = 1; k <= GMAX; k++)
         gauss_legendre(k, q->gx[k], q->gw[k]);
@@ -794,6 +806,8 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     plan_for(s, 5.0, &p);
     if (sp.axis >= 0) {   /* the face t = 1 alone: one panel along the flat axis, no rule */
         q->flat = sp.axis;
+        q->max_depth = FLAT_DEPTH;
+        q->max_panels = FLAT_PANELS;
         p.np[sp.axis] = 1, p.n[sp.axis] = 0;
         p.edge[sp.axis][0] = p.edge[sp.axis][1] = 1.0;
     } else

@@ -19,6 +19,8 @@ typedef struct {
                          * work's bound made them coarser */
     size_t refined, unrefined;   /* lined panels refined, and left unrefined by the work's bound */
     double refine_change;        /* the sum of what refinement changed of the refined panels' volume */
+    double refine_left;          /* the sum of |fine - coarse| of the volume over boxes whose refinement
+                                  * stopped at its depth (or the work's bound) before it agreed */
     int roots_skipped;  /* the work's bound stopped lines locating det J's roots (or the area's) */
 } quad_result;
 

@@ -708,10 +708,12 @@ static void props_should_match_the_160_digit_volume_of_fig4a_which_folds(void **
 /* pde_properties against the reference: every integral to 1e-9, inertia relative to its largest entry. */
 static void expect_props_match_reference(const char *name, const pde_props *p, const ref_props_out *r)
 {
-    /* A known shortfall, which issue 9 leaves open (its notes): fig. 3's sin(20 pi v) to
-     * sin(30 pi v) fold in up to 1024 panels, beyond core/quad.c's budget of refined panels: fig. 3a
-     * within 3e-8, fig. 3b 8.6e-7 (run under the sanitisers with PDESOLID_SLOW_TESTS=1). */
-    const double tol = strncmp(name, "fig3", 4) == 0 ? 2e-6 : 1e-9, area_tol = 1e-6;
+    /* A known shortfall, which issue 9 leaves open (its notes): fig. 3c and 3d's sin(8 pi v) to
+     * sin(14 pi v) fold in up to 1024 panels, beyond core/quad.c's budget of refined panels (fig. 3b
+     * was 8.6e-7 off so). Fig. 3a and 3b separate (det J = u G(v, w)): every panel of the face u = 1
+     * is refined, and they come within 3e-11 (run under the sanitisers with PDESOLID_SLOW_TESTS=1). */
+    const int fig3_3d = strcmp(name, "fig3c") == 0 || strcmp(name, "fig3d") == 0;
+    const double tol = fig3_3d ? 2e-6 : 1e-9, area_tol = 1e-6;
     double imax = 0, size = cbrt(r->volume);
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
