@@ -250,7 +250,8 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
     const int flat = pde_properties_flat_axis(sol);
     if (flat >= 0)
         nodes /= (double)nq[flat], panels /= panel_n[flat];
-    double base = K_LINE_PT * nodes, refined = fmin(1.0, 96.0 / panels);
+    /* Where det J separates, every panel is refined (core/quad.c's FLAT_PANELS, FACE_REFINE). */
+    double base = K_LINE_PT * nodes, refined = flat >= 0 ? 1.0 : fmin(1.0, 96.0 / panels);
     double evals = base + fmin(K_REFINE * refined * base, QUAD_REFINE_WORK / (modes + 1.0));
     /* The skin: six faces of nodes, and the refinement of its first 256 panels, about
      * K_AREA_REFINE times their own work, within the same bound. */
@@ -258,7 +259,7 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
                                (double)nq[0] * (double)nq[2]);
     double face_panels = 2.0 * (panel_n[0] * panel_n[1] + panel_n[1] * panel_n[2] + panel_n[0] * panel_n[2]);
     double fbase = K_LINE_PT * face_nodes;
-    evals += fbase + fmin(K_AREA_REFINE * fmin(1.0, 256.0 / face_panels) * fbase, QUAD_REFINE_WORK / (modes + 1.0));
+    evals += fbase + fmin(K_AREA_REFINE * (flat >= 0 ? 1.0 : fmin(1.0, 256.0 / face_panels)) * fbase, QUAD_REFINE_WORK / (modes + 1.0));
     w += evals * (K_Q_POINT + K_Q_MODE * (modes + 1.0));
     /* Boundary residual: per component, bres^2 points at w = 0 and 1 (each a full pde_eval_d). */
     w += 3.0 * bres * bres * 2.0 * pt;
