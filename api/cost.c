@@ -246,7 +246,12 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
     double panels = 1.0, panel_n[3];
     for (int a = 0; a < 3; a++)
         panels *= panel_n[a] = fmax(1.0, (double)nq[a] / 12.0);
-    double base = K_LINE_PT * nodes, refined = fmin(1.0, 96.0 / panels);
+    /* Where det J separates, the solid's integrals are over one face (core/quad.c). */
+    const int flat = pde_properties_flat_axis(sol);
+    if (flat >= 0)
+        nodes /= (double)nq[flat], panels /= panel_n[flat];
+    /* Where det J separates, every panel is refined (core/quad.c's FLAT_PANELS, FACE_REFINE). */
+    double base = K_LINE_PT * nodes, refined = flat >= 0 ? 1.0 : fmin(1.0, 96.0 / panels);
     double evals = base + fmin(K_REFINE * refined * base, QUAD_REFINE_WORK / (modes + 1.0));
     /* The skin: six faces of nodes, and the refinement of its first 256 panels, about
      * K_AREA_REFINE times their own work, within the same bound. */
@@ -254,7 +259,7 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
                                (double)nq[0] * (double)nq[2]);
     double face_panels = 2.0 * (panel_n[0] * panel_n[1] + panel_n[1] * panel_n[2] + panel_n[0] * panel_n[2]);
     double fbase = K_LINE_PT * face_nodes;
-    evals += fbase + fmin(K_AREA_REFINE * fmin(1.0, 256.0 / face_panels) * fbase, QUAD_REFINE_WORK / (modes + 1.0));
+    evals += fbase + fmin(K_AREA_REFINE * (flat >= 0 ? 1.0 : fmin(1.0, 256.0 / face_panels)) * fbase, QUAD_REFINE_WORK / (modes + 1.0));
     w += evals * (K_Q_POINT + K_Q_MODE * (modes + 1.0));
     /* Boundary residual: per component, bres^2 points at w = 0 and 1 (each a full pde_eval_d). */
     w += 3.0 * bres * bres * 2.0 * pt;
@@ -262,9 +267,10 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
     for (int i = 0; i < 3; i++)
         w += rres * rres * rres * (st[i].d4 + 2.0 * st[i].d0 + 3.0 * (st[i].fu + st[i].fv));
     c->work = w;
-    /* core/quad.c's factor tables: each axis's values and derivatives at up to 26 points per mode. */
+    /* core/quad.c's factor tables: each axis's values and derivatives at up to 26 points per mode;
+     * core/bound.c's memo of factors (3 axes x 256 slots x 5 doubles per mode, up to 64 modes). */
     c->bytes = grid_bytes(st, res, res) + 64.0 * (PDE_PROPS_BOXES + PDE_PROPS_BOXES_J) + 64.0 * modes + 65536.0 +
-               8.0 * (6.0 * 26.0 + 5.0) * (modes + 1.0);
+               8.0 * (6.0 * 26.0 + 5.0) * (modes + 1.0) + (modes <= 64.0 ? 3.0 * 256.0 * 5.0 * 8.0 * modes : 0.0);
 }
 
 /* ---- outputs ---- */

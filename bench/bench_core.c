@@ -14,6 +14,9 @@
  *   bench_core                    the tables for docs/BENCHMARKS.md
  *   bench_core --solve NAME N     only N solves of the preset NAME, for instruction counts:
  *     valgrind --tool=callgrind build/bench/bench_core --solve fig4a 1000
+ *   bench_core --props NAME N     N calls of pde_properties() on NAME's solution, then its
+ *                                 properties in 17 digits, the median time of the calls:
+ *     valgrind --tool=callgrind --toggle-collect=pde_properties build/bench/bench_core --props fig4a 1
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -163,6 +166,33 @@ static void bench_sample(const char *name, size_t n)
     api_model_free(m);
 }
 
+/* bench_core --props NAME N */
+static int props_one(const char *name, long n)
+{
+    api_model *m = load(name);
+    pde_solution *s;
+    if (!m || n < 1 || n > 1000 || pde_solve(api_model_get(m), &s, NULL) != PDE_OK)
+        return 1;
+    double t[1000];
+    pde_props p;
+    for (long k = 0; k < n; k++) {
+        double t0 = now();
+        if (pde_properties(s, NULL, &p) != PDE_OK)
+            return 1;
+        t[k] = 1e6 * (now() - t0);
+    }
+    printf("%s: %.0f us (median of %ld), det J separates along axis %d\nvolume %.17g\nsigned %.17g\narea %.17g\ncentroid %.17g %.17g %.17g\n",
+           name, median(t, (int)n), n, pde_properties_flat_axis(s), p.volume, p.signed_volume, p.surface_area, p.centroid[0], p.centroid[1],
+           p.centroid[2]);
+    printf("inertia %.17g %.17g %.17g %.17g %.17g %.17g\ndetj [%.17g, %.17g] found [%.17g, %.17g] gap %.3g folds %d\n"
+           "integrals %.3g\n", p.inertia[0][0], p.inertia[1][1], p.inertia[2][2], p.inertia[0][1], p.inertia[0][2],
+           p.inertia[1][2], p.detj_min, p.detj_max, p.detj_min_found, p.detj_max_found, p.detj_gap, p.folds,
+           p.integral_error);
+    pde_solution_free(s);
+    api_model_free(m);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 4 && strcmp(argv[1], "--solve") == 0) {
@@ -178,6 +208,8 @@ int main(int argc, char **argv)
         api_model_free(m);
         return 0;
     }
+    if (argc == 4 && strcmp(argv[1], "--props") == 0)
+        return props_one(argv[2], atol(argv[3]));
     char *names[] = { "fig1a", "fig1c", "fig1e", "fig1g", "fig2a", "fig2b", "fig2c", "fig3a", "fig3b",
                       "fig3c", "fig3d", "fig4a", "fig4b", "fig4c", "fig4d", "fig4e", "fig4f", "fig4g",
                       "fig4h", "fig4i", "fig4j", "fig4k", "fig4l", "fig4m", "fig4n", "fig4o", "fig4p",

@@ -4,7 +4,9 @@
  */
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "bound.h"
 
@@ -29,15 +31,98 @@ typedef struct {
     double d[3][MIN];
 } xjet;
 
-/* bound = 0: x's partials up to order at the point b->lo; 1: bounds of their magnitudes over b. */
-static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, xjet *j)
+/*
+ * A branch and bound's memo of every mode's factor derivatives (at a point) or their bounds (over
+ * an interval) along each axis: a box's two halves share its intervals and centres along the two
+ * axes not split, so most of a box's factors were evaluated for its parent (core/bound.c's
+ * bb_minimise). Direct-mapped by the interval; only for solutions of at most JC_MODES modes.
+ */
+enum { JC_N = 256, JC_MODES = 64 };   /* at most 3 * 256 * 5 * 64 doubles, 2 MB; fig. 4: 150 kB */
+
+typedef struct {
+    double lo, hi;
+    int order, bound;   /* order -1: empty */
+} jc_key;
+
+typedef struct jet_cache {
+    size_t mt;
+    jc_key key[3][JC_N];
+    double val[];   /* axis a, slot i: val + (a * JC_N + i) * 5 mt */
+} jet_cache;
+
+static jet_cache *jet_cache_new(const pde_solution *s)
+{
+    size_t mt = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes;
+    if (mt > JC_MODES)
+        return NULL;
+    jet_cache *jc = malloc(sizeof *jc + 3 * JC_N * 5 * mt * sizeof *jc->val);
+    if (!jc)
+        return NULL;   /* no memo: slower, not wrong */
+    jc->mt = mt;
+    for (int a = 0; a < 3; a++)
+        for (int i = 0; i < JC_N; i++)
+            jc->key[a][i].order = -1;
+    return jc;
+}
+
+/* Every mode's factor of axis a, derivatives 0..order at lo (bound 0) or their bounds over [lo, hi],
+ * five per mode, modes of the components in order; from the memo when it holds them. */
+static const double *axis_factors(const pde_solution *s, jet_cache *jc, int a, double lo, double hi, int order,
+                                  int bound)
+{
+    uint64_t kl, kh;
+    memcpy(&kl, &lo, sizeof kl);
+    memcpy(&kh, &hi, sizeof kh);
+    const uint64_t hsh = (kl * 0x9E3779B97F4A7C15u) ^ (kh * 0xC2B2AE3D27D4EB4Fu) ^ (uint64_t)(order * 2 + bound);
+    const size_t slot = (size_t)(hsh >> 56);   /* JC_N = 256 */
+    jc_key *k = &jc->key[a][slot];
+    double *out = jc->val + ((size_t)a * JC_N + slot) * 5 * jc->mt;
+    if (k->order == order && k->bound == bound && k->lo == lo && k->hi == hi)
+        return out;
+    *k = (jc_key){ lo, hi, order, bound };
+    size_t o = 0;
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes; m++, o++) {
+            const pde_mode *md = &s->comp[c].modes[m];
+            double *d = out + 5 * o;
+            if (a == 2)
+                bound ? mode_h_bounds(md, lo, hi, order, d) : mode_h_derivs(md, lo, order, d);
+            else
+                bound ? factor_bounds(a ? md->v : md->u, lo, hi, order, d)
+                      : factor_derivs(a ? md->v : md->u, lo, order, d);
+        }
+    return out;
+}
+
+/* Adds one mode's products of factors fu, fv, h (derivatives or bounds) to component c of j. */
+static void jet_add(xjet *j, int c, int n, const double *fu, const double *fv, const double *h)
+{
+    for (int q = 0; q < n; q++) {
+        /* A factor that is exactly 0 makes the term 0, even beside an overflowed bound. */
+        double p = fu[mi_u[q]], r = fv[mi_v[q]], e = h[mi_w[q]];
+        j->d[c][q] += (p == 0.0 || r == 0.0 || e == 0.0) ? 0.0 : p * r * e;
+    }
+}
+
+/* bound = 0: x's partials up to order at the point b->lo; 1: bounds of their magnitudes over b.
+ * jc: a branch and bound's memo, or NULL. */
+static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, jet_cache *jc, xjet *j)
 {
     const int n = mi_count[order];
+    const double *F[3] = { NULL, NULL, NULL };
+    if (jc)
+        for (int a = 0; a < 3; a++)
+            F[a] = axis_factors(s, jc, a, b->lo[a], bound ? b->hi[a] : b->lo[a], order, bound);
+    size_t o = 0;
     for (int c = 0; c < 3; c++) {
         const comp_solution *cs = &s->comp[c];
         for (int q = 0; q < n; q++)
             j->d[c][q] = 0.0;
-        for (size_t m = 0; m < cs->nmodes; m++) {
+        for (size_t m = 0; m < cs->nmodes; m++, o++) {
+            if (jc) {
+                jet_add(j, c, n, F[0] + 5 * o, F[1] + 5 * o, F[2] + 5 * o);
+                continue;
+            }
             const pde_mode *md = &cs->modes[m];
             double fu[5], fv[5], h[5];
             if (bound) {
@@ -49,11 +134,7 @@ static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound
                 factor_derivs(md->v, b->lo[1], order, fv);
                 mode_h_derivs(md, b->lo[2], order, h);
             }
-            for (int q = 0; q < n; q++) {
-                /* A factor that is exactly 0 makes the term 0, even beside an overflowed bound. */
-                double p = fu[mi_u[q]], r = fv[mi_v[q]], e = h[mi_w[q]];
-                j->d[c][q] += (p == 0.0 || r == 0.0 || e == 0.0) ? 0.0 : p * r * e;
-            }
+            jet_add(j, c, n, fu, fv, h);
         }
     }
 }
@@ -95,37 +176,45 @@ static void series_mul(const double *a, const double *b, double *out, int K)
  */
 static void detj_series(const xjet *j, int K, int bound, double *out)
 {
-    static const double fact[4] = { 1, 1, 2, 6 };
+    /* For q < MI3: the index of q + e_a (mi), and n_u! n_v! n_w! of q. */
+    static const unsigned char up[3][MI3] = {
+        { 1, 4, 5, 6, 10, 11, 12, 13, 14, 15, 20, 21, 22, 23, 24, 25, 26, 27, 28, 29 },
+        { 2, 5, 7, 8, 11, 13, 14, 16, 17, 18, 21, 23, 24, 26, 27, 28, 30, 31, 32, 33 },
+        { 3, 6, 8, 9, 12, 14, 15, 17, 18, 19, 22, 24, 25, 27, 28, 29, 31, 32, 33, 34 }
+    };
+    static const double fact[MI3] = { 1, 1, 1, 1, 2, 1, 1, 2, 1, 2, 6, 2, 2, 2, 1, 2, 6, 2, 2, 6 };
     double e[3][3][MI3], t[MI3], p[MI3];
     for (int r = 0; r < 3; r++)
         for (int a = 0; a < 3; a++)
-            for (int q = 0; q < mi_count[K]; q++) {
-                int n[3] = { mi_u[q], mi_v[q], mi_w[q] };
-                double f = fact[n[0]] * fact[n[1]] * fact[n[2]];
-                n[a]++;
-                e[r][a][q] = j->d[r][mi(n)] / f;
-            }
+            for (int q = 0; q < mi_count[K]; q++)
+                e[r][a][q] = j->d[r][up[a][q]] / fact[q];
+    /* By cofactors along the first row: nine products of series, not twelve. */
+    const double sg = bound ? 1.0 : -1.0;
     for (int q = 0; q < mi_count[K]; q++)
         out[q] = 0.0;
-    static const int perm[6][3] = { { 0, 1, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 0, 2, 1 }, { 2, 1, 0 }, { 1, 0, 2 } };
-    for (int s = 0; s < 6; s++) {
-        series_mul(e[0][perm[s][0]], e[1][perm[s][1]], t, K);
-        series_mul(t, e[2][perm[s][2]], p, K);
-        const double sign = (bound || s < 3) ? 1.0 : -1.0;
+    for (int a = 0; a < 3; a++) {
+        const int b = (a + 1) % 3, c = (a + 2) % 3;
+        double minor[MI3];
+        series_mul(e[1][b], e[2][c], t, K);
+        series_mul(e[1][c], e[2][b], p, K);
         for (int q = 0; q < mi_count[K]; q++)
-            out[q] += sign * p[q];
+            minor[q] = t[q] + sg * p[q];
+        series_mul(e[0][a], minor, p, K);
+        for (int q = 0; q < mi_count[K]; q++)
+            out[q] += p[q];
     }
 }
 
-void obj_model_at(const pde_solution *s, int what, const pbox *b, obj_model *m)
+/* obj_model_at with a branch and bound's memo jc (or NULL). */
+static void model_at(const pde_solution *s, int what, const pbox *b, jet_cache *jc, obj_model *m)
 {
     pbox c;
     for (int a = 0; a < 3; a++)
         c.lo[a] = c.hi[a] = 0.5 * (b->lo[a] + b->hi[a]);
     const int order = what < 3 ? 2 : 3;
     xjet pt, mx;
-    xjet_fill(s, &c, order, 0, &pt);
-    xjet_fill(s, b, order + 1, 1, &mx);
+    xjet_fill(s, &c, order, 0, jc, &pt);
+    xjet_fill(s, b, order + 1, 1, jc, &mx);
     /* Taylor coefficients: the value, the gradient, the Hessian at the centre, the third-order bound. */
     double tp[MI3], tb[MI3];
     if (what < 3) {
@@ -160,11 +249,16 @@ void obj_model_at(const pde_solution *s, int what, const pbox *b, obj_model *m)
     }
 }
 
+void obj_model_at(const pde_solution *s, int what, const pbox *b, obj_model *m)
+{
+    model_at(s, what, b, NULL, m);
+}
+
 double obj_magnitude(const pde_solution *s, int what)
 {
     const pbox cube = { { 0, 0, 0 }, { 1, 1, 1 } };
     xjet mx;
-    xjet_fill(s, &cube, 1, 1, &mx);
+    xjet_fill(s, &cube, 1, 1, NULL, &mx);
     if (what < 3)
         return mx.d[what][0];
     double t[MI3];
@@ -238,12 +332,12 @@ static double cubic_rest(const obj_model *m, const double r[3])
 
 /* obj_lower, leaving the final box's model in *mp. */
 static double lower_model(const pde_solution *s, int what, double sign, pbox *b, double *val, double at[3],
-                          obj_model *mp)
+                          jet_cache *jc, obj_model *mp)
 {
     obj_model m;
     double r[3], spread[3];
     for (int pass = 0;; pass++) {
-        obj_model_at(s, what, b, &m);
+        model_at(s, what, b, jc, &m);
         for (int k = 0; k < 3; k++)
             r[k] = 0.5 * (b->hi[k] - b->lo[k]);
         if (pass == 3)
@@ -279,7 +373,7 @@ static double lower_model(const pde_solution *s, int what, double sign, pbox *b,
 double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *val, double at[3])
 {
     obj_model m;
-    return lower_model(s, what, sign, b, val, at, &m);
+    return lower_model(s, what, sign, b, val, at, NULL, &m);
 }
 
 /* ---- branch and bound ---- */
@@ -350,13 +444,14 @@ static int split_axis(const obj_model *m, const pbox *b)
     return best;
 }
 
-pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], double tol,
-                       size_t budget, const pde_cancel *cancel, bb_result *out)
+pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], const pbox *within,
+                       double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
 {
     bb_result r = { .lower = DBL_MAX, .boxes = 0 };
     pbox p0 = { { start[0], start[1], start[2] }, { start[0], start[1], start[2] } };
     obj_model m0;
-    obj_model_at(s, what, &p0, &m0);
+    jet_cache *jc = jet_cache_new(s);   /* NULL: without the memo */
+    model_at(s, what, &p0, jc, &m0);
     r.best = sign * m0.v;
     for (int k = 0; k < 3; k++)
         r.at[k] = start[k];
@@ -368,14 +463,21 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
     double val, at[3];
     for (size_t k = 0; k < nslabs; k++) {
         bb_node n = { { { 0, 0, br[k] }, { 1, 1, br[k + 1] } }, 0, -1 };
+        if (within) {
+            for (int a = 0; a < 3; a++)
+                n.b.lo[a] = fmax(n.b.lo[a], within->lo[a]), n.b.hi[a] = fmin(n.b.hi[a], within->hi[a]);
+            if (n.b.lo[2] > n.b.hi[2] || (n.b.lo[2] == n.b.hi[2] && within->lo[2] < within->hi[2]))
+                continue;   /* a slab outside within, or only touching it */
+        }
         obj_model m;
-        n.lb = lower_model(s, what, sign, &n.b, &val, at, &m);
+        n.lb = lower_model(s, what, sign, &n.b, &val, at, jc, &m);
         n.axis = split_axis(&m, &n.b);
         r.boxes++;
         if (val < r.best)
             r.best = val, r.at[0] = at[0], r.at[1] = at[1], r.at[2] = at[2];
         if (heap_push(&h, &n)) {
             free(h.a);
+            free(jc);
             return PDE_ERR_NOMEM;
         }
     }
@@ -402,7 +504,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
             else
                 c.b.hi[k] = mid;
             obj_model m;
-            c.lb = lower_model(s, what, sign, &c.b, &val, at, &m);
+            c.lb = lower_model(s, what, sign, &c.b, &val, at, jc, &m);
             c.axis = split_axis(&m, &c.b);
             r.boxes++;
             if (val < r.best)
@@ -423,6 +525,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
         r.lower = fmin(r.lower, h.a[0].lb);
     r.lower = fmin(r.lower, r.best);
     free(h.a);
+    free(jc);
     if (st == PDE_OK)
         *out = r;
     return st;

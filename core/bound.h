@@ -53,11 +53,11 @@ typedef struct {
 } bb_result;
 
 /*
- * Minimises sign * f over the unit cube by branch and bound, from a known point start, until the
- * gap best - lower is at most tol or `budget` boxes have been bounded. stop() is polled every
- * 16 boxes; returns PDE_ERR_CANCELLED then.
+ * Minimises sign * f over the box within (NULL: the unit cube; it may be flat, a face) by branch and
+ * bound, from a known point start in it, until the gap best - lower is at most tol or `budget` boxes
+ * have been bounded. stop() is polled every 16 boxes; returns PDE_ERR_CANCELLED then.
  */
-pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], double tol,
-                       size_t budget, const pde_cancel *cancel, bb_result *out);
+pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], const pbox *within,
+                       double tol, size_t budget, const pde_cancel *cancel, bb_result *out);
 
 #endif

@@ -333,4 +333,8 @@ pde_status pde_properties(const pde_solution *sol, const pde_props_opts *opts, p
 /* The Gauss-Legendre nodes per axis that pde_properties() integrates over (for api/cost.h). */
 void pde_properties_nodes(const pde_solution *sol, size_t nodes[3]);
 
+/* The axis (0: u, 1: v) along which det J separates, so that pde_properties() integrates the solid
+ * over the face of that axis at 1 alone (docs/MATH.md, "Separable solids"), or -1 (for api/cost.h). */
+int pde_properties_flat_axis(const pde_solution *sol);
+
 #endif

@@ -336,6 +336,13 @@ void pde_properties_nodes(const pde_solution *s, size_t nodes[3])
         nodes[a] = (size_t)np[a] * (size_t)n[a];
 }
 
+int pde_properties_flat_axis(const pde_solution *s)
+{
+    quad_sep sp;
+    quad_separate(s, &sp);
+    return sp.axis;
+}
+
 /*
  * Eigenvalues (ascending) and unit eigenvectors (rows) of a symmetric 3 x 3 matrix, by cyclic
  * Jacobi rotations (Golub and Van Loan, section 8.5): accurate to rounding for every spectrum.
@@ -438,6 +445,7 @@ static double integral_error(const quad_result *q, const quad_result *qa)
     double e = fabs(q->acc[Q_SIGNED] - qa->acc[Q_SIGNED]) / vol;
     if (q->lined)
         e += 1e-12;   /* the refinement's tolerance where det J may change sign */
+    e += q->refine_left / vol;   /* boxes whose last refinement still changed their volume */
     if (q->unrefined)
         e += q->refined ? q->unrefined * q->refine_change / q->refined / vol : 1e-4;
     if (q->roots_skipped || qa->roots_skipped)
@@ -448,6 +456,33 @@ static double integral_error(const quad_result *q, const quad_result *qa)
     if (rules > 1e-10)
         e = fmax(e, rules);
     return e == e ? fmin(e, 1.0) : 1.0;
+}
+
+/*
+ * The extreme of sign * det J where det J separates (quad.h: det J = t^p D1, D1 det J on the face
+ * t = 1, p = n ns - 1): branch and bound over that face alone, a 2-D problem, then over t exactly:
+ * t^p is 1 when p = 0, else it spans [0, 1], so the minimum is min(D1's, 0), attained at t = 0 when
+ * it is 0. Without this, the 3-D branch and bound meets det J = 0 on the whole face t = 0, where
+ * its Taylor models never close the gap.
+ */
+static pde_status detj_separable(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
+                                 double tol, const pde_cancel *cancel, bb_result *out)
+{
+    pbox face = { { 0, 0, 0 }, { 1, 1, 1 } };
+    face.lo[sp->axis] = 1.0;
+    double at[3] = { start[0], start[1], start[2] };
+    at[sp->axis] = 1.0;
+    bb_result b;
+    pde_status st = bb_minimise(s, OBJ_DETJ, sign, at, &face, tol, PDE_PROPS_BOXES_J, cancel, &b);
+    if (st != PDE_OK)
+        return st;
+    if (sp->n * sp->ns > 1) {
+        b.lower = fmin(b.lower, 0.0);
+        if (b.best >= 0.0)
+            b.best = 0.0, b.at[sp->axis] = 0.0;
+    }
+    *out = b;
+    return PDE_OK;
 }
 
 pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde_props *out)
@@ -505,16 +540,22 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     if (!(jscale > 0.0))
         jscale = 1.0;
     /* Certify each extreme from its polished point. */
+    quad_sep sp;
+    quad_separate(s, &sp);
     for (int o = 0; o < 8; o++) {
         const int what = o < 6 ? o / 2 : 3;
         const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
         bb_result b;
-        if ((st = bb_minimise(s, what, sign, at[o], tol, o < 6 ? PDE_PROPS_BOXES : PDE_PROPS_BOXES_J, cancel, &b)) != PDE_OK)
+        if (what == 3 && sp.axis >= 0) {
+            if ((st = detj_separable(s, &sp, sign, at[o], tol, cancel, &b)) != PDE_OK)
+                return st;
+        } else if ((st = bb_minimise(s, what, sign, at[o], NULL, tol, o < 6 ? PDE_PROPS_BOXES : PDE_PROPS_BOXES_J,
+                                     cancel, &b)) != PDE_OK)
             return st;
         /* The bound holds for the exact closed form; evaluated values may differ by their rounding. */
         const double pad = 64.0 * DBL_EPSILON * obj_magnitude(s, what);
         const double bound = sign * (b.lower - pad), gap = b.best - b.lower + pad;
-        best[o] = sign * b.best;
+        best[o] = sign * b.best + 0.0;   /* + 0: no -0 */
         if (o < 6) {
             (o & 1 ? r.bbox_max : r.bbox_min)[what] = bound;
             r.bbox_gap = fmax(r.bbox_gap, gap);
@@ -536,7 +577,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         vol_scale *= fmax(best[2 * c + 1] - best[2 * c], 1e-3 * size);
     }
     quad_result q, qa;
-    if ((st = quad_solid(s, x0, jscale, vol_scale, cancel, &q)) != PDE_OK ||
+    if ((st = quad_solid(s, x0, jscale, vol_scale, 1, cancel, &q)) != PDE_OK ||
         (st = quad_area(s, size, cancel, &r.surface_area, &qa)) != PDE_OK)
         return st;
     mass_properties(&q, x0, &r);

@@ -19,12 +19,35 @@ typedef struct {
                          * work's bound made them coarser */
     size_t refined, unrefined;   /* lined panels refined, and left unrefined by the work's bound */
     double refine_change;        /* the sum of what refinement changed of the refined panels' volume */
+    double refine_left;          /* the sum of |fine - coarse| of the volume over boxes whose refinement
+                                  * stopped at its depth (or the work's bound) before it agreed */
     int roots_skipped;  /* the work's bound stopped lines locating det J's roots (or the area's) */
 } quad_result;
 
+/*
+ * det J separates along axis (0: u, 1: v) when each component either has every mode's factor of that
+ * axis t^n (the same n >= 1 for all of them: in[c] = 1) or every mode's factor 1 (in[c] = 0; a
+ * component without modes counts so). With ns = in[0] + in[1] + in[2] >= 1, x_c = t^(n in[c]) X_c
+ * of the two other parameters, and
+ *
+ *     det J = n t^(n ns - 1) G,     G = det J at t = 1, divided by n,
+ *
+ * (multiply det J's column of the axis by t / n: each row with in[c] = 1 becomes t^n (X_c, its two
+ * partials); a row with in[c] = 0 has 0 there). So |det J| and its sign are G's, times a
+ * factor >= 0 of t alone, and every integral over the cube is a product of an exact integral over t
+ * and one over the face t = 1 (docs/MATH.md, "Separable solids"). axis = -1 when det J does not
+ * separate so.
+ */
+typedef struct {
+    int axis, n, ns, in[3];
+} quad_sep;
+
+void quad_separate(const pde_solution *s, quad_sep *sep);
+
 /* jscale: the size of det J over the solid, for what counts as zero; vscale: the size of the
- * volume (jscale will do), for the refinement's tolerance. */
-pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale,
+ * volume (jscale will do), for the refinement's tolerance. separate: where det J separates
+ * (quad_separate), integrate over the face t = 1 only (pde_properties); 0: over the cube (tests). */
+pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
                       const pde_cancel *cancel, quad_result *out);
 
 /* The area of the skin; size: the solid's extent, for deciding that two faces coincide. Its panels
