@@ -22,6 +22,7 @@
 #include <cmocka.h>
 #include <curl/curl.h>
 
+#include "sbuf.h"
 #include "store.h"
 #include "support.h"
 
@@ -392,6 +393,121 @@ static void daemons_should_share_ids_through_redis_and_ride_out_its_outage(void 
     free(second);
 }
 
+/* A Redis store on port (up or not), its puts kept within pending_kb while it is down. */
+static srv_store *open_redis(int port, size_t pending_kb)
+{
+    char spec[64], why[256];
+    snprintf(spec, sizeof spec, "redis://127.0.0.1:%d/4", port);
+    srv_store *s = srv_store_open(&(srv_store_config){ .spec = spec, .prefix = "kept:", .pending_kb = pending_kb }, why,
+                                  sizeof why);
+    if (!s)
+        fail_msg("%s: %s", spec, why);
+    return s;
+}
+
+/* Waits up to 5 s for the store's kept puts to be written. */
+static void wait_until_nothing_pending(srv_store *s)
+{
+    srv_store_stats st;
+    for (int i = 0; i < 100; i++) {
+        srv_store_stats_get(s, &st);
+        if (!st.pending)
+            return;
+        usleep(50000);
+    }
+    fail_msg("%llu puts still pending after 5 s", st.pending);
+}
+
+static void puts_while_redis_is_down_should_be_kept_within_their_bound_and_written_when_it_returns(void **state)
+{
+    (void)state;
+    if (access("/usr/bin/redis-server", X_OK)) {
+        skip();
+        return;
+    }
+    int port = free_port();   /* nothing listens there yet */
+    srv_store *s = open_redis(port, 1);
+    /* Ten puts of 200 bytes (id, model and request) while Redis is down; 1 KiB keeps the last five. */
+    char id[10][33], model[10][180];
+    for (unsigned i = 0; i < 10; i++) {
+        snprintf(model[i], sizeof model[i], "{\"m\":%u,\"pad\":\"%0145u\"}", i, i);
+        assert_int_equal(32 + strlen(model[i]) + strlen("{\"r\":1}"), 200);
+        assert_int_equal(srv_store_put(s, id_of(0x1000 + i, id[i]), model[i], "{\"r\":1}"), SRV_STORE_DOWN);
+    }
+    srv_store_stats st;
+    srv_store_stats_get(s, &st);
+    assert_int_equal(st.pending, 5);
+    assert_int_equal(st.dropped, 5);
+    /* Meanwhile a kept put answers from memory; a dropped one cannot be answered. */
+    expect_entry(s, id[9], model[9], "{\"r\":1}");
+    char *m = NULL, *r = NULL;
+    assert_int_equal(srv_store_get(s, id[0], &m, &r), SRV_STORE_DOWN);
+    srv_sbuf b = { 0 };
+    srv_store_metrics(s, &b);
+    assert_non_null(strstr(b.s, "\npdesolid_store_pending 5\n"));
+    assert_non_null(strstr(b.s, "\npdesolid_store_pending_dropped_total 5\n"));
+    free(b.s);
+
+    pid_t redis = redis_start(port);
+    wait_until_nothing_pending(s);   /* with no call of ours: the store's thread writes them */
+    srv_store_stats_get(s, &st);
+    assert_int_equal(st.late, 5);
+    srv_store_close(s);
+    s = open_redis(port, 1);         /* nothing in memory: what Redis holds */
+    for (unsigned i = 0; i < 10; i++) {
+        if (i < 5)
+            expect_missing(s, id[i]);
+        else
+            expect_entry(s, id[i], model[i], "{\"r\":1}");
+    }
+    srv_store_close(s);
+    redis_stop(redis);
+}
+
+static void an_id_solved_while_redis_is_down_should_reach_the_other_daemons_when_it_returns(void **state)
+{
+    (void)state;
+    if (access("/usr/bin/redis-server", X_OK)) {
+        skip();
+        return;
+    }
+    int port = free_port();
+    pid_t redis = redis_start(port);
+    char args[256], id[33];
+    snprintf(args, sizeof args, "--store redis://127.0.0.1:%d/5", port);
+    daemon_t a, b;
+    daemon_start(&a, dir, args);
+    daemon_start(&b, dir, args);
+    redis_stop(redis);
+    char *doc = solve(&a, "{\"preset\":\"fig4c\"}", id);   /* a answers; its put cannot reach Redis */
+    expect_status(get(&b, "/solids/%s", id), 503);
+    http_reply r = get(&a, "/metrics");
+    assert_non_null(strstr(r.body, "\npdesolid_store_pending 1\n"));
+    free(r.body);
+
+    redis = redis_start(port);   /* empty: the id is only in a's memory */
+    r = (http_reply){ 0 };
+    for (int i = 0; i < 50; i++) {   /* a writes it within about a second of Redis's return */
+        free(r.body);
+        r = get(&b, "/solids/%s", id);
+        if (r.status == 200)
+            break;
+        usleep(100000);
+    }
+    if (r.status != 200)
+        fail_msg("b: GET /solids/%s: %ld %s", id, r.status, r.body);
+    assert_string_equal(r.body, doc);
+    free(r.body);
+    r = get(&a, "/metrics");
+    assert_non_null(strstr(r.body, "\npdesolid_store_pending 0\n"));
+    assert_non_null(strstr(r.body, "\npdesolid_store_late_puts_total 1\n"));
+    free(r.body);
+    daemon_stop(&a);
+    daemon_stop(&b);
+    redis_stop(redis);
+    free(doc);
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -417,6 +533,8 @@ int main(void)
         cmocka_unit_test(a_bad_spec_should_be_refused_and_none_give_no_store),
         cmocka_unit_test(ids_should_survive_sigkill_of_the_daemon),
         cmocka_unit_test(daemons_should_share_ids_through_redis_and_ride_out_its_outage),
+        cmocka_unit_test(puts_while_redis_is_down_should_be_kept_within_their_bound_and_written_when_it_returns),
+        cmocka_unit_test(an_id_solved_while_redis_is_down_should_reach_the_other_daemons_when_it_returns),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("store", tests, setup, teardown);
