@@ -334,4 +334,4 @@ static void lmdb_close(void *b)
     free(L);
 }
 
-const srv_store_backend srv_store_lmdb = { "lmdb:", 0, lmdb_open, lmdb_get, lmdb_put, lmdb_stats, lmdb_ready, lmdb_close };
+const srv_store_backend srv_store_lmdb = { "lmdb:", 0, lmdb_open, lmdb_get, lmdb_put, lmdb_stats, lmdb_ready, lmdb_close, NULL };
