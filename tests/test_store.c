@@ -166,6 +166,38 @@ static void the_bound_should_evict_the_least_recently_used_first(void **state)
     srv_store_close(s);
 }
 
+static unsigned long long commits_of(srv_store *s)
+{
+    srv_store_stats st;
+    srv_store_stats_get(s, &st);
+    return st.commits;
+}
+
+static void a_get_should_never_commit_and_its_refresh_be_written_later_in_one(void **state)
+{
+    (void)state;
+    srv_store *s = open_lmdb("stamps", 8);
+    char id[5][33];
+    for (unsigned i = 0; i < 4; i++)
+        assert_int_equal(srv_store_put(s, id_of(0x200 + i, id[i]), "{\"m\":1}", NULL), SRV_STORE_OK);
+    assert_int_equal(commits_of(s), 4);   /* one synchronous commit a new id */
+    /* The two oldest are in the older half: their reads ask for a refresh, and write nothing. */
+    expect_entry(s, id[0], "{\"m\":1}", NULL);
+    expect_entry(s, id[1], "{\"m\":1}", NULL);
+    assert_int_equal(commits_of(s), 4);
+    /* The next put writes them in its own commit. */
+    assert_int_equal(srv_store_put(s, id_of(0x204, id[4]), "{\"m\":1}", NULL), SRV_STORE_OK);
+    assert_int_equal(commits_of(s), 5);
+    /* With no put, the store's thread writes a refresh within about a second, in one commit. */
+    expect_entry(s, id[2], "{\"m\":1}", NULL);
+    expect_entry(s, id[3], "{\"m\":1}", NULL);
+    assert_int_equal(commits_of(s), 5);
+    for (int i = 0; i < 40 && commits_of(s) == 5; i++)
+        usleep(50000);
+    assert_int_equal(commits_of(s), 6);
+    srv_store_close(s);
+}
+
 /* Writes one byte to fd, then waits for one on the other. */
 static void signal_and_wait(int out, int in)
 {
@@ -529,6 +561,7 @@ int main(void)
         cmocka_unit_test(a_put_should_come_back_and_an_unknown_id_be_missing),
         cmocka_unit_test(a_put_should_survive_close_and_open),
         cmocka_unit_test(the_bound_should_evict_the_least_recently_used_first),
+        cmocka_unit_test(a_get_should_never_commit_and_its_refresh_be_written_later_in_one),
         cmocka_unit_test(two_processes_on_one_directory_should_see_each_others_puts),
         cmocka_unit_test(a_bad_spec_should_be_refused_and_none_give_no_store),
         cmocka_unit_test(ids_should_survive_sigkill_of_the_daemon),
