@@ -2,8 +2,9 @@
  * bench_store: the LMDB store's put and get (server/store_lmdb.c), against a
  * solve of the model they keep: a put is a synchronous commit (an fsync),
  * paid once per new id; a get is what a cache miss of a known id costs before
- * it re-solves; a get in the older half of the LRU order also refreshes its
- * stamp, a synchronous commit too (scattered), one of a recent id does not. Medians of single calls, on fig4a's canonical model (about
+ * it re-solves; a get in the older half of the LRU order (scattered) asks
+ * for its stamp to be refreshed, in memory, written later in one commit with
+ * others; one of a recent id does not. Medians of single calls, on fig4a's canonical model (about
  * 400 bytes), in a store in $TMPDIR or /tmp. With redis-server on
  * 127.0.0.1:$REDIS_PORT (when set), the same for Redis.
  */

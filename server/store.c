@@ -46,6 +46,7 @@ struct srv_store {
     kept *head, *tail;       /* the oldest first */
     kept *flying;            /* taken from head, being written by the thread */
     size_t pending, pending_bytes, pending_max;
+    atomic_int any;          /* pending or flying: a get looks there (read without the lock) */
     unsigned long long late, dropped;
 };
 
@@ -67,6 +68,7 @@ static kept *take_oldest(srv_store *s)
         s->tail = NULL;
     s->pending--;
     s->pending_bytes -= k->size;
+    atomic_store(&s->any, s->pending || s->flying);
     return k;
 }
 
@@ -96,6 +98,7 @@ static void keep(srv_store *s, kept *k, int again)
         s->pending++;
         s->pending_bytes += k->size;
         make_room(s, 0);
+        atomic_store(&s->any, s->pending || s->flying);
         return;
     }
     make_room(s, k->size);
@@ -107,6 +110,7 @@ static void keep(srv_store *s, kept *k, int again)
     s->tail = k;
     s->pending++;
     s->pending_bytes += k->size;
+    atomic_store(&s->any, 1);
 }
 
 /* The kept put of id, or NULL. Lock held. */
@@ -124,12 +128,13 @@ static const kept *find_kept(const srv_store *s, const char *id)
 static void write_kept(srv_store *s)
 {
     while (s->head) {
-        kept *k = take_oldest(s);
-        s->flying = k;
+        kept *k = s->flying = take_oldest(s);
+        atomic_store(&s->any, 1);
         pthread_mutex_unlock(&s->lock);
         srv_store_status st = s->b->put(s->impl, k->id, k->model, k->request);
         pthread_mutex_lock(&s->lock);
         s->flying = NULL;
+        atomic_store(&s->any, s->pending > 0);
         if (st == SRV_STORE_DOWN) {
             keep(s, k, 1);
             return;
@@ -167,6 +172,8 @@ static void *store_thread(void *arg)
 /* A call answered: the kept puts may go now. */
 static void answered(srv_store *s)
 {
+    if (!atomic_load(&s->any))
+        return;
     pthread_mutex_lock(&s->lock);
     if (s->pending)
         pthread_cond_signal(&s->wake);
@@ -231,14 +238,16 @@ srv_store_status srv_store_get(srv_store *s, const char *id, char **model, char 
     }
     char *req = NULL;
     srv_store_status st = SRV_STORE_MISSING;
-    pthread_mutex_lock(&s->lock);
-    const kept *k = s->pending || s->flying ? find_kept(s, id) : NULL;
-    if (k) {   /* answered by this process, not in the store yet */
-        *model = strdup(k->model);
-        req = k->request ? strdup(k->request) : NULL;
-        st = *model && (req || !k->request) ? SRV_STORE_OK : SRV_STORE_NOMEM;
+    const kept *k = NULL;
+    if (atomic_load(&s->any)) {
+        pthread_mutex_lock(&s->lock);
+        if ((k = find_kept(s, id))) {   /* answered by this process, not in the store yet */
+            *model = strdup(k->model);
+            req = k->request ? strdup(k->request) : NULL;
+            st = *model && (req || !k->request) ? SRV_STORE_OK : SRV_STORE_NOMEM;
+        }
+        pthread_mutex_unlock(&s->lock);
     }
-    pthread_mutex_unlock(&s->lock);
     if (!k)
         st = s->b->get(s->impl, id, model, &req);
     else if (st != SRV_STORE_OK) {
