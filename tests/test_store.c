@@ -7,6 +7,7 @@
  */
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <pthread.h>
 #include <setjmp.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -195,6 +196,54 @@ static void a_get_should_never_commit_and_its_refresh_be_written_later_in_one(vo
     for (int i = 0; i < 40 && commits_of(s) == 5; i++)
         usleep(50000);
     assert_int_equal(commits_of(s), 6);
+    srv_store_close(s);
+}
+
+/* 50 new ids put by one of eight threads at once. */
+typedef struct {
+    srv_store *s;
+    unsigned base;
+    int failed;
+} putter;
+
+static void *put_fifty(void *arg)
+{
+    putter *p = arg;
+    char id[33], model[32];
+    for (unsigned i = 0; i < 50; i++) {
+        snprintf(model, sizeof model, "{\"m\":%u}", p->base + i);
+        p->failed |= srv_store_put(p->s, id_of(p->base + i, id), model, NULL) != SRV_STORE_OK;
+    }
+    return NULL;
+}
+
+static void puts_at_once_should_share_commits_and_each_be_kept(void **state)
+{
+    (void)state;
+    srv_store *s = open_lmdb("group", 8);
+    pthread_t th[8];
+    putter p[8];
+    for (unsigned i = 0; i < 8; i++) {
+        p[i] = (putter){ s, 0x3000 + 100 * i, 0 };
+        assert_int_equal(pthread_create(&th[i], NULL, put_fifty, &p[i]), 0);
+    }
+    for (int i = 0; i < 8; i++) {
+        pthread_join(th[i], NULL);
+        assert_false(p[i].failed);
+    }
+    /* Each put returned after its commit; puts that waited for one went together in the next. */
+    assert_true(commits_of(s) < 400);
+    srv_store_close(s);
+    s = open_lmdb("group", 8);
+    char id[33], model[32];
+    for (unsigned i = 0; i < 8; i++)
+        for (unsigned j = 0; j < 50; j++) {
+            snprintf(model, sizeof model, "{\"m\":%u}", p[i].base + j);
+            expect_entry(s, id_of(p[i].base + j, id), model, NULL);
+        }
+    srv_store_stats st;
+    srv_store_stats_get(s, &st);
+    assert_int_equal(st.entries, 400);
     srv_store_close(s);
 }
 
@@ -562,6 +611,7 @@ int main(void)
         cmocka_unit_test(a_put_should_survive_close_and_open),
         cmocka_unit_test(the_bound_should_evict_the_least_recently_used_first),
         cmocka_unit_test(a_get_should_never_commit_and_its_refresh_be_written_later_in_one),
+        cmocka_unit_test(puts_at_once_should_share_commits_and_each_be_kept),
         cmocka_unit_test(two_processes_on_one_directory_should_see_each_others_puts),
         cmocka_unit_test(a_bad_spec_should_be_refused_and_none_give_no_store),
         cmocka_unit_test(ids_should_survive_sigkill_of_the_daemon),
