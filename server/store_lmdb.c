@@ -3,7 +3,9 @@
  * directory (created 0700 if missing), opened with MDB_NOTLS so that any
  * solver thread may read; several processes may share it (LMDB's locks).
  * A put commits with a synchronous write (no MDB_NOSYNC): once it returns,
- * the id survives SIGKILL and power loss.
+ * the id survives SIGKILL and power loss. Group commit: puts that arrive
+ * while a commit is under way wait, and the first of them writes them all in
+ * the next commit (lmdb_put), so concurrent new ids share one fsync.
  *
  * Four databases:
  *   ids   id -> u32 model length, model, request (the request may be empty)
@@ -43,6 +45,14 @@
 
 #define TOUCH_MAX 4096   /* refreshes waiting to be written */
 
+/* A put waiting for its commit (lmdb_put). */
+typedef struct put_req {
+    struct put_req *next;
+    const char *id, *model, *request;
+    size_t mlen, rlen;
+    int done, rc;
+} put_req;
+
 typedef struct {
     MDB_env *env;
     MDB_dbi ids, age, lru, meta;
@@ -52,6 +62,10 @@ typedef struct {
     char touches[TOUCH_MAX][API_ID_LEN];  /* in the order asked */
     atomic_size_t ntouch;                 /* written under the lock, read without it */
     uint16_t slot[2 * TOUCH_MAX];         /* open addressing over touches: index + 1, 0 free */
+    pthread_mutex_t glock;                /* group commit: the puts waiting, and who writes */
+    pthread_cond_t gdone;
+    put_req *queue, **qtail;
+    int writing;
 } lmdb_store;
 
 /* mkdir -p, the last component 0700. */
@@ -242,8 +256,12 @@ static void *lmdb_open(const char *dir, const srv_store_config *cfg, char *why, 
         rc = mdb_txn_commit(t);
     else if (t)
         mdb_txn_abort(t);
-    if (!rc)
+    if (!rc) {
         pthread_mutex_init(&L->lock, NULL);
+        pthread_mutex_init(&L->glock, NULL);
+        pthread_cond_init(&L->gdone, NULL);
+        L->qtail = &L->queue;
+    }
     if (rc) {
         snprintf(why, whylen, "--store %s: %s: %s", dir, step, rc > 0 ? strerror(rc) : mdb_strerror(rc));
         if (L->env)
@@ -308,13 +326,36 @@ static srv_store_status lmdb_get(void *b, const char *id, char **model, char **r
     return status_of(rc);
 }
 
-static srv_store_status lmdb_put(void *b, const char *id, const char *model, const char *request)
+/* Puts p in t: a known id only gets a new stamp (entries are immutable). */
+static int put_one(lmdb_store *L, MDB_txn *t, const put_req *p)
 {
-    lmdb_store *L = b;
-    size_t mlen = strlen(model), rlen = request ? strlen(request) : 0;
-    uint64_t size = API_ID_LEN + 4 + mlen + rlen;
-    if (mlen > UINT32_MAX || size > L->budget)
-        return SRV_STORE_ERROR;
+    uint64_t size = API_ID_LEN + 4 + p->mlen + p->rlen;
+    MDB_val k = { API_ID_LEN, (void *)p->id }, v;
+    if (!mdb_get(t, L->ids, &k, &v))
+        return touch(L, t, p->id);
+    int rc = 0;
+    uint64_t bytes = get_u64(t, L->meta, "bytes");
+    while (!rc && bytes + size > L->budget) {
+        rc = evict_one(L, t);
+        bytes = get_u64(t, L->meta, "bytes");
+    }
+    if (rc == MDB_NOTFOUND)
+        rc = 0;
+    v.mv_size = size - API_ID_LEN;
+    if (!rc && !(rc = mdb_put(t, L->ids, &k, &v, MDB_RESERVE))) {
+        uint32_t m32 = (uint32_t)p->mlen;
+        memcpy(v.mv_data, &m32, 4);
+        memcpy((char *)v.mv_data + 4, p->model, p->mlen);
+        memcpy((char *)v.mv_data + 4 + p->mlen, p->request ? p->request : "", p->rlen);
+        rc = put_u64(t, L->meta, "bytes", bytes + size);
+    }
+    return rc ? rc : touch(L, t, p->id);
+}
+
+/* Writes the puts of batch in one synchronous commit (with the refreshes asked for); 0 or the error,
+ * the same for all. */
+static int write_batch(lmdb_store *L, const put_req *batch)
+{
     int rc = 0;
     for (int attempt = 0; attempt < 4; attempt++) {
         MDB_txn *t;
@@ -324,33 +365,12 @@ static srv_store_status lmdb_put(void *b, const char *id, const char *model, con
             rc = mdb_txn_begin(L->env, NULL, 0, &t);
         }
         if (rc)
-            return status_of(rc);
-        MDB_val k = { API_ID_LEN, (void *)id }, v;
-        if ((rc = apply_touches(L, t))) {
-            /* the refreshes are lost; MDB_MAP_FULL evicts below and tries the put again */
-        } else if (!mdb_get(t, L->ids, &k, &v)) {   /* immutable: a known id only gets a new stamp */
-            rc = touch(L, t, id);
-        } else {
-            uint64_t bytes = get_u64(t, L->meta, "bytes");
-            while (!rc && bytes + size > L->budget) {
-                rc = evict_one(L, t);
-                bytes = get_u64(t, L->meta, "bytes");
-            }
-            if (rc == MDB_NOTFOUND)
-                rc = 0;
-            v.mv_size = size - API_ID_LEN;
-            if (!rc && !(rc = mdb_put(t, L->ids, &k, &v, MDB_RESERVE))) {
-                uint32_t m32 = (uint32_t)mlen;
-                memcpy(v.mv_data, &m32, 4);
-                memcpy((char *)v.mv_data + 4, model, mlen);
-                memcpy((char *)v.mv_data + 4 + mlen, request ? request : "", rlen);
-                rc = put_u64(t, L->meta, "bytes", bytes + size);
-            }
-            if (!rc)
-                rc = touch(L, t, id);
-        }
+            return rc;
+        rc = apply_touches(L, t);   /* on an error the refreshes are lost */
+        for (const put_req *p = batch; !rc && p; p = p->next)
+            rc = put_one(L, t, p);
         if (!rc)
-            return status_of(commit(L, t));
+            return commit(L, t);
         mdb_txn_abort(t);
         if (rc != MDB_MAP_FULL)
             break;
@@ -368,7 +388,42 @@ static srv_store_status lmdb_put(void *b, const char *id, const char *model, con
         if (commit(L, t))
             break;
     }
-    return status_of(rc);
+    return rc;
+}
+
+/* Group commit: the puts that arrive while a commit is under way wait for it, and the first of them
+ * then writes them all in the next commit. Each returns once its own commit is on disk. */
+static srv_store_status lmdb_put(void *b, const char *id, const char *model, const char *request)
+{
+    lmdb_store *L = b;
+    put_req me = { NULL, id, model, request, strlen(model), request ? strlen(request) : 0, 0, 0 };
+    if (me.mlen > UINT32_MAX || API_ID_LEN + 4 + me.mlen + me.rlen > L->budget)
+        return SRV_STORE_ERROR;
+    pthread_mutex_lock(&L->glock);
+    *L->qtail = &me;
+    L->qtail = &me.next;
+    while (!me.done) {
+        if (L->writing) {
+            pthread_cond_wait(&L->gdone, &L->glock);
+            continue;
+        }
+        put_req *batch = L->queue;
+        L->queue = NULL;
+        L->qtail = &L->queue;
+        L->writing = 1;
+        pthread_mutex_unlock(&L->glock);
+        int rc = write_batch(L, batch);
+        pthread_mutex_lock(&L->glock);
+        for (put_req *p = batch, *next; p; p = next) {
+            next = p->next;   /* p is its caller's, gone once done */
+            p->rc = rc;
+            p->done = 1;
+        }
+        L->writing = 0;
+        pthread_cond_broadcast(&L->gdone);
+    }
+    pthread_mutex_unlock(&L->glock);
+    return status_of(me.rc);
 }
 
 static void lmdb_stats(void *b, srv_store_stats *out)
@@ -411,6 +466,8 @@ static void lmdb_close(void *b)
     lmdb_store *L = b;
     mdb_env_close(L->env);
     pthread_mutex_destroy(&L->lock);
+    pthread_mutex_destroy(&L->glock);
+    pthread_cond_destroy(&L->gdone);
     free(L);
 }
 
