@@ -19,6 +19,12 @@
  *   "redis://HOST:PORT[/DB]"    Redis (store_redis.c): shared between machines; key prefix, TTL.
  *   "none"                      no store: srv_store_open returns NULL with why "".
  * Every function is thread-safe. Entries are immutable: putting an existing id only refreshes it.
+ *
+ * A put the store cannot take now (SRV_STORE_DOWN: Redis unreachable) is kept in memory, within
+ * pending_kb, and written by the store's own thread as soon as the store answers again (it retries
+ * every second); a get of such an id answers it from memory meanwhile. Over the bound, the oldest
+ * kept puts are dropped (counted: dropped). Kept puts that are still unwritten when the process
+ * ends are lost; srv_store_close tries them once more first.
  */
 #ifndef SRV_STORE_H
 #define SRV_STORE_H
@@ -36,10 +42,15 @@ typedef struct {
     unsigned ttl_s;              /* Redis: seconds an entry lives after its last put or get; 0: forever */
     unsigned connect_timeout_ms; /* Redis; 0: 200 */
     unsigned command_timeout_ms; /* Redis; 0: 500 */
+    size_t pending_kb;           /* puts kept while the store is down (models and requests), KiB; 0: 16384 */
 } srv_store_config;
 
 typedef struct {
     unsigned long long bytes, entries, evictions, puts, gets, misses, errors;
+    unsigned long long pending;  /* puts kept in memory, waiting for the store */
+    unsigned long long late;     /* kept puts written since, once the store answered again */
+    unsigned long long dropped;  /* kept puts dropped, the oldest first, to stay within pending_kb */
+    unsigned long long commits;  /* LMDB: write transactions this process committed (each a synchronous write) */
     int up;                      /* 1 if the store answered its last call */
 } srv_store_stats;
 

@@ -18,6 +18,7 @@ typedef struct {
     void (*stats)(void *b, srv_store_stats *out);
     int (*ready)(void *b);
     void (*close)(void *b);
+    void (*tick)(void *b);   /* NULL, or work the backend defers: called by store.c's thread about once a second */
 } srv_store_backend;
 
 extern const srv_store_backend srv_store_lmdb, srv_store_redis;

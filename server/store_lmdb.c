@@ -3,7 +3,9 @@
  * directory (created 0700 if missing), opened with MDB_NOTLS so that any
  * solver thread may read; several processes may share it (LMDB's locks).
  * A put commits with a synchronous write (no MDB_NOSYNC): once it returns,
- * the id survives SIGKILL and power loss.
+ * the id survives SIGKILL and power loss. Group commit: puts that arrive
+ * while a commit is under way wait, and the first of them writes them all in
+ * the next commit (lmdb_put), so concurrent new ids share one fsync.
  *
  * Four databases:
  *   ids   id -> u32 model length, model, request (the request may be empty)
@@ -18,10 +20,15 @@
  * (the rest is B-tree pages and copy-on-write room). A put that would go over
  * evicts the least recently used entries first; a put that still meets
  * MDB_MAP_FULL evicts an eighth of the entries and tries again.
- * How often a get writes: a get refreshes its entry's stamp (one write
- * transaction) only when the entry is in the older half of the LRU order
- * (its stamp is below clock - entries / 2). Hot entries cost no writes, and
- * an entry read since it reached the older half is never the next evicted.
+ * A get never writes. It asks for its entry's stamp to be refreshed only
+ * when the entry is in the older half of the LRU order (its stamp is below
+ * clock + asked - entries / 2, asked counting the refreshes not yet written);
+ * the refreshes asked for wait in memory (up to TOUCH_MAX ids, more are not
+ * kept) and are written by this process's next put, in its transaction, or
+ * else within about a second by store.c's thread (tick), in one commit for
+ * all. So hot entries cost nothing, an entry read since it reached the older
+ * half is not the next evicted by this process, and a crash loses at most
+ * the last second's refreshes (the order, never an entry).
  */
 #include <errno.h>
 #include <lmdb.h>
@@ -36,11 +43,29 @@
 #include "id.h"
 #include "store_impl.h"
 
+#define TOUCH_MAX 4096   /* refreshes waiting to be written */
+
+/* A put waiting for its commit (lmdb_put). */
+typedef struct put_req {
+    struct put_req *next;
+    const char *id, *model, *request;
+    size_t mlen, rlen;
+    int done, rc;
+} put_req;
+
 typedef struct {
     MDB_env *env;
     MDB_dbi ids, age, lru, meta;
     uint64_t budget;
-    atomic_ullong evictions;
+    atomic_ullong evictions, commits;
+    pthread_mutex_t lock;                 /* the refreshes asked for */
+    char touches[TOUCH_MAX][API_ID_LEN];  /* in the order asked */
+    atomic_size_t ntouch;                 /* written under the lock, read without it */
+    uint16_t slot[2 * TOUCH_MAX];         /* open addressing over touches: index + 1, 0 free */
+    pthread_mutex_t glock;                /* group commit: the puts waiting, and who writes */
+    pthread_cond_t gdone;
+    put_req *queue, **qtail;
+    int writing;
 } lmdb_store;
 
 /* mkdir -p, the last component 0700. */
@@ -110,6 +135,60 @@ static int touch(lmdb_store *L, MDB_txn *t, const char *id)
     return mdb_put(t, L->lru, &lk, &k, 0);
 }
 
+/* Writes the refreshes asked for (of the entries still there) in t; they are gone from memory
+ * whether t commits or not: a refresh lost costs LRU order, never an entry. */
+static int apply_touches(lmdb_store *L, MDB_txn *t)
+{
+    pthread_mutex_lock(&L->lock);
+    size_t n = L->ntouch;
+    char(*ids)[API_ID_LEN] = n ? malloc(n * API_ID_LEN) : NULL;
+    if (ids)
+        memcpy(ids, L->touches, n * API_ID_LEN);
+    L->ntouch = 0;
+    memset(L->slot, 0, sizeof L->slot);
+    pthread_mutex_unlock(&L->lock);
+    int rc = 0;
+    for (size_t i = 0; ids && !rc && i < n; i++) {
+        MDB_val k = { API_ID_LEN, ids[i] }, v;
+        if (!mdb_get(t, L->ids, &k, &v))
+            rc = touch(L, t, ids[i]);
+    }
+    free(ids);
+    return rc;
+}
+
+/* Asks for id's stamp to be refreshed (apply_touches); nothing if it is asked already or too many are. */
+static void ask_touch(lmdb_store *L, const char *id)
+{
+    uint32_t h = 2166136261u;   /* FNV-1a */
+    for (int i = 0; i < API_ID_LEN; i++)
+        h = (h ^ (unsigned char)id[i]) * 16777619u;
+    pthread_mutex_lock(&L->lock);
+    size_t i = h % (2 * TOUCH_MAX);
+    while (L->slot[i] && memcmp(L->touches[L->slot[i] - 1], id, API_ID_LEN))
+        i = (i + 1) % (2 * TOUCH_MAX);
+    size_t n = L->ntouch;
+    if (!L->slot[i] && n < TOUCH_MAX) {
+        memcpy(L->touches[n], id, API_ID_LEN);
+        L->slot[i] = (uint16_t)(n + 1);
+        L->ntouch = n + 1;
+    }
+    pthread_mutex_unlock(&L->lock);
+}
+
+static size_t asked(lmdb_store *L)
+{
+    return atomic_load_explicit(&L->ntouch, memory_order_relaxed);
+}
+
+static int commit(lmdb_store *L, MDB_txn *t)
+{
+    int rc = mdb_txn_commit(t);
+    if (!rc)
+        atomic_fetch_add(&L->commits, 1);
+    return rc;
+}
+
 /* Evicts the least recently used entry; MDB_NOTFOUND when there is none. */
 static int evict_one(lmdb_store *L, MDB_txn *t)
 {
@@ -177,6 +256,12 @@ static void *lmdb_open(const char *dir, const srv_store_config *cfg, char *why, 
         rc = mdb_txn_commit(t);
     else if (t)
         mdb_txn_abort(t);
+    if (!rc) {
+        pthread_mutex_init(&L->lock, NULL);
+        pthread_mutex_init(&L->glock, NULL);
+        pthread_cond_init(&L->gdone, NULL);
+        L->qtail = &L->queue;
+    }
     if (rc) {
         snprintf(why, whylen, "--store %s: %s: %s", dir, step, rc > 0 ? strerror(rc) : mdb_strerror(rc));
         if (L->env)
@@ -230,28 +315,47 @@ static srv_store_status lmdb_get(void *b, const char *id, char **model, char **r
         MDB_val sv;
         MDB_stat st;
         if (!rc && !mdb_get(t, L->age, &k, &sv) && sv.mv_size == 8 && !mdb_stat(t, L->ids, &st)) {
-            uint64_t stamp, clock = get_u64(t, L->meta, "clock");
+            uint64_t stamp, clock = get_u64(t, L->meta, "clock") + asked(L);
             memcpy(&stamp, sv.mv_data, 8);
             refresh = stamp + st.ms_entries / 2 < clock;
         }
     }
     mdb_txn_abort(t);
-    if (!rc && refresh && !mdb_txn_begin(L->env, NULL, 0, &t)) {
-        if (!mdb_get(t, L->ids, &k, &v) && !touch(L, t, id))
-            mdb_txn_commit(t);
-        else
-            mdb_txn_abort(t);
-    }
+    if (!rc && refresh)
+        ask_touch(L, id);
     return status_of(rc);
 }
 
-static srv_store_status lmdb_put(void *b, const char *id, const char *model, const char *request)
+/* Puts p in t: a known id only gets a new stamp (entries are immutable). */
+static int put_one(lmdb_store *L, MDB_txn *t, const put_req *p)
 {
-    lmdb_store *L = b;
-    size_t mlen = strlen(model), rlen = request ? strlen(request) : 0;
-    uint64_t size = API_ID_LEN + 4 + mlen + rlen;
-    if (mlen > UINT32_MAX || size > L->budget)
-        return SRV_STORE_ERROR;
+    uint64_t size = API_ID_LEN + 4 + p->mlen + p->rlen;
+    MDB_val k = { API_ID_LEN, (void *)p->id }, v;
+    if (!mdb_get(t, L->ids, &k, &v))
+        return touch(L, t, p->id);
+    int rc = 0;
+    uint64_t bytes = get_u64(t, L->meta, "bytes");
+    while (!rc && bytes + size > L->budget) {
+        rc = evict_one(L, t);
+        bytes = get_u64(t, L->meta, "bytes");
+    }
+    if (rc == MDB_NOTFOUND)
+        rc = 0;
+    v.mv_size = size - API_ID_LEN;
+    if (!rc && !(rc = mdb_put(t, L->ids, &k, &v, MDB_RESERVE))) {
+        uint32_t m32 = (uint32_t)p->mlen;
+        memcpy(v.mv_data, &m32, 4);
+        memcpy((char *)v.mv_data + 4, p->model, p->mlen);
+        memcpy((char *)v.mv_data + 4 + p->mlen, p->request ? p->request : "", p->rlen);
+        rc = put_u64(t, L->meta, "bytes", bytes + size);
+    }
+    return rc ? rc : touch(L, t, p->id);
+}
+
+/* Writes the puts of batch in one synchronous commit (with the refreshes asked for); 0 or the error,
+ * the same for all. */
+static int write_batch(lmdb_store *L, const put_req *batch)
+{
     int rc = 0;
     for (int attempt = 0; attempt < 4; attempt++) {
         MDB_txn *t;
@@ -261,31 +365,12 @@ static srv_store_status lmdb_put(void *b, const char *id, const char *model, con
             rc = mdb_txn_begin(L->env, NULL, 0, &t);
         }
         if (rc)
-            return status_of(rc);
-        MDB_val k = { API_ID_LEN, (void *)id }, v;
-        if (!mdb_get(t, L->ids, &k, &v)) {   /* immutable: a known id only gets a new stamp */
-            rc = touch(L, t, id);
-        } else {
-            uint64_t bytes = get_u64(t, L->meta, "bytes");
-            while (!rc && bytes + size > L->budget) {
-                rc = evict_one(L, t);
-                bytes = get_u64(t, L->meta, "bytes");
-            }
-            if (rc == MDB_NOTFOUND)
-                rc = 0;
-            v.mv_size = size - API_ID_LEN;
-            if (!rc && !(rc = mdb_put(t, L->ids, &k, &v, MDB_RESERVE))) {
-                uint32_t m32 = (uint32_t)mlen;
-                memcpy(v.mv_data, &m32, 4);
-                memcpy((char *)v.mv_data + 4, model, mlen);
-                memcpy((char *)v.mv_data + 4 + mlen, request ? request : "", rlen);
-                rc = put_u64(t, L->meta, "bytes", bytes + size);
-            }
-            if (!rc)
-                rc = touch(L, t, id);
-        }
+            return rc;
+        rc = apply_touches(L, t);   /* on an error the refreshes are lost */
+        for (const put_req *p = batch; !rc && p; p = p->next)
+            rc = put_one(L, t, p);
         if (!rc)
-            return status_of(mdb_txn_commit(t));
+            return commit(L, t);
         mdb_txn_abort(t);
         if (rc != MDB_MAP_FULL)
             break;
@@ -300,10 +385,45 @@ static srv_store_status lmdb_put(void *b, const char *id, const char *model, con
             mdb_txn_abort(t);
             break;
         }
-        if (mdb_txn_commit(t))
+        if (commit(L, t))
             break;
     }
-    return status_of(rc);
+    return rc;
+}
+
+/* Group commit: the puts that arrive while a commit is under way wait for it, and the first of them
+ * then writes them all in the next commit. Each returns once its own commit is on disk. */
+static srv_store_status lmdb_put(void *b, const char *id, const char *model, const char *request)
+{
+    lmdb_store *L = b;
+    put_req me = { NULL, id, model, request, strlen(model), request ? strlen(request) : 0, 0, 0 };
+    if (me.mlen > UINT32_MAX || API_ID_LEN + 4 + me.mlen + me.rlen > L->budget)
+        return SRV_STORE_ERROR;
+    pthread_mutex_lock(&L->glock);
+    *L->qtail = &me;
+    L->qtail = &me.next;
+    while (!me.done) {
+        if (L->writing) {
+            pthread_cond_wait(&L->gdone, &L->glock);
+            continue;
+        }
+        put_req *batch = L->queue;
+        L->queue = NULL;
+        L->qtail = &L->queue;
+        L->writing = 1;
+        pthread_mutex_unlock(&L->glock);
+        int rc = write_batch(L, batch);
+        pthread_mutex_lock(&L->glock);
+        for (put_req *p = batch, *next; p; p = next) {
+            next = p->next;   /* p is its caller's, gone once done */
+            p->rc = rc;
+            p->done = 1;
+        }
+        L->writing = 0;
+        pthread_cond_broadcast(&L->gdone);
+    }
+    pthread_mutex_unlock(&L->glock);
+    return status_of(me.rc);
 }
 
 static void lmdb_stats(void *b, srv_store_stats *out)
@@ -312,6 +432,7 @@ static void lmdb_stats(void *b, srv_store_stats *out)
     MDB_txn *t;
     out->up = 1;
     out->evictions = atomic_load(&L->evictions);
+    out->commits = atomic_load(&L->commits);
     if (mdb_txn_begin(L->env, NULL, MDB_RDONLY, &t))
         return;
     MDB_stat st;
@@ -327,11 +448,27 @@ static int lmdb_ready(void *b)
     return 1;
 }
 
+/* Writes the refreshes asked for, in one commit (store.c's thread, about once a second). */
+static void lmdb_tick(void *b)
+{
+    lmdb_store *L = b;
+    MDB_txn *t;
+    if (!asked(L) || mdb_txn_begin(L->env, NULL, 0, &t))
+        return;
+    if (!apply_touches(L, t))
+        commit(L, t);
+    else
+        mdb_txn_abort(t);
+}
+
 static void lmdb_close(void *b)
 {
     lmdb_store *L = b;
     mdb_env_close(L->env);
+    pthread_mutex_destroy(&L->lock);
+    pthread_mutex_destroy(&L->glock);
+    pthread_cond_destroy(&L->gdone);
     free(L);
 }
 
-const srv_store_backend srv_store_lmdb = { "lmdb:", 0, lmdb_open, lmdb_get, lmdb_put, lmdb_stats, lmdb_ready, lmdb_close };
+const srv_store_backend srv_store_lmdb = { "lmdb:", 0, lmdb_open, lmdb_get, lmdb_put, lmdb_stats, lmdb_ready, lmdb_close, lmdb_tick };

@@ -265,4 +265,4 @@ static void redis_close(void *b)
 }
 
 const srv_store_backend srv_store_redis = { "redis://", 1, redis_open, redis_get, redis_put, redis_stats, redis_ready,
-                                            redis_close };
+                                            redis_close, NULL };

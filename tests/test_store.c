@@ -7,6 +7,7 @@
  */
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <pthread.h>
 #include <setjmp.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -22,6 +23,7 @@
 #include <cmocka.h>
 #include <curl/curl.h>
 
+#include "sbuf.h"
 #include "store.h"
 #include "support.h"
 
@@ -162,6 +164,86 @@ static void the_bound_should_evict_the_least_recently_used_first(void **state)
     free(g);
     for (int i = 0; i < 6; i++)
         free(m[i]);
+    srv_store_close(s);
+}
+
+static unsigned long long commits_of(srv_store *s)
+{
+    srv_store_stats st;
+    srv_store_stats_get(s, &st);
+    return st.commits;
+}
+
+static void a_get_should_never_commit_and_its_refresh_be_written_later_in_one(void **state)
+{
+    (void)state;
+    srv_store *s = open_lmdb("stamps", 8);
+    char id[5][33];
+    for (unsigned i = 0; i < 4; i++)
+        assert_int_equal(srv_store_put(s, id_of(0x200 + i, id[i]), "{\"m\":1}", NULL), SRV_STORE_OK);
+    assert_int_equal(commits_of(s), 4);   /* one synchronous commit a new id */
+    /* The two oldest are in the older half: their reads ask for a refresh, and write nothing. */
+    expect_entry(s, id[0], "{\"m\":1}", NULL);
+    expect_entry(s, id[1], "{\"m\":1}", NULL);
+    assert_int_equal(commits_of(s), 4);
+    /* The next put writes them in its own commit. */
+    assert_int_equal(srv_store_put(s, id_of(0x204, id[4]), "{\"m\":1}", NULL), SRV_STORE_OK);
+    assert_int_equal(commits_of(s), 5);
+    /* With no put, the store's thread writes a refresh within about a second, in one commit. */
+    expect_entry(s, id[2], "{\"m\":1}", NULL);
+    expect_entry(s, id[3], "{\"m\":1}", NULL);
+    assert_int_equal(commits_of(s), 5);
+    for (int i = 0; i < 40 && commits_of(s) == 5; i++)
+        usleep(50000);
+    assert_int_equal(commits_of(s), 6);
+    srv_store_close(s);
+}
+
+/* 50 new ids put by one of eight threads at once. */
+typedef struct {
+    srv_store *s;
+    unsigned base;
+    int failed;
+} putter;
+
+static void *put_fifty(void *arg)
+{
+    putter *p = arg;
+    char id[33], model[32];
+    for (unsigned i = 0; i < 50; i++) {
+        snprintf(model, sizeof model, "{\"m\":%u}", p->base + i);
+        p->failed |= srv_store_put(p->s, id_of(p->base + i, id), model, NULL) != SRV_STORE_OK;
+    }
+    return NULL;
+}
+
+static void puts_at_once_should_share_commits_and_each_be_kept(void **state)
+{
+    (void)state;
+    srv_store *s = open_lmdb("group", 8);
+    pthread_t th[8];
+    putter p[8];
+    for (unsigned i = 0; i < 8; i++) {
+        p[i] = (putter){ s, 0x3000 + 100 * i, 0 };
+        assert_int_equal(pthread_create(&th[i], NULL, put_fifty, &p[i]), 0);
+    }
+    for (int i = 0; i < 8; i++) {
+        pthread_join(th[i], NULL);
+        assert_false(p[i].failed);
+    }
+    /* Each put returned after its commit; puts that waited for one went together in the next. */
+    assert_true(commits_of(s) < 400);
+    srv_store_close(s);
+    s = open_lmdb("group", 8);
+    char id[33], model[32];
+    for (unsigned i = 0; i < 8; i++)
+        for (unsigned j = 0; j < 50; j++) {
+            snprintf(model, sizeof model, "{\"m\":%u}", p[i].base + j);
+            expect_entry(s, id_of(p[i].base + j, id), model, NULL);
+        }
+    srv_store_stats st;
+    srv_store_stats_get(s, &st);
+    assert_int_equal(st.entries, 400);
     srv_store_close(s);
 }
 
@@ -392,6 +474,121 @@ static void daemons_should_share_ids_through_redis_and_ride_out_its_outage(void 
     free(second);
 }
 
+/* A Redis store on port (up or not), its puts kept within pending_kb while it is down. */
+static srv_store *open_redis(int port, size_t pending_kb)
+{
+    char spec[64], why[256];
+    snprintf(spec, sizeof spec, "redis://127.0.0.1:%d/4", port);
+    srv_store *s = srv_store_open(&(srv_store_config){ .spec = spec, .prefix = "kept:", .pending_kb = pending_kb }, why,
+                                  sizeof why);
+    if (!s)
+        fail_msg("%s: %s", spec, why);
+    return s;
+}
+
+/* Waits up to 5 s for the store's kept puts to be written. */
+static void wait_until_nothing_pending(srv_store *s)
+{
+    srv_store_stats st;
+    for (int i = 0; i < 100; i++) {
+        srv_store_stats_get(s, &st);
+        if (!st.pending)
+            return;
+        usleep(50000);
+    }
+    fail_msg("%llu puts still pending after 5 s", st.pending);
+}
+
+static void puts_while_redis_is_down_should_be_kept_within_their_bound_and_written_when_it_returns(void **state)
+{
+    (void)state;
+    if (access("/usr/bin/redis-server", X_OK)) {
+        skip();
+        return;
+    }
+    int port = free_port();   /* nothing listens there yet */
+    srv_store *s = open_redis(port, 1);
+    /* Ten puts of 200 bytes (id, model and request) while Redis is down; 1 KiB keeps the last five. */
+    char id[10][33], model[10][180];
+    for (unsigned i = 0; i < 10; i++) {
+        snprintf(model[i], sizeof model[i], "{\"m\":%u,\"pad\":\"%0145u\"}", i, i);
+        assert_int_equal(32 + strlen(model[i]) + strlen("{\"r\":1}"), 200);
+        assert_int_equal(srv_store_put(s, id_of(0x1000 + i, id[i]), model[i], "{\"r\":1}"), SRV_STORE_DOWN);
+    }
+    srv_store_stats st;
+    srv_store_stats_get(s, &st);
+    assert_int_equal(st.pending, 5);
+    assert_int_equal(st.dropped, 5);
+    /* Meanwhile a kept put answers from memory; a dropped one cannot be answered. */
+    expect_entry(s, id[9], model[9], "{\"r\":1}");
+    char *m = NULL, *r = NULL;
+    assert_int_equal(srv_store_get(s, id[0], &m, &r), SRV_STORE_DOWN);
+    srv_sbuf b = { 0 };
+    srv_store_metrics(s, &b);
+    assert_non_null(strstr(b.s, "\npdesolid_store_pending 5\n"));
+    assert_non_null(strstr(b.s, "\npdesolid_store_pending_dropped_total 5\n"));
+    free(b.s);
+
+    pid_t redis = redis_start(port);
+    wait_until_nothing_pending(s);   /* with no call of ours: the store's thread writes them */
+    srv_store_stats_get(s, &st);
+    assert_int_equal(st.late, 5);
+    srv_store_close(s);
+    s = open_redis(port, 1);         /* nothing in memory: what Redis holds */
+    for (unsigned i = 0; i < 10; i++) {
+        if (i < 5)
+            expect_missing(s, id[i]);
+        else
+            expect_entry(s, id[i], model[i], "{\"r\":1}");
+    }
+    srv_store_close(s);
+    redis_stop(redis);
+}
+
+static void an_id_solved_while_redis_is_down_should_reach_the_other_daemons_when_it_returns(void **state)
+{
+    (void)state;
+    if (access("/usr/bin/redis-server", X_OK)) {
+        skip();
+        return;
+    }
+    int port = free_port();
+    pid_t redis = redis_start(port);
+    char args[256], id[33];
+    snprintf(args, sizeof args, "--store redis://127.0.0.1:%d/5", port);
+    daemon_t a, b;
+    daemon_start(&a, dir, args);
+    daemon_start(&b, dir, args);
+    redis_stop(redis);
+    char *doc = solve(&a, "{\"preset\":\"fig4c\"}", id);   /* a answers; its put cannot reach Redis */
+    expect_status(get(&b, "/solids/%s", id), 503);
+    http_reply r = get(&a, "/metrics");
+    assert_non_null(strstr(r.body, "\npdesolid_store_pending 1\n"));
+    free(r.body);
+
+    redis = redis_start(port);   /* empty: the id is only in a's memory */
+    r = (http_reply){ 0 };
+    for (int i = 0; i < 50; i++) {   /* a writes it within about a second of Redis's return */
+        free(r.body);
+        r = get(&b, "/solids/%s", id);
+        if (r.status == 200)
+            break;
+        usleep(100000);
+    }
+    if (r.status != 200)
+        fail_msg("b: GET /solids/%s: %ld %s", id, r.status, r.body);
+    assert_string_equal(r.body, doc);
+    free(r.body);
+    r = get(&a, "/metrics");
+    assert_non_null(strstr(r.body, "\npdesolid_store_pending 0\n"));
+    assert_non_null(strstr(r.body, "\npdesolid_store_late_puts_total 1\n"));
+    free(r.body);
+    daemon_stop(&a);
+    daemon_stop(&b);
+    redis_stop(redis);
+    free(doc);
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -413,10 +610,14 @@ int main(void)
         cmocka_unit_test(a_put_should_come_back_and_an_unknown_id_be_missing),
         cmocka_unit_test(a_put_should_survive_close_and_open),
         cmocka_unit_test(the_bound_should_evict_the_least_recently_used_first),
+        cmocka_unit_test(a_get_should_never_commit_and_its_refresh_be_written_later_in_one),
+        cmocka_unit_test(puts_at_once_should_share_commits_and_each_be_kept),
         cmocka_unit_test(two_processes_on_one_directory_should_see_each_others_puts),
         cmocka_unit_test(a_bad_spec_should_be_refused_and_none_give_no_store),
         cmocka_unit_test(ids_should_survive_sigkill_of_the_daemon),
         cmocka_unit_test(daemons_should_share_ids_through_redis_and_ride_out_its_outage),
+        cmocka_unit_test(puts_while_redis_is_down_should_be_kept_within_their_bound_and_written_when_it_returns),
+        cmocka_unit_test(an_id_solved_while_redis_is_down_should_reach_the_other_daemons_when_it_returns),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("store", tests, setup, teardown);
