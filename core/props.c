@@ -472,6 +472,8 @@ static pde_status detj_separable(const pde_solution *s, const quad_sep *sp, doub
     face.lo[sp->axis] = 1.0;
     double at[3] = { start[0], start[1], start[2] };
     at[sp->axis] = 1.0;
+    if (sp->free >= 0)   /* det J is constant along it: a segment of w, a 1-D problem */
+        face.lo[sp->free] = face.hi[sp->free] = at[sp->free];
     bb_result b;
     pde_status st = bb_minimise(s, OBJ_DETJ, sign, at, &face, tol, PDE_PROPS_BOXES_J, cancel, &b);
     if (st != PDE_OK)
