@@ -58,6 +58,7 @@
  * at four halvings (7e-7 at two, within 96 panels). */
 #define FLAT_DEPTH 4
 #define FLAT_PANELS ((size_t)-1)
+#define SEG_MEMO 128          /* segments of w remembered by free_panel */
 #define FREE_DEPTH 2          /* halvings along w where det J does not depend on the face's other parameter */
 
 /* The panels: their edges along each axis, the points of each axis's rule, and its estimated error. */
@@ -86,6 +87,11 @@ typedef struct {
     int n[3];                    /* the current panel's points per axis (0: the flat axis) */
     int flat;                    /* the axis fixed at 1 (quad_separate), or -1 */
     int free;                    /* the face's parameter det J does not depend on (quad_sep), or -1 */
+    /* free_panel's segments of w whose sign was certified or not, the same for every panel of the
+     * other parameter: remembered, up to SEG_MEMO of them */
+    double seg_lo[SEG_MEMO], seg_hi[SEG_MEMO];
+    unsigned char seg_def[SEG_MEMO];
+    int nseg;
     int max_depth;               /* OUTER_DEPTH, or FLAT_DEPTH with a flat axis */
     size_t max_panels;           /* REFINE_PANELS, or FLAT_PANELS */
     size_t off[3], mt;           /* modes of the components before c; modes in all */
@@ -584,9 +590,17 @@ static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int dep
  */
 static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
 {
-    pbox seg = *b;
-    seg.lo[q->free] = seg.hi[q->free] = 0.5 * (b->lo[q->free] + b->hi[q->free]);
-    const int definite = sign_definite(q, &seg);
+    int definite = -1;
+    for (int i = 0; i < q->nseg && definite < 0; i++)
+        if (q->seg_lo[i] == b->lo[2] && q->seg_hi[i] == b->hi[2])
+            definite = q->seg_def[i];
+    if (definite < 0) {   /* at any one value of the other parameter: 1/2 */
+        pbox seg = *b;
+        seg.lo[q->free] = seg.hi[q->free] = 0.5;
+        definite = sign_definite(q, &seg);
+        if (q->nseg < SEG_MEMO)
+            q->seg_lo[q->nseg] = b->lo[2], q->seg_hi[q->nseg] = b->hi[2], q->seg_def[q->nseg++] = (unsigned char)definite;
+    }
     if (!definite && depth < FREE_DEPTH) {
         const int saved = q->n[2];
         const double mid = 0.5 * (b->lo[2] + b->hi[2]);
@@ -776,6 +790,7 @@ static qctx *qctx_new(const pde_solution *s, const pde_cancel *cancel)
     q->cancel = cancel;
     q->flat = -1;
     q->free = -1;
+    q->nseg = 0;
     q->max_depth = OUTER_DEPTH;
     q->max_panels = REFINE_PANELS;
     q->modes = q->mt + 1;
