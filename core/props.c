@@ -343,6 +343,13 @@ int pde_properties_flat_axis(const pde_solution *s)
     return sp.axis;
 }
 
+int pde_properties_free_axis(const pde_solution *s)
+{
+    quad_sep sp;
+    quad_separate(s, &sp);
+    return sp.free;
+}
+
 /*
  * Eigenvalues (ascending) and unit eigenvectors (rows) of a symmetric 3 x 3 matrix, by cyclic
  * Jacobi rotations (Golub and Van Loan, section 8.5): accurate to rounding for every spectrum.
