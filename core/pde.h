@@ -337,4 +337,9 @@ void pde_properties_nodes(const pde_solution *sol, size_t nodes[3]);
  * over the face of that axis at 1 alone (docs/MATH.md, "Separable solids"), or -1 (for api/cost.h). */
 int pde_properties_flat_axis(const pde_solution *sol);
 
+/* Where det J also does not depend on that face's other parameter (docs/MATH.md, "det J constant
+ * along the face"): that parameter (0: u, 1: v), so that det J's bounds and the integrals' roots
+ * are 1-D along w; else -1 (for api/cost.h). */
+int pde_properties_free_axis(const pde_solution *sol);
+
 #endif

@@ -343,6 +343,13 @@ int pde_properties_flat_axis(const pde_solution *s)
     return sp.axis;
 }
 
+int pde_properties_free_axis(const pde_solution *s)
+{
+    quad_sep sp;
+    quad_separate(s, &sp);
+    return sp.free;
+}
+
 /*
  * Eigenvalues (ascending) and unit eigenvectors (rows) of a symmetric 3 x 3 matrix, by cyclic
  * Jacobi rotations (Golub and Van Loan, section 8.5): accurate to rounding for every spectrum.
@@ -472,6 +479,8 @@ static pde_status detj_separable(const pde_solution *s, const quad_sep *sp, doub
     face.lo[sp->axis] = 1.0;
     double at[3] = { start[0], start[1], start[2] };
     at[sp->axis] = 1.0;
+    if (sp->free >= 0)   /* det J is constant along it: a segment of w, a 1-D problem */
+        face.lo[sp->free] = face.hi[sp->free] = at[sp->free];
     bb_result b;
     pde_status st = bb_minimise(s, OBJ_DETJ, sign, at, &face, tol, PDE_PROPS_BOXES_J, cancel, &b);
     if (st != PDE_OK)

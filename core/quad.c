@@ -58,6 +58,8 @@
  * at four halvings (7e-7 at two, within 96 panels). */
 #define FLAT_DEPTH 4
 #define FLAT_PANELS ((size_t)-1)
+#define SEG_MEMO 128          /* segments of w remembered by free_panel */
+#define FREE_DEPTH 2          /* halvings along w where det J does not depend on the face's other parameter */
 
 /* The panels: their edges along each axis, the points of each axis's rule, and its estimated error. */
 typedef struct {
@@ -84,6 +86,12 @@ typedef struct {
     double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];   /* n-point rules on [0, 1] */
     int n[3];                    /* the current panel's points per axis (0: the flat axis) */
     int flat;                    /* the axis fixed at 1 (quad_separate), or -1 */
+    int free;                    /* the face's parameter det J does not depend on (quad_sep), or -1 */
+    /* free_panel's segments of w whose sign was certified or not, the same for every panel of the
+     * other parameter: remembered, up to SEG_MEMO of them */
+    double seg_lo[SEG_MEMO], seg_hi[SEG_MEMO];
+    unsigned char seg_def[SEG_MEMO];
+    int nseg;
     int max_depth;               /* OUTER_DEPTH, or FLAT_DEPTH with a flat axis */
     size_t max_panels;           /* REFINE_PANELS, or FLAT_PANELS */
     size_t off[3], mt;           /* modes of the components before c; modes in all */
@@ -572,8 +580,60 @@ static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int dep
     memcpy(q->n, saved_n, sizeof saved_n);
 }
 
+/*
+ * Where det J does not depend on the face's parameter q->free (quad_sep), its sign on b is its sign
+ * on b's segment of w at any one value of it, certified in 1-D (sign_definite), where the bounds
+ * close. Where it is not certified, the w-range is halved, down to FREE_DEPTH halvings, then
+ * integrated along lines of w through the rule's nodes in the other parameter: each line's
+ * integral is exact to rounding (line_integrate), and across lines the integrand is smooth, since
+ * det J's roots are the same on every line. No octants, no refinement.
+ */
+static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
+{
+    int definite = -1;
+    for (int i = 0; i < q->nseg && definite < 0; i++)
+        if (q->seg_lo[i] == b->lo[2] && q->seg_hi[i] == b->hi[2])
+            definite = q->seg_def[i];
+    if (definite < 0) {   /* at any one value of the other parameter: 1/2 */
+        pbox seg = *b;
+        seg.lo[q->free] = seg.hi[q->free] = 0.5;
+        definite = sign_definite(q, &seg);
+        if (q->nseg < SEG_MEMO)
+            q->seg_lo[q->nseg] = b->lo[2], q->seg_hi[q->nseg] = b->hi[2], q->seg_def[q->nseg++] = (unsigned char)definite;
+    }
+    if (!definite && depth < FREE_DEPTH) {
+        const int saved = q->n[2];
+        const double mid = 0.5 * (b->lo[2] + b->hi[2]);
+        memset(acc, 0, Q_N * sizeof *acc);
+        for (int h = 0; h < 2; h++) {
+            pbox c = *b;
+            double part[Q_N];
+            *(h ? &c.lo[2] : &c.hi[2]) = mid;
+            q->n[2] = rule_points(q->f[2] * (c.hi[2] - c.lo[2]));
+            free_panel(q, &c, depth + 1, part);
+            for (int e = 0; e < Q_N; e++)
+                acc[e] += part[e];
+        }
+        q->n[2] = saved;
+        return;
+    }
+    int k = 2;
+    if (definite)   /* lines along the axis with the fewer points */
+        k = q->n[q->free] < q->n[2] ? q->free : 2;
+    else
+        q->r.lined++;
+    panel_lines(q, b, k, definite, acc);
+}
+
 static void panel(qctx *q, const pbox *b)
 {
+    if (q->free >= 0) {
+        double acc[Q_N];
+        free_panel(q, b, 0, acc);
+        for (int e = 0; e < Q_N; e++)
+            q->r.acc[e] += acc[e];
+        return;
+    }
     const int definite = sign_definite(q, b);
     int k = 0;
     if (definite) {   /* lines along the axis with the fewest points, the cheapest */
@@ -729,6 +789,8 @@ static qctx *qctx_new(const pde_solution *s, const pde_cancel *cancel)
     q->s = s;
     q->cancel = cancel;
     q->flat = -1;
+    q->free = -1;
+    q->nseg = 0;
     q->max_depth = OUTER_DEPTH;
     q->max_panels = REFINE_PANELS;
     q->modes = q->mt + 1;
@@ -744,9 +806,59 @@ static void qctx_free(qctx *q)
     free(q);
 }
 
+/* The Wronskian a b' - b a' of two factors is constant: see quad_sep's free. Sufficient, not
+ * necessary: an unrecognised pair only keeps the general path. */
+static int wronskian_constant(pde_factor a, pde_factor b)
+{
+    if ((a.kind == PDE_SIN && a.p == 0.0) || (b.kind == PDE_SIN && b.p == 0.0))
+        return 1;   /* a factor 0 */
+    if (a.kind == b.kind && a.p == b.p)
+        return 1;   /* W(f, f) = 0 */
+    if (a.kind == PDE_POW && b.kind == PDE_POW)
+        return a.p + b.p == 1.0;   /* W(1, t) = 1 */
+    if (a.kind == PDE_EXP && b.kind == PDE_EXP)
+        return a.p == -b.p;   /* W = -2 alpha */
+    if (a.p != b.p)
+        return 0;
+    return (a.kind == PDE_SIN && b.kind == PDE_COS) || (a.kind == PDE_COS && b.kind == PDE_SIN) ||
+           (a.kind == PDE_SINH && b.kind == PDE_COSH) || (a.kind == PDE_COSH && b.kind == PDE_SINH);
+}
+
+/* quad_sep's free: the face's other parameter along which G is constant, or -1. */
+static int separate_free(const pde_solution *s, const quad_sep *sp)
+{
+    if (sp->ns != 2)
+        return -1;
+    const int f = 1 - sp->axis;   /* the face's other parameter, u or v */
+    int c1 = -1, c2 = -1;
+    for (int c = 0; c < 3; c++) {
+        const comp_solution *cs = &s->comp[c];
+        if (sp->in[c]) {
+            if (c1 < 0)
+                c1 = c;
+            else
+                c2 = c;
+            continue;
+        }
+        for (size_t m = 0; m < cs->nmodes; m++) {
+            const pde_factor g = f == 0 ? cs->modes[m].u : cs->modes[m].v;
+            if (g.kind != PDE_POW || g.p != 0.0)
+                return -1;
+        }
+    }
+    const comp_solution *a = &s->comp[c1], *b = &s->comp[c2];
+    for (size_t i = 0; i < a->nmodes; i++)
+        for (size_t j = 0; j < b->nmodes; j++)
+            if (!wronskian_constant(f == 0 ? a->modes[i].u : a->modes[i].v,
+                                    f == 0 ? b->modes[j].u : b->modes[j].v))
+                return -1;
+    return f;
+}
+
 void quad_separate(const pde_solution *s, quad_sep *sep)
 {
     sep->axis = -1;
+    sep->free = -1;
     for (int a = 0; a < 2; a++) {
         int n = 0, ok = 1;
         for (int c = 0; c < 3 && ok; c++) {
@@ -765,6 +877,7 @@ void quad_separate(const pde_solution *s, quad_sep *sep)
         }
         if (ok && n > 0) {
             sep->axis = a, sep->n = n, sep->ns = sep->in[0] + sep->in[1] + sep->in[2];
+            sep->free = separate_free(s, sep);
             return;
         }
     }
@@ -798,9 +911,10 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     qctx *q = qctx_new(s, cancel);
     if (!q)
         return PDE_ERR_NOMEM;
-    quad_sep sp = { .axis = -1 };
+    quad_sep sp = { .axis = -1, .free = -1 };
     if (separate)
         quad_separate(s, &sp);
+    q->free = separate == 1 ? sp.free : -1;
     q->jtol = 1e-13 * jscale;
     q->vscale = vscale;
     qplan p;

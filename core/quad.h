@@ -40,13 +40,20 @@ typedef struct {
  */
 typedef struct {
     int axis, n, ns, in[3];
+    /* The face's other parameter s (not the axis, not w) when G does not depend on it: ns = 2, the
+     * component with in[c] = 0 a function of w alone, and every pair of s-factors of the two others
+     * with a constant Wronskian a b' - b a' (sin and cos, sinh and cosh of one frequency, one factor
+     * twice, exp(+-alpha s), 1 and s). Then G = Z'(w) sum h_i(w) k_j(w) W_ij = g(w); else -1. */
+    int free;
 } quad_sep;
 
 void quad_separate(const pde_solution *s, quad_sep *sep);
 
 /* jscale: the size of det J over the solid, for what counts as zero; vscale: the size of the
  * volume (jscale will do), for the refinement's tolerance. separate: where det J separates
- * (quad_separate), integrate over the face t = 1 only (pde_properties); 0: over the cube (tests). */
+ * (quad_separate), integrate over the face t = 1 only, and along w alone where det J does not
+ * depend on the face's other parameter (pde_properties); 2: the face without that (tests); 0: over
+ * the cube (tests). */
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
                       const pde_cancel *cancel, quad_result *out);
 

@@ -654,14 +654,25 @@ static void separable_integrals_should_equal_the_adaptive_integrals_over_the_cub
         quad_result fast, cube;
         assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 1, NULL, &fast), PDE_OK);
         assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 0, NULL, &cube), PDE_OK);
+        /* det J constant along v (quad_sep's free): lines along w alone, against the face's own path */
+        assert_int_equal(sp.free, 1);
+        quad_result face;
+        assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 2, NULL, &face), PDE_OK);
         double scale[Q_N];   /* each integral against its size: |det J| times |r|^k */
         const double size = cbrt(p.volume) + 1.0;
         for (int e = 0; e < Q_N; e++)
             scale[e] = p.volume * (e == Q_VOL || e == Q_SIGNED ? 1.0 : e < Q_M2 ? size : size * size);
-        for (int e = 0; e < Q_N; e++)
+        for (int e = 0; e < Q_N; e++) {
             if (!(fabs(fast.acc[e] - cube.acc[e]) <= 1e-12 * scale[e]))
                 fail_msg("%s: integral %d: %.17g separable, %.17g over the cube", names[k], e, fast.acc[e],
                          cube.acc[e]);
+            if (!(fabs(fast.acc[e] - face.acc[e]) <= 1e-12 * scale[e]))
+                fail_msg("%s: integral %d: %.17g along w, %.17g over the face", names[k], e, fast.acc[e],
+                         face.acc[e]);
+        }
+        /* det J's bounds in 1-D (along w) close to their tolerance, 1e-9 of its size */
+        if (!(p.detj_gap <= 2e-9 * jscale))
+            fail_msg("%s: det J's gap %g of %g", names[k], p.detj_gap, jscale);
         pde_solution_free(sol);
     }
 }
@@ -686,7 +697,21 @@ static void det_j_should_not_separate_without_the_product_structure(void **state
     quad_separate(sol, &sp);
     assert_int_equal(sp.axis, -1);
     z->u = keep;
+    quad_separate(sol, &sp);
+    assert_int_equal(sp.free, 1);               /* fig. 4a: det J = u g(w) */
     pde_mode *x = &sol->comp[0].modes[0];
+    const pde_factor xv = x->v;
+    x->v = (pde_factor){ xv.kind, 2 * xv.p };   /* x's v at twice y's frequency: det J depends on v */
+    quad_separate(sol, &sp);
+    assert_int_equal(sp.axis, 0);
+    assert_int_equal(sp.free, -1);
+    x->v = xv;
+    pde_factor zv = z->v;
+    z->v = (pde_factor){ PDE_SIN, 2 };          /* z = sin(2 pi v) Z(w): its row has a v-partial */
+    quad_separate(sol, &sp);
+    assert_int_equal(sp.axis, 0);
+    assert_int_equal(sp.free, -1);
+    z->v = zv;
     x->u = (pde_factor){ PDE_COS, 1 };          /* one mode of x not u^n */
     quad_separate(sol, &sp);
     assert_int_equal(sp.axis, -1);
