@@ -42,7 +42,8 @@ static void add_stream(api_meshopt *z, const api_meshopt_stream *s, size_t writt
     d->offset = z->len;
     d->length = written;
     d->decoded_offset = z->decoded_len;
-    z->len = align4(z->len + written);
+    z->len = align4(d->offset + written);
+    memset(z->data + d->offset + written, 0, z->len - (d->offset + written));   /* nothing of the heap's */
     z->decoded_len = align4(z->decoded_len + d->stride * d->count);
 }
 
