@@ -85,6 +85,9 @@ const pde_props *api_out_props(api_output *o, const pde_cancel *cancel, api_erro
         pde_status st = pde_properties(o->sol, &opts, &o->props);
         if (st == PDE_ERR_CANCELLED)
             api_out_cancelled(err);
+        else if (st == PDE_ERR_RANGE)
+            api_fail(err, API_ERR_DOCUMENT, "", "the solid is too large: its properties (volume, inertia) exceed "
+                     "the range of a double; scale the model's data or forces down");
         if (st != PDE_OK)
             return NULL;
     }

@@ -54,7 +54,8 @@ int api_out_f32(api_output *o, const float *f, size_t n);    /* n floats, little
 void api_le32(unsigned char *p, uint32_t v);
 void api_le64(unsigned char *p, uint64_t v);
 
-/* The caller's properties, or computed now; NULL with err when cancelled, NULL (err untouched) when out of memory. */
+/* The caller's properties, or computed now; NULL with err when cancelled or when they overflow a double (a document
+ * error), NULL (err untouched) when out of memory. */
 const pde_props *api_out_props(api_output *o, const pde_cancel *cancel, api_error *err);
 /* -1 with err set to API_ERR_CANCELLED. */
 int api_out_cancelled(api_error *err);

@@ -1020,9 +1020,37 @@ static void obj_ply_msh_and_vtu_should_read_back_in_meshio(void **state)
     }
 }
 
+/* A solid whose integrals overflow a double (fig. 4a with p0 = 1e100) is a document the client can mend,
+ * not an out-of-memory 500: every format that carries the properties says why. */
+static void properties_beyond_a_double_should_be_a_document_error(void **state)
+{
+    (void)state;
+    const char *doc = "{\"preset\":\"fig4a\",\"params\":{\"p0\":1e100}}";
+    api_error err;
+    api_model *m = api_model_parse(doc, strlen(doc), &err);
+    assert_non_null(m);
+    pde_solution *sol = NULL;
+    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
+    for (int f = 0; f < API_FMT_COUNT; f++) {
+        const api_format_info *fi = api_format_info_of((api_format)f);
+        if (!fi->props)
+            continue;
+        const unsigned res[3] = { 4, 4, 4 };
+        memset(&err, 0, sizeof err);
+        api_output *o = api_output_open(sol, NULL, NULL, (api_format)f, res, NULL, &err);
+        if (o)
+            fail_msg("%s: opened a solid whose integrals overflow", fi->name);
+        if (err.status != API_ERR_DOCUMENT || !(strstr(err.message, "too large") || strstr(err.message, "float32")))
+            fail_msg("%s: status %d, \"%s\"", fi->name, (int)err.status, err.message);
+    }
+    pde_solution_free(sol);
+    api_model_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(properties_beyond_a_double_should_be_a_document_error),
         cmocka_unit_test(presets_should_carry_the_papers_values),
         cmocka_unit_test(presets_should_be_the_tests_own_transcription),
         cmocka_unit_test(every_preset_should_give_gltf_and_glb_that_the_khronos_validator_passes),
