@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -201,7 +202,7 @@ static void output_file_should_never_be_ignored(void **state)
     (void)state;
     char *out, *err, path[256];
     size_t len;
-    const char *exts[] = { "json", "grid.json", "glb", "stl", "obj", "ply", "msh", "vtu" };
+    const char *exts[] = { "json", "grid.json", "glb", "stl", "obj", "ply", "msh", "vtu", "PLY", "Glb" };   /* any case */
     for (size_t i = 0; i < sizeof exts / sizeof *exts; i++) {
         char args[128];
         snprintf(args, sizeof args, "solve --preset fig3d --res 8 -o byext.%s", exts[i]);
@@ -214,7 +215,7 @@ static void output_file_should_never_be_ignored(void **state)
         unsigned char *got = (unsigned char *)read_file(path, &len);
         assert_non_null(got);
         /* What the extension names: glb's magic, stl's 84 + 50 n bytes, grid's resolution, json's id. */
-        if (!strcmp(exts[i], "glb"))
+        if (!strcasecmp(exts[i], "glb"))
             assert_memory_equal(got, "glTF", 4);
         else if (!strcmp(exts[i], "stl"))
             assert_int_equal((len - 84) % 50, 0);
@@ -222,7 +223,7 @@ static void output_file_should_never_be_ignored(void **state)
             assert_non_null(strstr((char *)got, "\"resolution\""));
         else if (!strcmp(exts[i], "obj"))
             assert_memory_equal(got, "# pdesolid", 10);
-        else if (!strcmp(exts[i], "ply"))
+        else if (!strcasecmp(exts[i], "ply"))
             assert_memory_equal(got, "ply\nformat binary_little_endian", 31);
         else if (!strcmp(exts[i], "msh"))
             assert_memory_equal(got, "$MeshFormat\n4.1", 15);

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
 
 #include "describe.h"
@@ -316,7 +317,7 @@ static int format_from_extension(options *o)
     for (int i = 0; i < API_FMT_COUNT; i++) {
         const api_format_info *f = api_format_info_of((api_format)i);
         size_t k = strlen(f->ext);
-        if (k < n && k > best && strcmp(o->out + n - k, f->ext) == 0) {
+        if (k < n && k > best && strcasecmp(o->out + n - k, f->ext) == 0) {   /* x.PLY too */
             best = k;
             o->format = f->name;
         }
