@@ -130,9 +130,9 @@ int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *er
     for (int i = 0; i < 3; i++) {
         if (v[i] < 2)
             return api_fail(err, API_ERR_DOCUMENT, "", "res: %llu is too few; at least 2 %s", v[i], what);
-        if (v[i] > max)
-            return api_fail(err, API_ERR_DOCUMENT, "", "res: %llu is more than the limit of %u %s for %s", v[i], max, what,
-                            formats[f]->name);
+        if (v[i] > max)   /* the text as sent: strtoull saturates past 2^64 */
+            return api_fail(err, API_ERR_DOCUMENT, "", "res: \"%.40s\" is more than the limit of %u %s for %s", text, max,
+                            what, formats[f]->name);
         total *= v[i];
     }
     if (!mesh && total > API_RES_GRID_POINTS)

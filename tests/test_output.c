@@ -866,7 +866,7 @@ static void bad_formats_and_resolutions_should_name_the_limit(void **state)
         { "5000", "grid", "limit of 4096" }, { "600", "glb", "limit of 512" },
         { "1024", "f32", "points in all" }, { "a,b,c", "grid", "NU,NV,NW" },
         { "3,3", "grid", "NU,NV,NW" },      { "-4", "grid", "NU,NV,NW" },
-        { "4,4,4,", "grid", "NU,NV,NW" },   { "99999999999999999999", "grid", "limit" },
+        { "4,4,4,", "grid", "NU,NV,NW" },   { "99999999999999999999", "grid", "99999999999999999999\" is more than the limit" },
     };
     for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
         api_format f;
