@@ -367,7 +367,7 @@ static srv_entry *find_solid(srv_req *r)
     if (!e && missing)
         srv_problem(r, 404, NULL,
                     "no solid %s: it was never solved here, or was evicted; POST its model to /solve",
-                    valid ? r->arg : "with that id (an id is 32 hex digits)");
+                    valid ? r->arg : "with that id (an id is 32 lowercase hex digits)");
     return e;
 }
 
@@ -383,7 +383,7 @@ static void get_solid_request(srv_req *r)
         srv_set_text(r, 200, "application/json", request);
     else if (st == SRV_STORE_OK || st == SRV_STORE_MISSING)
         srv_problem(r, 404, NULL, "no request kept for %s: the store (--store) has no such id",
-                    api_id_valid(r->arg) ? r->arg : "that id (an id is 32 hex digits)");
+                    api_id_valid(r->arg) ? r->arg : "that id (an id is 32 lowercase hex digits)");
     else
         store_down(r);
 }
