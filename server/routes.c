@@ -555,8 +555,8 @@ int srv_route_find(const char *method, const char *path, char *arg, size_t argn,
         char tmp[96];
         if (match(srv_routes[i].path, path, tmp, sizeof tmp) != 1)
             continue;
-        used += (size_t)snprintf(allow + used, used < allown ? allown - used : 0, "%s%s", used ? ", " : "",
-                                 srv_routes[i].method);
+        used += (size_t)snprintf(allow + used, used < allown ? allown - used : 0, "%s%s%s", used ? ", " : "",
+                                 srv_routes[i].method, strcmp(srv_routes[i].method, "GET") ? "" : ", HEAD");
         if (used >= allown)
             used = allown - 1;
     }

@@ -513,6 +513,11 @@ static void bad_requests_should_get_problems_and_the_daemon_should_keep_serving(
     char allow[64];
     assert_true(header_value(&r, "Allow", allow, sizeof allow));
     free(r.body);
+    r = http(&d, "DELETE", "/livez", NULL, 0, NULL);   /* a GET route takes HEAD too, and says so */
+    expect_problem(&r, 405, NULL, "use GET, HEAD, OPTIONS");
+    assert_true(header_value(&r, "Allow", allow, sizeof allow));
+    assert_string_equal(allow, "GET, HEAD, OPTIONS");
+    free(r.body);
     r = http(&d, "GET", "/solids/xyz", NULL, 0, NULL);
     expect_problem(&r, 404, NULL, "no solid");
     free(r.body);
