@@ -129,6 +129,8 @@ static int sample_faces(const pde_solution *sol, const face f[2], const unsigned
             pde_grid_plane_d(g, sample(b, res[2]), x, xd[0], xd[1], xd[2]);
         }
         for (int side = 0; side < 2; side++) {
+            if (side && (rc = stopped(cancel)))   /* a poll per face row, as before the faces were paired */
+                break;
             /* sample a of this side in the plane's layout: (v, u) interleaved for u = 0, 1, else by rows */
             const size_t step = axis == 0 ? 2 : 1, first = axis == 0 ? (size_t)side : (size_t)side * na;
             const size_t s0 = f[side].base + b * na;
