@@ -5,9 +5,10 @@
  * The skin is the image of the parameter cube's boundary, sampled on the
  * lattice i/(n-1) of each axis, so its topology is known before any position
  * is: no position is hashed or searched for.
- * 1. Each face is sampled on its own grid with the closed form's first
- *    derivatives (pde_grid), and triangulated, wound so that its normal points
- *    out of the parameter cube.
+ * 1. The two faces of each axis are sampled on one grid with the closed
+ *    form's first derivatives (pde_grid; u = 0, 1 as a grid of nu = 2, which
+ *    core fills column-wise), and triangulated, wound so that each face's
+ *    normal points out of the parameter cube.
  * 2. Samples are joined (union-find) where they are one point:
  *    - a face's edge row is its neighbour's (the cube's 12 edges): by the
  *      lattice alone;
