@@ -137,23 +137,57 @@ static void gltf_json(api_sw *w, const api_output *o, const gltf_state *s, const
     api_sw_puts(w, glb ? "]}" : "]}\n");
 }
 
-/* The plain blob: positions and normals in glTF's frame, det J, indices; each a multiple of 4 bytes. */
+/*
+ * Bytes [off, off + n) of the plain blob, both multiples of 4, into dst: positions and normals in
+ * glTF's frame (x, z, -y), det J, indices; each a multiple of 4 bytes. glb streams it straight from
+ * the mesh a chunk at a time; gltf's base64 reads it whole.
+ */
+static void plain_bytes(const api_mesh *m, size_t off, unsigned char *dst, size_t n)
+{
+    const size_t nv = m->nverts, end = off + n;
+    for (int seg = 0; seg < 2 && off < end; seg++) {   /* positions, then normals */
+        const size_t s0 = 12 * nv * (size_t)seg, s1 = s0 + 12 * nv;
+        const float *src = seg ? m->nrm : m->pos;
+        const size_t stop = s1 < end ? s1 : end;
+        while (off < stop) {
+            const size_t f = (off - s0) / 4, c = f % 3;
+            const float *v = src + (f - c);
+            if (c == 0 && off + 12 <= stop) {   /* whole vertices */
+                const size_t nw = (stop - off) / 12;
+                for (size_t i = 0; i < nw; i++, v += 3) {
+                    const float t[3] = { v[0], v[2], -v[1] };
+                    memcpy(dst + 12 * i, t, 12);
+                }
+                off += 12 * nw, dst += 12 * nw;
+                continue;
+            }
+            const float x = c == 0 ? v[0] : c == 1 ? v[2] : -v[1];
+            memcpy(dst, &x, 4);
+            off += 4, dst += 4;
+        }
+    }
+    if (off < end && off < 28 * nv) {
+        const size_t k = (end < 28 * nv ? end : 28 * nv) - off;
+        memcpy(dst, (const unsigned char *)m->detj + (off - 24 * nv), k);
+        off += k, dst += k;
+    }
+    if (off < end)
+        memcpy(dst, (const unsigned char *)m->tri + (off - 28 * nv), end - off);
+}
+
+static size_t plain_len(const api_mesh *m)
+{
+    return 28 * m->nverts + 12 * m->ntris;
+}
+
+/* The plain blob whole, for gltf's base64. */
 static int plain_blob(gltf_state *s)
 {
-    const api_mesh *m = &s->mesh;
-    size_t nv = m->nverts, nt = m->ntris;
-    s->blob_len = 28 * nv + 12 * nt;
+    s->blob_len = plain_len(&s->mesh);
     s->blob = malloc(s->blob_len);
     if (!s->blob)
         return -1;
-    float *bp = (float *)(void *)s->blob, *bn = bp + 3 * nv;
-    for (size_t i = 0; i < nv; i++) {
-        const float *p = m->pos + 3 * i, *q = m->nrm + 3 * i;
-        bp[3 * i] = p[0], bp[3 * i + 1] = p[2], bp[3 * i + 2] = -p[1];
-        bn[3 * i] = q[0], bn[3 * i + 1] = q[2], bn[3 * i + 2] = -q[1];
-    }
-    memcpy(s->blob + 24 * nv, m->detj, 4 * nv);
-    memcpy(s->blob + 28 * nv, m->tri, 12 * nt);
+    plain_bytes(&s->mesh, 0, s->blob, s->blob_len);
     return 0;
 }
 
@@ -189,8 +223,10 @@ static int open_as(api_output *o, const pde_cancel *cancel, api_error *err, int 
     o->st = s;
     if (!s || api_out_mesh(o, cancel, &s->mesh, err))
         return -1;
-    if (o->opts.compress == API_COMPRESS_MESHOPT ? compressed_blob(s, err) : plain_blob(s))
+    if (o->opts.compress == API_COMPRESS_MESHOPT ? compressed_blob(s, err) : glb ? 0 : plain_blob(s))
         return -1;
+    if (glb && !s->compressed)
+        s->blob_len = plain_len(&s->mesh);   /* streamed from the mesh by glb_fill, never held whole */
     const pde_props *props = api_out_props(o, cancel, err);
     char *pj = props ? api_props_json(props) : NULL;
     if (!pj)
@@ -291,8 +327,15 @@ static int glb_fill(api_output *o)
     size_t n = s->blob_len - s->blob_pos;
     if (n > 1 << 20)
         n = 1 << 20;
-    if (api_out_put(o, s->blob + s->blob_pos, n))
-        return -1;
+    if (s->compressed) {
+        if (api_out_put(o, s->blob + s->blob_pos, n))
+            return -1;
+    } else {
+        if (api_out_reserve(o, n))
+            return -1;
+        plain_bytes(&s->mesh, s->blob_pos, (unsigned char *)o->buf + o->len, n);
+        o->len += n;
+    }
     s->blob_pos += n;
     return 0;
 }

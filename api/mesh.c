@@ -5,9 +5,10 @@
  * The skin is the image of the parameter cube's boundary, sampled on the
  * lattice i/(n-1) of each axis, so its topology is known before any position
  * is: no position is hashed or searched for.
- * 1. Each face is sampled on its own grid with the closed form's first
- *    derivatives (pde_grid), and triangulated, wound so that its normal points
- *    out of the parameter cube.
+ * 1. The two faces of each axis are sampled on one grid with the closed
+ *    form's first derivatives (pde_grid; u = 0, 1 as a grid of nu = 2, which
+ *    core fills column-wise), and triangulated, wound so that each face's
+ *    normal points out of the parameter cube.
  * 2. Samples are joined (union-find) where they are one point:
  *    - a face's edge row is its neighbour's (the cube's 12 edges): by the
  *      lattice alone;
@@ -67,23 +68,28 @@ static size_t face_sample(const face *f, const size_t ijk[3])
     return f->base + ijk[o[1]] * f->na + ijk[o[0]];
 }
 
-/* The raw samples: positions, the face's x_a x x_b, and det J. */
+/* The raw samples: positions, the face's x_a x x_b, and det J; lo, hi of the positions, and whether
+ * any is not finite. */
 typedef struct {
     float *pos, *nrm, *detj;
+    float lo[3], hi[3];
+    int bad;
 } samples;
 
 /*
- * Face f's samples, na x nb, fast index first, from the closed form with its derivatives. The
- * grid is made per face: a plane of u = side is a row of (v) per w, and so on. 1 when cancelled,
- * -1 out of memory.
+ * The two faces of an axis, f[0] at 0 and f[1] at 1, na x nb samples each, fast index first, from the
+ * closed form with its derivatives. One grid holds both faces' fixed parameter, so each plane's h(w)
+ * and each row's coefficients serve both: u = 0, 1 is a grid of nu = 2 (a plane of w, rows along v),
+ * v = 0, 1 one of nv = 2 (rows 0 and 1 of a plane), w = 0, 1 the planes 0 and 1 of the (u, v) grid,
+ * one row at a time. 1 when cancelled, -1 out of memory.
  */
-static int sample_face(const pde_solution *sol, const face *f, const unsigned res[3], const pde_cancel *cancel,
-                       samples *out)
+static int sample_faces(const pde_solution *sol, const face f[2], const unsigned res[3], const pde_cancel *cancel,
+                        samples *out)
 {
-    size_t nu = res[0], nv = res[1];
-    size_t nmax = nu > nv ? nu : nv;
+    const int axis = f[0].axis;
+    const size_t nu = res[0], nv = res[1], nmax = nu > nv ? nu : nv;
     double *us = malloc((nu + nv) * sizeof *us), *vs = us ? us + nu : NULL;
-    float *d = malloc(9 * nmax * sizeof *d);
+    float *d = malloc(4 * 3 * 2 * nmax * sizeof *d);   /* x, x_u, x_v, x_w of a plane's row(s) */
     if (!us || !d) {
         free(us);
         free(d);
@@ -93,44 +99,70 @@ static int sample_face(const pde_solution *sol, const face *f, const unsigned re
         us[i] = sample(i, nu);
     for (size_t j = 0; j < nv; j++)
         vs[j] = sample(j, nv);
-    double fixed = f->side;
-    pde_grid *g = NULL;
+    const double ends[2] = { 0.0, 1.0 };
+    pde_grid *g = NULL, *g1 = NULL;   /* g1: the plane w = 1's own grid, so neither moves between planes */
     pde_status st;
-    if (f->axis == 0)
-        st = pde_grid_create(sol, &fixed, 1, vs, nv, &g);        /* (v, w) */
-    else if (f->axis == 1)
-        st = pde_grid_create(sol, us, nu, &fixed, 1, &g);        /* (u, w) */
-    else
-        st = pde_grid_create(sol, us, nu, vs, nv, &g);           /* (u, v) */
+    if (axis == 0)
+        st = pde_grid_create(sol, ends, 2, vs, nv, &g);         /* (v, w) */
+    else if (axis == 1)
+        st = pde_grid_create(sol, us, nu, ends, 2, &g);         /* (u, w) */
+    else if ((st = pde_grid_create(sol, us, nu, vs, nv, &g)) == PDE_OK)   /* (u, v) */
+        st = pde_grid_create(sol, us, nu, vs, nv, &g1);
     free(us);
     if (st != PDE_OK) {
+        pde_grid_free(g);
         free(d);
         return -1;
     }
     int o[2], rc = 0;
-    face_axes(f, o);
-    float *xd[3] = { d, d + 3 * nmax, d + 6 * nmax };   /* x_u, x_v, x_w along a row */
-    for (size_t b = 0; b < f->nb && !rc; b++) {       /* a row at a time, to poll between rows */
+    face_axes(&f[0], o);
+    const size_t na = f[0].na, m = 6 * nmax;
+    float *x = d, *xd[3] = { d + m, d + 2 * m, d + 3 * m };   /* x, then x_u, x_v, x_w */
+    float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    int bad = 0;
+    for (size_t b = 0; b < f[0].nb && !rc; b++) {       /* a row at a time, to poll between rows */
         if ((rc = stopped(cancel)))
             break;
-        const size_t s0 = f->base + b * f->na;
-        if (f->axis == 2)
-            pde_grid_rows(g, fixed, b, b + 1, out->pos + 3 * s0, xd[0], xd[1], xd[2]);
-        else
-            pde_grid_plane_d(g, sample(b, res[2]), out->pos + 3 * s0, xd[0], xd[1], xd[2]);
-        for (size_t a = 0; a < f->na; a++) {
-            const float *ta = xd[o[0]] + 3 * a, *tb = xd[o[1]] + 3 * a, *tc = xd[f->axis] + 3 * a;
-            double n[3] = { (double)ta[1] * tb[2] - (double)ta[2] * tb[1], (double)ta[2] * tb[0] - (double)ta[0] * tb[2],
-                            (double)ta[0] * tb[1] - (double)ta[1] * tb[0] };
-            /* det(x_u, x_v, x_w) = (x_a x x_b) . x_axis, times the sign of (a, b, axis)'s order */
-            double det = n[0] * tc[0] + n[1] * tc[1] + n[2] * tc[2];
-            float *nr = out->nrm + 3 * (s0 + a);
-            for (int k = 0; k < 3; k++)
-                nr[k] = (float)n[k];
-            out->detj[s0 + a] = (float)(f->axis == 1 ? -det : det);
+        if (axis == 2) {
+            pde_grid_rows(g, 0.0, b, b + 1, x, xd[0], xd[1], xd[2]);
+            pde_grid_rows(g1, 1.0, b, b + 1, x + 3 * na, xd[0] + 3 * na, xd[1] + 3 * na, xd[2] + 3 * na);
+        } else {
+            pde_grid_plane_d(g, sample(b, res[2]), x, xd[0], xd[1], xd[2]);
+        }
+        for (int side = 0; side < 2; side++) {
+            if (side && (rc = stopped(cancel)))   /* a poll per face row, as before the faces were paired */
+                break;
+            /* sample a of this side in the plane's layout: (v, u) interleaved for u = 0, 1, else by rows */
+            const size_t step = axis == 0 ? 2 : 1, first = axis == 0 ? (size_t)side : (size_t)side * na;
+            const size_t s0 = f[side].base + b * na;
+            float *restrict pos = out->pos + 3 * s0, *restrict nrm = out->nrm + 3 * s0, *restrict dj = out->detj + s0;
+            const float sg = axis == 1 ? -1.0f : 1.0f;
+            for (size_t a = 0; a < na; a++) {
+                const size_t e = 3 * (first + a * step);
+                const float *ta = xd[o[0]] + e, *tb = xd[o[1]] + e, *tc = xd[axis] + e;
+                double n[3] = { (double)ta[1] * tb[2] - (double)ta[2] * tb[1], (double)ta[2] * tb[0] - (double)ta[0] * tb[2],
+                                (double)ta[0] * tb[1] - (double)ta[1] * tb[0] };
+                /* det(x_u, x_v, x_w) = (x_a x x_b) . x_axis, times the sign of (a, b, axis)'s order */
+                double det = n[0] * tc[0] + n[1] * tc[1] + n[2] * tc[2];
+                for (int k = 0; k < 3; k++) {
+                    const float p = x[e + k];
+                    pos[3 * a + k] = p;
+                    nrm[3 * a + k] = (float)n[k];
+                    bad |= !isfinite(p);
+                    lo[k] = p < lo[k] ? p : lo[k];
+                    hi[k] = p > hi[k] ? p : hi[k];
+                }
+                dj[a] = sg * (float)det;
+            }
         }
     }
+    for (int k = 0; k < 3; k++) {
+        out->lo[k] = lo[k] < out->lo[k] ? lo[k] : out->lo[k];
+        out->hi[k] = hi[k] > out->hi[k] ? hi[k] : out->hi[k];
+    }
+    out->bad |= bad;
     pde_grid_free(g);
+    pde_grid_free(g1);
     free(d);
     return rc;
 }
@@ -190,13 +222,26 @@ static void tri_normal(const float *p, const float *q, const float *r, double n[
     cross(a, b, n);
 }
 
-/* Six times the signed volume of the tetrahedron (0, p, q, r), for samples p, q, r. */
-static double tri_volume(const float *pos, uint32_t p, uint32_t q, uint32_t r)
+/*
+ * Cell v00 (a sample index; na samples to a row) of a face: its triangles' normals (twice their area
+ * vectors) in the unreversed winding, (v00, v10, v11) and (v00, v11, v01), and six times the signed
+ * volume of the tetrahedra (0, triangle) in the face's winding (sgn -1 when it reverses), as
+ * x_00 . n, so the volume costs a dot product on the normal.
+ */
+static inline void cell_normals(const float *restrict pos, size_t v00, size_t na, double sgn, double n[2][3],
+                                double vol[2])
 {
-    const float *a = pos + 3 * p, *b = pos + 3 * q, *c = pos + 3 * r;
-    return (double)a[0] * ((double)b[1] * c[2] - (double)b[2] * c[1]) +
-           (double)a[1] * ((double)b[2] * c[0] - (double)b[0] * c[2]) +
-           (double)a[2] * ((double)b[0] * c[1] - (double)b[1] * c[0]);
+    const float *p = pos + 3 * v00, *p10 = p + 3, *p01 = p + 3 * na, *p11 = p01 + 3;
+    double e1[3], d[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = (double)p10[k] - p[k];
+        d[k] = (double)p11[k] - p[k];
+        e2[k] = (double)p01[k] - p[k];
+    }
+    cross(e1, d, n[0]);
+    cross(d, e2, n[1]);
+    for (int q = 0; q < 2; q++)
+        vol[q] = sgn * ((double)p[0] * n[q][0] + (double)p[1] * n[q][1] + (double)p[2] * n[q][2]);
 }
 
 /* The samples of triangle q (0, 1) of cell (a, b) of face f, wound outward of the cube. */
@@ -245,7 +290,8 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             nraw += f->na * f->nb;
             ntraw += 2 * (f->na - 1) * (f->nb - 1);
         }
-    samples raw = { malloc(3 * nraw * sizeof(float)), malloc(3 * nraw * sizeof(float)), malloc(nraw * sizeof(float)) };
+    samples raw = { malloc(3 * nraw * sizeof(float)), malloc(3 * nraw * sizeof(float)), malloc(nraw * sizeof(float)),
+                    { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY }, 0 };
     uint32_t *up = malloc(nraw * sizeof *up);
     uint32_t *vof = malloc(nraw * sizeof *vof);    /* this face's vertex at each root, or UINT32_MAX */
     uint32_t *pid = malloc(nraw * sizeof *pid);    /* the position id of each root, or UINT32_MAX */
@@ -259,25 +305,21 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         goto done;
 
     /* 1. Faces. */
-    for (int fi = 0; fi < 6; fi++) {
-        int r = sample_face(sol, &faces[fi], res, cancel, &raw);
+    for (int a = 0; a < 3; a++) {
+        int r = sample_faces(sol, &faces[2 * a], res, cancel, &raw);
         if (r) {
             cancelled = r > 0;
             goto done;
         }
     }
-    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
-    for (size_t i = 0; i < nraw; i++)
-        for (int k = 0; k < 3; k++) {
-            const float x = raw.pos[3 * i + k];
-            if (!isfinite(x)) {
-                why = "the solid's coordinates exceed the range of float32; no mesh can hold them";
-                why_status = API_ERR_DOCUMENT;
-                goto done;
-            }
-            lo[k] = x < lo[k] ? x : lo[k];
-            hi[k] = x > hi[k] ? x : hi[k];
-        }
+    if (raw.bad) {
+        why = "the solid's coordinates exceed the range of float32; no mesh can hold them";
+        why_status = API_ERR_DOCUMENT;
+        goto done;
+    }
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; k++)
+        lo[k] = raw.lo[k], hi[k] = raw.hi[k];
     const double extent = fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
     const double eps = extent > 0 ? 1e-6 * extent : 1e-30;
 
@@ -326,18 +368,23 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     double vol = 0.0;   /* six times the enclosed volume, over the live triangles */
     for (int fi = 0; fi < 6; fi++) {
         const face *f = &faces[fi];
-        for (size_t b = 0; b + 1 < f->nb; b++)
-            for (size_t a = 0; a + 1 < f->na; a++)
-                for (int q = 0; q < 2; q++, t++) {
-                    uint32_t s[3];
-                    cell_tri(f, a, b, q, s);
-                    double n[3];
-                    tri_normal(raw.pos + 3 * s[0], raw.pos + 3 * s[1], raw.pos + 3 * s[2], n);
-                    const uint32_t r0 = up[s[0]], r1 = up[s[1]], r2 = up[s[2]];
-                    live[t] = !(r0 == r1 || r1 == r2 || r0 == r2 || n[0] * n[0] + n[1] * n[1] + n[2] * n[2] <= tiny2);
-                    if (live[t])
-                        vol += tri_volume(raw.pos, r0, r1, r2), ntri++;
-                }
+        const double sgn = f->reverse ? -1.0 : 1.0;
+        for (size_t b = 0; b + 1 < f->nb; b++) {
+            const uint32_t *restrict u0 = up + f->base + b * f->na, *restrict u1 = u0 + f->na;
+            for (size_t a = 0; a + 1 < f->na; a++, t += 2) {
+                double n[2][3], v[2];
+                cell_normals(raw.pos, f->base + b * f->na + a, f->na, sgn, n, v);
+                const uint32_t r00 = u0[a], r10 = u0[a + 1], r01 = u1[a], r11 = u1[a + 1];
+                /* both triangles hold v00 and v11: (v00, v10, v11) and (v00, v11, v01), either winding */
+                const int diag = r00 != r11;
+                live[t] = diag && r10 != r00 && r10 != r11 && n[0][0] * n[0][0] + n[0][1] * n[0][1] + n[0][2] * n[0][2] > tiny2;
+                live[t + 1] = diag && r01 != r00 && r01 != r11 && n[1][0] * n[1][0] + n[1][1] * n[1][1] + n[1][2] * n[1][2] > tiny2;
+                if (live[t])
+                    vol += v[0], ntri++;
+                if (live[t + 1])
+                    vol += v[1], ntri++;
+            }
+        }
     }
     for (int a = 0; a < 3; a++) {
         const face *f0 = &faces[2 * a], *f1 = &faces[2 * a + 1];
@@ -360,7 +407,10 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                         s0[i] = up[s0[i]], s1[i] = up[s1[i]];
                     if (sorted(s0, r0) != sorted(s1, r1) && memcmp(r0, r1, sizeof r0) == 0) {
                         live[first0 + k] = live[first1 + k] = 0;
-                        vol -= tri_volume(raw.pos, s0[0], s0[1], s0[2]) + tri_volume(raw.pos, s1[0], s1[1], s1[2]);
+                        double n[2][3], v0[2], v1[2];
+                        cell_normals(raw.pos, f0->base + b * f0->na + c, f0->na, f0->reverse ? -1.0 : 1.0, n, v0);
+                        cell_normals(raw.pos, f1->base + b * f1->na + c, f1->na, f1->reverse ? -1.0 : 1.0, n, v1);
+                        vol -= v0[q] + v1[q];
                         ntri -= 2;
                     }
                 }
@@ -394,17 +444,23 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         const double sgn = (f->reverse ? -1.0 : 1.0) * (flip ? -1.0 : 1.0);
         for (size_t k = f->base; k < end; k++)
             vof[up[k]] = UINT32_MAX;
+        uint32_t off[2][3];   /* the corners of a cell's triangles, from its v00, as wound in the mesh */
+        for (int q = 0; q < 2; q++) {
+            cell_tri(f, 0, 0, q, off[q]);
+            for (int i = 0; i < 3; i++)
+                off[q][i] -= (uint32_t)f->base;
+            if (flip) {
+                const uint32_t x = off[q][1];
+                off[q][1] = off[q][2], off[q][2] = x;
+            }
+        }
         for (size_t b = 0; b + 1 < f->nb; b++)
             for (size_t a = 0; a + 1 < f->na; a++)
                 for (int q = 0; q < 2; q++, t++) {
                     if (!live[t])
                         continue;
-                    uint32_t s[3];
-                    cell_tri(f, a, b, q, s);
-                    if (flip) {
-                        const uint32_t x = s[1];
-                        s[1] = s[2], s[2] = x;
-                    }
+                    const uint32_t v00 = (uint32_t)(f->base + b * f->na + a);
+                    const uint32_t s[3] = { v00 + off[q][0], v00 + off[q][1], v00 + off[q][2] };
                     for (int i = 0; i < 3; i++) {
                         const uint32_t r = up[s[i]];
                         if (vof[r] == UINT32_MAX) {

@@ -87,6 +87,7 @@ void pde_grid_free(pde_grid *g)
         free(g->k[c]);
     }
     free(g->row);
+    free(g->col);
     free(g);
 }
 
@@ -135,6 +136,13 @@ pde_status pde_grid_create(const pde_solution *sol, const double *us, size_t nu,
             for (size_t j = 0; j < nv; j++)
                 factor_eval(modes[m].v, vs[j], &g->psi[c][m * nv + j], &g->dpsi[c][m * nv + j]);
         }
+    }
+    if (nu <= COL_NU) {
+        size_t ndmax = 1;
+        for (int c = 0; c < 3; c++)
+            ndmax = g->nd[c] > ndmax ? g->nd[c] : ndmax;
+        if (!(g->col = malloc(3 * ndmax * nv * sizeof *g->col)))
+            goto nomem;
     }
     *out = g;
     return PDE_OK;
@@ -246,10 +254,105 @@ static void emit(float *out, size_t nu, const double *const tab[3], const double
         emit1(out + c, nu, tab[c], k[c], nd[c]);
 }
 
+/* sum_d k[d ks] t[d ts] to float32, in emit1's order, so both paths give the same bits. */
+static inline float dot_k(const double *k, size_t ks, const double *t, size_t ts, size_t nd)
+{
+    switch (nd) {
+    case 0:
+        return 0.0f;
+    case 1:
+        return (float)(k[0] * t[0]);
+    case 2:
+        return (float)(k[0] * t[0] + k[ks] * t[ts]);
+    case 3:
+        return (float)(k[0] * t[0] + k[ks] * t[ts] + k[2 * ks] * t[2 * ts]);
+    }
+    double s = 0.0;
+    for (size_t d = 0; d < nd; d++)
+        s += k[d * ks] * t[d * ts];
+    return (float)s;
+}
+
+/*
+ * Rows j0 <= j < j1 of a narrow grid (nu <= COL_NU): grid_coefs for every row at once, mode by mode
+ * over contiguous v (the same sums in the same order), then each point's few dot products.
+ */
+static void grid_cols(pde_grid *g, size_t j0, size_t j1, float *const outs[4])
+{
+    const size_t nu = g->nu, nv = g->nv, n = j1 - j0;
+    for (int c = 0; c < 3; c++) {
+        const size_t nd = g->nd[c], nm = g->nm[c];
+        double *restrict kx = g->col, *restrict kv = kx + nd * n, *restrict kw = kv + nd * n;
+        /* a u-factor's coefficients, BLK rows at a time in registers, summed over its modes in order */
+        enum { BLK = 8 };
+        for (size_t d = 0; d < nd; d++)
+            for (size_t jb = 0; jb < n; jb += BLK) {
+                const size_t nb = n - jb < BLK ? n - jb : BLK;
+                double ax[BLK] = { 0 }, av[BLK] = { 0 }, aw[BLK] = { 0 };
+                for (size_t m = 0; m < nm; m++) {
+                    if (g->group[c][m] != d)
+                        continue;
+                    const double h = g->h[c][m], dh = g->dh[c][m];
+                    const double *restrict p = g->psi[c] + m * nv + j0 + jb, *restrict dp = g->dpsi[c] + m * nv + j0 + jb;
+                    if (nb == BLK) {
+                        for (size_t j = 0; j < BLK; j++) {
+                            ax[j] += h * p[j];
+                            av[j] += h * dp[j];
+                            aw[j] += dh * p[j];
+                        }
+                    } else {
+                        for (size_t j = 0; j < nb; j++) {
+                            ax[j] += h * p[j];
+                            av[j] += h * dp[j];
+                            aw[j] += dh * p[j];
+                        }
+                    }
+                }
+                for (size_t j = 0; j < nb; j++) {
+                    kx[d * n + jb + j] = ax[j];
+                    kv[d * n + jb + j] = av[j];
+                    kw[d * n + jb + j] = aw[j];
+                }
+            }
+        const double *tab[4] = { g->phi[c], g->dphi[c], g->phi[c], g->phi[c] };
+        const double *ks[4] = { kx, kx, kv, kw };
+        for (int q = 0; q < 4; q++) {
+            float *o = outs[q];
+            if (!o)
+                continue;
+            const double *restrict k = ks[q], *restrict t = tab[q];
+            switch (nd) {   /* dot_k's cases, the switch out of the loop */
+            case 1:
+                for (size_t j = 0; j < n; j++)
+                    for (size_t i = 0; i < nu; i++)
+                        o[3 * (j * nu + i) + c] = (float)(k[j] * t[i]);
+                break;
+            case 2:
+                for (size_t j = 0; j < n; j++)
+                    for (size_t i = 0; i < nu; i++)
+                        o[3 * (j * nu + i) + c] = (float)(k[j] * t[i] + k[n + j] * t[nu + i]);
+                break;
+            default:
+                for (size_t j = 0; j < n; j++)
+                    for (size_t i = 0; i < nu; i++)
+                        o[3 * (j * nu + i) + c] = dot_k(k + j, n, t + i, nu, nd);
+            }
+        }
+    }
+}
+
 void pde_grid_rows(pde_grid *g, double w, size_t j0, size_t j1, float *xyz, float *xu, float *xv,
                    float *xw)
 {
     const size_t nu = g->nu;
+    if (g->col) {
+        const size_t end = j1 < g->nv ? j1 : g->nv;
+        float *const outs[4] = { xyz, xu, xv, xw };
+        grid_set_w(g, w);
+        if (j0 < end)
+            grid_cols(g, j0, end, outs);
+        return;
+    }
     const double *phi[3] = { g->phi[0], g->phi[1], g->phi[2] };
     const double *dphi[3] = { g->dphi[0], g->dphi[1], g->dphi[2] };
     const double *kx[3], *kv[3], *kw[3];

@@ -168,7 +168,12 @@ struct pde_grid {
     double w;                   /* the current plane, NaN before the first */
     double *k[3];               /* 3 nd: a row's coefficients for x, xv and xw */
     double *row;                /* 12 nu */
+    double *col;                /* nu <= COL_NU: 3 max(nd) nv, the coefficients of a plane's rows side by side */
 };
+
+/* Grids this narrow (faces u = const) fill a plane column-wise: the coefficients of all its rows at
+ * once, over contiguous v, instead of a few points per row. */
+enum { COL_NU = 2 };
 
 enum { GRID_X = 1, GRID_XU = 2, GRID_XV = 4, GRID_XW = 8 };
 

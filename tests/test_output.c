@@ -1047,6 +1047,44 @@ static void properties_beyond_a_double_should_be_a_document_error(void **state)
     api_model_free(m);
 }
 
+/* The skin's faces u = 0, 1 come from a grid of nu = 2, which fills its planes column-wise (core/eval.c);
+ * every bit of it, and of nu = 1, must be what a wide grid gives at the same u. */
+static void narrow_grids_should_sample_the_same_bits_as_wide_ones(void **state)
+{
+    (void)state;
+    enum { NV = 19, NW = 5 };
+    const double wide[5] = { 0.0, 0.25, 0.5, 0.75, 1.0 }, ends[2] = { 0.0, 1.0 };
+    double vs[NV];
+    for (int j = 0; j < NV; j++)
+        vs[j] = j / (double)(NV - 1);
+    for (size_t i = 0; i < paper_figure_count(); i++) {
+        pde_solution *sol = solve_preset(paper_figure_name(i), NULL);
+        pde_grid *gw, *g2, *g1;
+        assert_int_equal(pde_grid_create(sol, wide, 5, vs, NV, &gw), PDE_OK);
+        assert_int_equal(pde_grid_create(sol, ends, 2, vs, NV, &g2), PDE_OK);
+        assert_int_equal(pde_grid_create(sol, wide + 4, 1, vs, NV, &g1), PDE_OK);
+        static float a[4][3 * 5 * NV], b[4][3 * 2 * NV], c[4][3 * NV];
+        for (int k = 0; k < NW; k++) {
+            const double w = k / (double)(NW - 1);
+            pde_grid_plane_d(gw, w, a[0], a[1], a[2], a[3]);
+            pde_grid_plane_d(g2, w, b[0], b[1], b[2], b[3]);
+            pde_grid_rows(g1, w, 3, NV, c[0] + 9, c[1] + 9, c[2] + 9, c[3] + 9);   /* rows 3.. only */
+            pde_grid_rows(g1, w, 0, 3, c[0], c[1], c[2], c[3]);
+            for (int q = 0; q < 4; q++)
+                for (int j = 0; j < NV; j++) {
+                    if (memcmp(&b[q][3 * 2 * j], &a[q][3 * 5 * j], 12) || memcmp(&b[q][3 * (2 * j + 1)], &a[q][3 * (5 * j + 4)], 12))
+                        fail_msg("%s: nu = 2 differs at v %d, w %g, quantity %d", paper_figure_name(i), j, w, q);
+                    if (memcmp(&c[q][3 * j], &a[q][3 * (5 * j + 4)], 12))
+                        fail_msg("%s: nu = 1 differs at v %d, w %g, quantity %d", paper_figure_name(i), j, w, q);
+                }
+        }
+        pde_grid_free(gw);
+        pde_grid_free(g2);
+        pde_grid_free(g1);
+        pde_solution_free(sol);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1061,6 +1099,7 @@ int main(void)
         cmocka_unit_test(grid_json_should_read_back_as_the_f32_output),
         cmocka_unit_test(stl_skin_should_be_closed_and_enclose_the_computed_volume),
         cmocka_unit_test(every_skin_should_be_closed_with_normals_and_det_j_from_the_closed_form),
+        cmocka_unit_test(narrow_grids_should_sample_the_same_bits_as_wide_ones),
         cmocka_unit_test(vts_should_hold_the_points_and_det_j),
         cmocka_unit_test(json_should_hold_the_closed_form_properties_and_id),
         cmocka_unit_test(every_output_with_properties_should_carry_each_of_them_by_name),
