@@ -1021,10 +1021,10 @@ window.pdesolid = {
   samplesFor,
   // The solid's box on the screen and the part of the view the panels leave free, in CSS pixels.
   layout() { return { solid: skin ? screenRect(skin.geometry.boundingBox) : null, free: freeRect() }; },
-  // rect: a part of the canvas in CSS pixels {x, y, w, h}; default, the middle quarter.
-  snapshot(rect) {
+  // rect: a part of the canvas in CSS pixels {x, y, w, h}; default, the middle quarter; read at size x size.
+  snapshot(rect, size = 64) {
     render();
-    const src = renderer.domElement, w = 64, h = 64, k = src.width / Math.max(view.clientWidth, 1);
+    const src = renderer.domElement, w = size, h = size, k = src.width / Math.max(view.clientWidth, 1);
     const r = rect ? { x: rect.x * k, y: rect.y * k, w: rect.w * k, h: rect.h * k }
       : { x: src.width / 2 - src.width / 8, y: src.height / 2 - src.height / 8, w: src.width / 4, h: src.height / 4 };
     const c = document.createElement('canvas');
@@ -1032,14 +1032,17 @@ window.pdesolid = {
     const g = c.getContext('2d');
     g.drawImage(src, r.x, r.y, r.w, r.h, 0, 0, w, h);
     const d = g.getImageData(0, 0, w, h).data, bg = [0xf4, 0xf5, 0xf7];
-    let ink = 0, red = 0, hash = 0;
+    let ink = 0, red = 0, dark = 0, hash = 0;
     for (let i = 0; i < d.length; i += 4) {
       if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 24) ink++;
+      if (0.3 * d[i] + 0.59 * d[i + 1] + 0.11 * d[i + 2] < 70) dark++;   // the lines' ink (0x1d2330)
       if (d[i] > 150 && d[i] > 2 * d[i + 1] && d[i] > 2 * d[i + 2]) red++;
       hash = (hash * 31 + d[i] + 7 * d[i + 1] + 13 * d[i + 2]) >>> 0;
     }
-    return { ink: ink / (w * h), red: red / (w * h), hash };
+    return { ink: ink / (w * h), red: red / (w * h), dark: dark / (w * h), hash };
   },
+  // The skin's depth offset behind the lines, on or off (the browser test's check against z-fighting).
+  skinOffset(on) { material.polygonOffset = on; material.needsUpdate = true; },
 };
 
 main().catch((e) => fail({ detail: String(e) }));

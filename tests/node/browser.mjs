@@ -226,6 +226,28 @@ await check('isoparametric lines and slices draw', async () => {
   for (const view of ['lines', 'slices']) await page.locator(`[data-view="${view}"] input`).uncheck();
 });
 
+await check('isoparametric lines drawn over the skin are whole lines, not dashes (no z-fighting)', async () => {
+  // fig1a's faces are planes, so its lines lie exactly in the skin: without the skin's depth offset they
+  // break up into dashes where the depth test goes the skin's way. The lines' ink is what they darken
+  // beyond the skin alone, in the solid's box on the screen.
+  await gallery('fig1a');
+  const { x0, y0, x1, y1 } = await page.evaluate(() => window.pdesolid.layout().solid);
+  const rect = { x: x0, y: y0, w: x1 - x0, h: y1 - y0 };
+  const dark = async () => (await page.evaluate((r) => window.pdesolid.snapshot(r, 512), rect)).dark;
+  const before = await snapshot(), skinOnly = await dark();
+  await page.locator('[data-view="lines"] input').check();
+  await page.waitForFunction((h) => window.pdesolid.snapshot().hash !== h, before.hash, { timeout: 30000 });
+  const on = (await dark()) - skinOnly;
+  await page.screenshot({ path: `${out}/lines-on-skin.png` });
+  await page.evaluate(() => window.pdesolid.skinOffset(false));
+  const off = (await dark()) - skinOnly;
+  await page.screenshot({ path: `${out}/lines-on-skin-without-offset.png` });
+  await page.evaluate(() => window.pdesolid.skinOffset(true));
+  await page.locator('[data-view="lines"] input').uncheck();
+  console.log(`# the lines' ink over the skin: ${(100 * on).toFixed(1)}% of the solid's box, ${(100 * off).toFixed(1)}% without the offset`);
+  if (!(on > 0.02 && on >= 1.3 * off)) throw new Error(`line ink ${on} with the offset, ${off} without: the lines break up`);
+});
+
 await check('every preset loads from the gallery', async () => {
   const names = await page.$$eval('#gallery button', (bs) => bs.map((b) => b.dataset.preset));
   const listed = await page.evaluate(async () => (await (await fetch('/presets')).json()).presets.length);
