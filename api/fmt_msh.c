@@ -13,7 +13,7 @@ static int msh_open(api_output *o, const pde_cancel *cancel, api_error *err)
 {
     api_vol *s = calloc(1, sizeof *s);
     o->st = s;
-    return s ? api_volmesh_build(o->sol, o->res, cancel, &s->mesh, err) : -1;
+    return s ? api_out_volmesh(o, cancel, &s->mesh, err) : -1;
 }
 
 static int msh_fill(api_output *o)

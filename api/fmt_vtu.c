@@ -15,7 +15,7 @@ static int vtu_open(api_output *o, const pde_cancel *cancel, api_error *err)
     o->st = s;
     if (!s || !api_out_props(o, cancel, err))
         return -1;
-    return api_volmesh_build(o->sol, o->res, cancel, &s->mesh, err);
+    return api_out_volmesh(o, cancel, &s->mesh, err);
 }
 
 static int vtu_fill(api_output *o)
