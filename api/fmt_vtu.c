@@ -28,11 +28,11 @@ static int vtu_fill(api_output *o)
     return r < 0 ? -1 : 0;
 }
 
-/* Raw binary: about 28 bytes a point and 80 a cell, at a unit or so a byte. */
+/* Raw binary: about 28 bytes a point and 80 a cell, copied at well under a unit a byte. */
 static void vtu_cost(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, struct api_cost *c)
 {
     (void)opts;
-    api_cost_volmesh(sol, res, 30.0, c);
+    api_cost_volmesh(sol, res, 40.0, c);
 }
 
 const api_format_info api_format_vtu = {
