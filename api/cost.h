@@ -65,8 +65,8 @@ void api_cost_vts(const pde_solution *sol, const unsigned res[3], const api_outp
  * mesh itself), at work_byte units a byte of output, and out_tri units a triangle. */
 void api_cost_skin(const pde_solution *sol, const unsigned res[3], double blob_vertex, double blob_tri,
                    double work_byte, double out_tri, api_cost *c);
-/* A volume mesh (api/volmesh.h) of res points, written as text of about text_point bytes a point. */
-void api_cost_volmesh(const pde_solution *sol, const unsigned res[3], double text_point, api_cost *c);
+/* A volume mesh (api/volmesh.h) of res points: its build, and its writer at write_point units a point. */
+void api_cost_volmesh(const pde_solution *sol, const unsigned res[3], double write_point, api_cost *c);
 /* pde_eval_d() at npoints points and api_eval_json() of the answer (with derivatives or not). */
 void api_cost_eval(const pde_solution *sol, size_t npoints, int derivatives, api_cost *c);
 

@@ -216,6 +216,19 @@ void api_skin_close(void *st)
 
 /* ---- volume meshes ---- */
 
+int api_out_volmesh(api_output *o, const pde_cancel *cancel, api_volmesh *m, api_error *err)
+{
+    if (api_volmesh_build(o->sol, o->res, cancel, m, err))
+        return -1;
+    if (m->ncells > 0)
+        return 0;
+    api_volmesh_free(m);
+    *m = (api_volmesh){ 0 };
+    return api_fail(err, API_ERR_DOCUMENT, "", "res: %u,%u,%u samples give a volume mesh with no cells (every cell "
+                    "collapses to a face, a line or a point); take at least 3 samples per axis, more along an "
+                    "axis that closes into a loop", o->res[0], o->res[1], o->res[2]);
+}
+
 void api_vol_close(void *st)
 {
     api_vol *v = st;

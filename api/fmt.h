@@ -60,8 +60,10 @@ const pde_props *api_out_props(api_output *o, const pde_cancel *cancel, api_erro
 /* -1 with err set to API_ERR_CANCELLED. */
 int api_out_cancelled(api_error *err);
 
-/* The properties as VTK FieldData, one array per property named group_name ("detJ_min_at"). */
-int api_out_vtk_field_data(api_output *o, const pde_props *p);
+/* The properties as VTK FieldData, one array per property named group_name ("detJ_min_at"), through
+ * put(ctx, ...) (0, or -1 when put fails): the one writer of them, for vts and vtu alike. */
+int api_vtk_field_data(const pde_props *p, api_volmesh_put put, void *ctx);
+int api_out_vtk_field_data(api_output *o, const pde_props *p);   /* the same into o->buf */
 
 /* ---- grids sampled a few rows at a time (grid, f32, vts) ---- */
 
@@ -112,6 +114,9 @@ typedef struct {
     int done;           /* the writer returned 1 */
 } api_vol;
 
+/* Builds the volume mesh at o->res into *m; 0, or -1 with err (a mesh with no cells is a document error
+ * naming res, *m then empty). */
+int api_out_volmesh(api_output *o, const pde_cancel *cancel, api_volmesh *m, api_error *err);
 void api_vol_close(void *st);                          /* frees an api_vol */
 int api_vol_put(void *ctx, const void *p, size_t n);   /* the writers' put: ctx is the api_output */
 

@@ -15,7 +15,7 @@ static int vtu_open(api_output *o, const pde_cancel *cancel, api_error *err)
     o->st = s;
     if (!s || !api_out_props(o, cancel, err))
         return -1;
-    return api_volmesh_build(o->sol, o->res, cancel, &s->mesh, err);
+    return api_out_volmesh(o, cancel, &s->mesh, err);
 }
 
 static int vtu_fill(api_output *o)
@@ -28,11 +28,11 @@ static int vtu_fill(api_output *o)
     return r < 0 ? -1 : 0;
 }
 
-/* Raw binary: about 28 bytes a point and 80 a cell, at a unit or so a byte. */
+/* Raw binary: about 28 bytes a point and 80 a cell, copied at well under a unit a byte. */
 static void vtu_cost(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, struct api_cost *c)
 {
     (void)opts;
-    api_cost_volmesh(sol, res, 30.0, c);
+    api_cost_volmesh(sol, res, 40.0, c);
 }
 
 const api_format_info api_format_vtu = {

@@ -328,10 +328,12 @@ char *api_eval_json(const char *id, const double *values, const double *du, cons
 }
 
 /* The properties as VTK field data, one array per row of prop_rows named group_name ("detJ_min_at"),
- * in ascii at 17 digits, so ParaView lists them with the dataset. */
-int api_out_vtk_field_data(api_output *o, const pde_props *props)
+ * in ascii at 17 digits, so ParaView lists them with the dataset. vts (through api_out_vtk_field_data)
+ * and vtu (api/volmesh.c's writer) both write them here. */
+int api_vtk_field_data(const pde_props *props, api_volmesh_put put, void *ctx)
 {
-    if (api_out_puts(o, "    <FieldData>\n"))
+    static const char open[] = "    <FieldData>\n", close[] = "    </FieldData>\n";
+    if (put(ctx, open, sizeof open - 1))
         return -1;
     for (size_t i = 0; i < PROP_ROWS; i++) {
         const prop_row *r = &prop_rows[i];
@@ -346,10 +348,15 @@ int api_out_vtk_field_data(api_output *o, const pde_props *props)
         for (int k = 0; !r->flag && k < n; k++)
             p += sprintf(p, "%s%.17g", k ? " " : "", v[k]);
         p += sprintf(p, "</DataArray>\n");
-        if (api_out_put(o, line, (size_t)(p - line)))
+        if (put(ctx, line, (size_t)(p - line)))
             return -1;
     }
-    return api_out_puts(o, "    </FieldData>\n");
+    return put(ctx, close, sizeof close - 1);
+}
+
+int api_out_vtk_field_data(api_output *o, const pde_props *props)
+{
+    return api_vtk_field_data(props, api_vol_put, o);
 }
 
 /* ---- the stream ---- */

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fmt.h"
 #include "volmesh.h"
 
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
@@ -560,23 +561,19 @@ static size_t vtu_bytes(const api_volmesh *m, int blk)
     }
 }
 
+static int sbuf_put(void *ctx, const void *p, size_t n)
+{
+    sbuf *b = ctx;
+    if (n > b->cap - b->n)
+        return -1;
+    addb(b, p, n);
+    return 0;
+}
+
+/* The properties as field data: api_vtk_field_data (api/fmt.h), the same arrays and names as vts's. */
 static void vtu_field(const pde_props *p, sbuf *b)
 {
-    const struct { const char *name; const double *v; int n; } rows[] = {
-        { "volume", &p->volume, 1 },           { "signed_volume", &p->signed_volume, 1 },
-        { "detj_min", &p->detj_min, 1 },       { "detj_max", &p->detj_max, 1 },
-        { "surface_area", &p->surface_area, 1 }, { "centroid", p->centroid, 3 },
-        { "bbox_min", p->bbox_min, 3 },        { "bbox_max", p->bbox_max, 3 },
-    };
-    addf(b, "    <FieldData>\n");
-    for (size_t i = 0; i < sizeof rows / sizeof rows[0]; i++) {
-        addf(b, "      <DataArray type=\"Float64\" Name=\"%s\" NumberOfTuples=\"1\" NumberOfComponents=\"%d\" "
-                "format=\"ascii\">", rows[i].name, rows[i].n);
-        for (int k = 0; k < rows[i].n; k++)
-            addf(b, "%s%.17g", k ? " " : "", rows[i].v[k]);
-        addf(b, "</DataArray>\n");
-    }
-    addf(b, "    </FieldData>\n");
+    (void)api_vtk_field_data(p, sbuf_put, b);   /* a few KB into an empty piece of a MB: fits */
 }
 
 static int vtu_step(const api_volmesh *m, const pde_props *props, api_volmesh_cursor *c, sbuf *b)

@@ -221,15 +221,15 @@ static void every_output_with_properties_should_carry_each_of_them_by_name(void 
     assert_int_equal(pde_properties(sol, NULL, &computed), PDE_OK);
     distinct_props(&distinct);
     const pde_props *cases[] = { NULL, &distinct };   /* computed by the output, and given to it */
-    const api_format fmts[] = { API_FMT_JSON, API_FMT_GLB, API_FMT_VTS };
+    const api_format fmts[] = { API_FMT_JSON, API_FMT_GLB, API_FMT_VTS, API_FMT_VTU };
     for (size_t c = 0; c < 2; c++)
-        for (size_t i = 0; i < 3; i++) {
+        for (size_t i = 0; i < 4; i++) {
             const pde_props *want = cases[c] ? cases[c] : &computed;
             assert_true(api_format_info_of(fmts[i])->props);
             const unsigned res[3] = { 4, 4, 4 };
             size_t len;
             unsigned char *b = render_props(sol, "abc", cases[c], fmts[i], res, &len);
-            if (fmts[i] == API_FMT_VTS) {
+            if (fmts[i] == API_FMT_VTS || fmts[i] == API_FMT_VTU) {   /* one writer of VTK field data */
                 b = realloc(b, len + 1);
                 b[len] = '\0';
                 vts_field_data_should_hold((const char *)b, want);
@@ -898,6 +898,34 @@ static void bad_formats_and_resolutions_should_name_the_limit(void **state)
     assert_true(res[0] == 8 && res[1] == 16 && res[2] == 32);
 }
 
+/* A volume mesh with no cells (fig4a at 2 samples a side, or 2 of u and v: every cell collapses) is a
+ * document error naming res and what res works, as the skins refuse an empty skin. */
+static void empty_volume_meshes_should_be_a_document_error_naming_res(void **state)
+{
+    (void)state;
+    pde_solution *sol = solve_preset("fig4a", NULL);
+    const unsigned bad[][3] = { { 2, 2, 2 }, { 2, 2, 64 } };
+    const api_format fmts[] = { API_FMT_MSH, API_FMT_VTU };
+    for (size_t i = 0; i < 2; i++)
+        for (size_t k = 0; k < 2; k++) {
+            api_error err;
+            api_output *o = api_output_open_ex(sol, NULL, NULL, fmts[i], bad[k], NULL, NULL, &err);
+            if (o)
+                fail_msg("%s at %u,%u,%u: opened with no cells", api_format_info_of(fmts[i])->name, bad[k][0],
+                         bad[k][1], bad[k][2]);
+            assert_int_equal(err.status, API_ERR_DOCUMENT);
+            if (!strstr(err.message, "res") || !strstr(err.message, "at least 3"))
+                fail_msg("%s: %s", api_format_info_of(fmts[i])->name, err.message);
+        }
+    const unsigned ok[3] = { 3, 3, 3 };
+    for (size_t i = 0; i < 2; i++) {
+        size_t len;
+        free(render(sol, NULL, fmts[i], ok, &len));
+        assert_true(len > 0);
+    }
+    pde_solution_free(sol);
+}
+
 /* Writes the output of f to path. */
 static void render_to(const pde_solution *sol, api_format f, const unsigned res[3], const char *path)
 {
@@ -1107,6 +1135,7 @@ int main(void)
         cmocka_unit_test(id_should_not_depend_on_how_the_model_is_spelled),
         cmocka_unit_test(bad_formats_and_resolutions_should_name_the_limit),
         cmocka_unit_test(obj_ply_msh_and_vtu_should_read_back_in_meshio),
+        cmocka_unit_test(empty_volume_meshes_should_be_a_document_error_naming_res),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("output", tests, setup, teardown);
