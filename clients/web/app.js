@@ -379,25 +379,8 @@ async function preview(body, ctl, inputAt) {
   if (!r?.ok || inflight !== ctl) return;
   const buf = await r.arrayBuffer().catch(() => null);
   if (!buf || inflight !== ctl || buf.byteLength !== 12 * n * n * n) return;
-  const p = toGltfFrame(new Float32Array(buf)), at = (i, j, k) => (k * n + j) * n + i;
-  const pos = new Float32Array(6 * n * n * 3), idx = [];
-  let v = 0;
-  for (const [face, e] of [[0, 0], [0, n - 1], [1, 0], [1, n - 1], [2, 0], [2, n - 1]]) {
-    const base = v;
-    for (let b = 0; b < n; b++) for (let a = 0; a < n; a++) {
-      const g = 3 * (face === 0 ? at(e, a, b) : face === 1 ? at(a, e, b) : at(a, b, e));
-      pos.set(p.subarray(g, g + 3), 3 * v++);
-    }
-    for (let b = 0; b < n - 1; b++) for (let a = 0; a < n - 1; a++) {
-      const q = base + b * n + a;
-      idx.push(q, q + 1, q + n + 1, q, q + n + 1, q + n);
-    }
-  }
-  const g = new THREE.BufferGeometry();
-  g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-  g.setIndex(idx);
-  g.computeVertexNormals();
-  g.computeBoundingBox();
+  const p = toGltfFrame(new Float32Array(buf)), at = (i, j, k) => 3 * ((k * n + j) * n + i);
+  const g = sheetGeometry(p, n, [0, n - 1].flatMap((e) => [(a, b) => at(e, a, b), (a, b) => at(a, e, b), (a, b) => at(a, b, e)]));
   if (skin) { solid.remove(skin); skin.geometry.dispose(); }
   skin = new THREE.Mesh(g, material);
   applySkinColour();
@@ -521,23 +504,32 @@ async function refreshGridViews() {
   }
   if (state.slices) {
     // Five surfaces w = 0, 1/4, 1/2, 3/4, 1.
-    const pos = [], idx = [];
-    for (const k of [0, 4, 8, 12, 16]) {
-      const base = pos.length / 3;
-      for (let j = 0; j < n; j++) for (let i = 0; i < n; i++) { const a = at(i, j, k); pos.push(p[a], p[a + 1], p[a + 2]); }
-      for (let j = 0; j < n - 1; j++) for (let i = 0; i < n - 1; i++) {
-        const a = base + j * n + i;
-        idx.push(a, a + 1, a + n + 1, a, a + n + 1, a + n);
-      }
-    }
-    const g = new THREE.BufferGeometry();
-    g.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
-    g.setIndex(idx);
-    g.computeVertexNormals();
+    const g = sheetGeometry(p, n, [0, 4, 8, 12, 16].map((k) => (i, j) => at(i, j, k)));
     slices = new THREE.Mesh(g, new THREE.MeshStandardMaterial({ color: 0xe0a030, side: THREE.DoubleSide, transparent: true, opacity: 0.6 }));
     solid.add(slices);
   }
 }
+// Two triangles a cell over n x n sheets of the points p (x, y, z each); a sheet maps (a, b) to its point's
+// offset in p. The preview's skin and the w = const slices.
+function sheetGeometry(p, n, sheets) {
+  const pos = new Float32Array(sheets.length * n * n * 3), idx = [];
+  let v = 0;
+  for (const at of sheets) {
+    const base = v;
+    for (let b = 0; b < n; b++) for (let a = 0; a < n; a++) { const o = at(a, b); pos.set(p.subarray(o, o + 3), 3 * v++); }
+    for (let b = 0; b < n - 1; b++) for (let a = 0; a < n - 1; a++) {
+      const q = base + b * n + a;
+      idx.push(q, q + 1, q + n + 1, q, q + n + 1, q + n);
+    }
+  }
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+  g.setIndex(idx);
+  g.computeVertexNormals();
+  g.computeBoundingBox();
+  return g;
+}
+
 // The grids are in the model's frame (z up); drawn beside the glTF skin, in glTF's: (x, z, -y).
 function toGltfFrame(raw) {
   const p = new Float32Array(raw.length);
