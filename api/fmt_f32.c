@@ -23,6 +23,6 @@ static int f32_fill(api_output *o)
 }
 
 const api_format_info api_format_f32 = {
-    .name = "f32", .mime = "application/octet-stream", .ext = ".f32", .binary = 1,
+    .name = "f32", .mime = "application/octet-stream", .ext = ".f32", .binary = 1, .range = API_RANGE_POINTS,
     .open = f32_open, .fill = f32_fill, .close = api_sampled_close, .cost = api_cost_f32,
 };

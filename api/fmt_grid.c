@@ -54,6 +54,6 @@ static int grid_fill(api_output *o)
 }
 
 const api_format_info api_format_grid = {
-    .name = "grid", .mime = "application/json", .ext = ".grid.json",
+    .name = "grid", .mime = "application/json", .ext = ".grid.json", .range = API_RANGE_POINTS,
     .open = grid_open, .fill = grid_fill, .close = api_sampled_close, .cost = api_cost_grid_json,
 };

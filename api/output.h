@@ -67,6 +67,13 @@ typedef struct {
 typedef struct api_output api_output;
 struct api_cost;
 
+/* What of the solid a format writes as float32, which api_output_open() checks fits (a zero column: all). */
+typedef enum {
+    API_RANGE_DERIVS = 0,   /* the coordinates and products of derivatives: normals, det J (skins, volumes) */
+    API_RANGE_POINTS,       /* the coordinates only (grid, f32) */
+    API_RANGE_DOUBLES,      /* doubles only (json: its properties refuse what overflows a double) */
+} api_range;
+
 typedef struct api_format_info {
     const char *name;      /* as in ?format= and --format */
     const char *mime;
@@ -75,6 +82,7 @@ typedef struct api_format_info {
     int props;             /* carries the properties: api_output_open() computes them when not given */
     int binary;            /* bytes that are not text: not written to a terminal */
     int compress;          /* takes compress=meshopt */
+    api_range range;       /* what must fit float32 */
     /* The stream (api/fmt.h says what each does). */
     int (*open)(api_output *o, const pde_cancel *cancel, api_error *err);
     int (*fill)(api_output *o);
@@ -104,7 +112,11 @@ int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *er
 /*
  * id: the model's id (id.h), or NULL. props: the solution's properties if the
  * caller has them (the formats with props set carry them), or NULL to compute them.
- * NULL and err on failure (out of memory, a mesh out of range). The long work
+ * NULL and err on failure (out of memory, a mesh out of range). A solid that
+ * could reach beyond float32's range in what the format writes (its range
+ * column) is a document error before any work, in every format alike: the
+ * bound is the closed form's, the sum of its modes' largest magnitudes, so
+ * no format ever writes an inf or a NaN. The long work
  * happens here: the properties it computes, the mesh (gltf, glb, stl, obj, ply, msh, vtu), the
  * whole json document; cancel (NULL: never) is polled through it, and when
  * it stops the call frees everything and err has status API_ERR_CANCELLED.

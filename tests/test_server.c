@@ -207,6 +207,56 @@ static void solve_should_give_every_format_as_the_core_computes_it(void **state)
     stop(&d);
 }
 
+/* A solid beyond float32's range is a 422 in every format, as the skins have always refused it: fig. 4a with
+ * p0 = 1e308 overflows the coordinates themselves (grid wrote nulls, f32 and msh inf and nan, with a 200);
+ * with p0 = 1e30 its coordinates (about 1e25) fit, but the products of its derivatives (the skin's normals,
+ * det J) do not, so every format that writes those refuses it (obj wrote "vn 0 0 null", msh and vts an inf
+ * det J), while grid, f32 and json (doubles) still answer, every number finite. */
+static void a_solid_beyond_float32_should_be_a_422_in_every_format_that_would_overflow(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    for (int f = 0; f < API_FMT_COUNT; f++) {
+        const char *name = api_format_info_of((api_format)f)->name;
+        char path[96];
+        snprintf(path, sizeof path, "/solve?format=%s&res=9", name);
+        reply r = post(&d, path, "{\"preset\":\"fig4a\",\"params\":{\"p0\":1e308}}");
+        if (r.status != 422)
+            fail_msg("%s at p0 = 1e308: %ld, not 422", name, r.status);
+        expect_problem(&r, 422, NULL, "too large");
+        if (f != API_FMT_JSON && !strstr(r.body, "float32"))
+            fail_msg("%s at p0 = 1e308: the detail does not name float32: %s", name, r.body);
+        free(r.body);
+        r = post(&d, path, "{\"preset\":\"fig4a\",\"params\":{\"p0\":1e30}}");
+        int answers = f == API_FMT_JSON || f == API_FMT_GRID || f == API_FMT_F32;
+        if (!answers) {
+            if (r.status != 422)
+                fail_msg("%s at p0 = 1e30: %ld, not 422", name, r.status);
+            expect_problem(&r, 422, NULL, "float32");
+        } else {
+            if (r.status != 200)
+                fail_msg("%s at p0 = 1e30: %ld, not 200: %s", name, r.status, r.body);
+            if (f == API_FMT_F32) {
+                assert_int_equal(r.len, 12 * 9 * 9 * 9);
+                for (size_t i = 0; i < r.len / 4; i++) {
+                    float v;
+                    memcpy(&v, r.body + 4 * i, 4);
+                    if (!isfinite(v))
+                        fail_msg("f32 at p0 = 1e30: value %zu is %g", i, (double)v);
+                }
+            } else if (strstr(r.body, "null") || !json_strict_valid(r.body, r.len)) {
+                fail_msg("%s at p0 = 1e30: not finite JSON: %.300s", name, r.body);
+            }
+        }
+        free(r.body);
+    }
+    reply r = http(&d, "GET", "/livez", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    free(r.body);
+    stop(&d);
+}
+
 static void eval_should_agree_with_the_cli(void **state)
 {
     (void)state;
@@ -896,6 +946,7 @@ int main(void)
         cmocka_unit_test(the_page_should_take_a_query_of_its_own),
         cmocka_unit_test(openapi_should_be_valid_and_name_every_route),
         cmocka_unit_test(solve_should_give_every_format_as_the_core_computes_it),
+        cmocka_unit_test(a_solid_beyond_float32_should_be_a_422_in_every_format_that_would_overflow),
         cmocka_unit_test(eval_should_agree_with_the_cli),
         cmocka_unit_test(cache_hits_misses_and_evictions_should_show_in_metrics),
         cmocka_unit_test(concurrent_identical_requests_should_solve_once),
