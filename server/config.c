@@ -74,7 +74,10 @@ static const flag flags[] = {
       "others stay. No address is locked out longer\n"
       "than --request-timeout (a request in progress)\n"
       "or --timeout (an idle keep-alive connection)" },
-    { "--max-conns", "N", K_UNSIGNED, AT(max_conns), 1, 65535, "1024", NULL, "connections in all" },
+    { "--max-conns", "N", K_UNSIGNED, AT(max_conns), 1, 65535, "1024", NULL,
+      "connections in all; 64 more are answered 503\n"
+      "with Retry-After and closed, and past those a\n"
+      "new one is closed at once" },
     { "--grace", "S", K_UNSIGNED, AT(grace), 0, 3600, "30", NULL,
       "seconds to finish requests on SIGTERM or SIGINT" },
     { "--cors-origin", "LIST", K_STR, AT(cors), 0, 0, "", "none: same origin only",

@@ -37,6 +37,12 @@
 #define DRAIN_BYTES (16u << 20)
 #define DRAIN_SECONDS 5.0
 
+/* Connections beyond --max-conns that are accepted only to be answered 503 (each for at most --timeout idle, or
+ * one request); past these, a new connection is closed at once. libmicrohttpd's own limit is never reached: at it,
+ * with the inter-thread channel that suspending needs, it stops accepting, and new clients wait in the listen
+ * queue unanswered. */
+#define SPARE_CONNS 64u
+
 /* ---- the request's key for the response cache ---- */
 
 /* Route, format, res, compress, then the body or the path's argument: the whole request, nothing cut. */
@@ -71,7 +77,8 @@ static void make_key(srv_req *r)
 
 /* What a connection carries from request to request. */
 typedef struct {
-    int nul;   /* the request's path or query held %00 */
+    int nul;    /* the request's path or query held %00 */
+    int over;   /* opened beyond --max-conns: its requests are answered 503 */
 } conn_state;
 
 
@@ -218,6 +225,13 @@ static int admit(srv_req *r, const char *method)
         r->decided = r->close = 1;
         r->retry_after = 1;
         srv_problem(r, 503, NULL, "the server is shutting down");
+        return 0;
+    }
+    if (cs && cs->over) {
+        r->decided = r->close = 1;
+        r->retry_after = 1;
+        srv_problem(r, 503, NULL, "the server has its limit of %u connections open (--max-conns); try again",
+                    s->cfg.max_conns);
         return 0;
     }
     int status = 0;
@@ -492,11 +506,25 @@ static void connection_event(void *cls, struct MHD_Connection *conn, void **sock
     srv_server *s = cls;
     srv_metrics_connection(s->metrics, toe == MHD_CONNECTION_NOTIFY_STARTED ? 1 : -1);
     if (toe == MHD_CONNECTION_NOTIFY_STARTED) {
-        *socket_context = calloc(1, sizeof(conn_state));   /* NULL: %00 goes unnoticed, and is still kept literal */
+        unsigned n = atomic_fetch_add(&s->conns, 1) + 1;
+        conn_state *cs = calloc(1, sizeof *cs);   /* NULL: %00 goes unnoticed (still kept literal), as may --max-conns */
+        if (cs)
+            cs->over = n > s->cfg.max_conns;
+        *socket_context = cs;
     } else {
+        atomic_fetch_sub(&s->conns, 1);
         free(*socket_context);
         *socket_context = NULL;
     }
+}
+
+/* Past --max-conns and its spares, a new connection is closed at once. */
+static enum MHD_Result accept_policy(void *cls, const struct sockaddr *addr, socklen_t addrlen)
+{
+    (void)addr;
+    (void)addrlen;
+    srv_server *s = cls;
+    return atomic_load(&s->conns) < s->cfg.max_conns + SPARE_CONNS ? MHD_YES : MHD_NO;
 }
 
 /* ---- start and stop ---- */
@@ -561,10 +589,14 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
     unsigned flags = MHD_USE_EPOLL_INTERNAL_THREAD | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG;
     if (ai->ai_family == AF_INET6)
         flags |= MHD_USE_IPv6;
-    s->d = MHD_start_daemon(flags, (uint16_t)c->port, NULL, NULL, handler, s, MHD_OPTION_SOCK_ADDR, ai->ai_addr,
+    /* libmicrohttpd splits its limit evenly between the polling threads, which may accept unevenly: so that no
+     * thread reaches its share (and stops accepting), each may hold all; accept_policy keeps the real limit. */
+    unsigned workers = (unsigned)(c->http_threads > 1 ? c->http_threads : 1);
+    s->d = MHD_start_daemon(flags, (uint16_t)c->port, accept_policy, s, handler, s, MHD_OPTION_SOCK_ADDR, ai->ai_addr,
                             MHD_OPTION_THREAD_POOL_SIZE, (unsigned)(c->http_threads > 1 ? c->http_threads : 0),
                             MHD_OPTION_CONNECTION_TIMEOUT, c->timeout, MHD_OPTION_PER_IP_CONNECTION_LIMIT, c->per_ip,
-                            MHD_OPTION_CONNECTION_LIMIT, c->max_conns, MHD_OPTION_STRICT_FOR_CLIENT, (int)0,
+                            MHD_OPTION_CONNECTION_LIMIT, (c->max_conns + SPARE_CONNS + 1) * workers,
+                            MHD_OPTION_STRICT_FOR_CLIENT, (int)0,
                             MHD_OPTION_UNESCAPE_CALLBACK, unescape, NULL, MHD_OPTION_NOTIFY_COMPLETED, completed, s,
                             MHD_OPTION_NOTIFY_CONNECTION, connection_event, s, MHD_OPTION_END);
     freeaddrinfo(ai);

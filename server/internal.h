@@ -49,6 +49,7 @@ struct srv_server {
     pthread_mutex_t lock;        /* with idle: srv_stop waits for in_flight to reach 0 */
     pthread_cond_t idle;
     atomic_size_t in_flight;     /* requests begun and not completed */
+    atomic_uint conns;           /* connections open (--max-conns, and SRV_CONN_SPARE more to refuse on) */
     atomic_int stopping;         /* no new work: quiescing */
     atomic_int aborting;         /* grace is over: jobs end at once, queued ones answer 503 */
     uint16_t port;

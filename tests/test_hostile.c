@@ -436,6 +436,80 @@ static void slow_bodies_at_the_per_address_limit_should_not_lock_the_address_out
     stop(&d);
 }
 
+/* At --max-conns, one more connection is answered at once, a 503 problem with Retry-After, and closed;
+ * the connections already open are served as before, and once one closes a new one is served. (It used to
+ * wait in the listen queue unanswered: libmicrohttpd, with the inter-thread channel that suspending needs,
+ * stops accepting at its connection limit rather than closing what is over it.) */
+static void a_connection_over_max_conns_should_get_a_prompt_503_while_the_others_are_served(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--max-conns 4 --max-conns-per-ip 200 --http-threads 2");
+    enum { N = 4 };
+    const char *keep = "GET /livez HTTP/1.1\r\nHost: x\r\n\r\n";
+    int fd[N];
+    for (int i = 0; i < N; i++) {   /* each open and accepted: it has had an answer, and stays */
+        fd[i] = raw_dial(d.port);
+        assert_true(fd[i] >= 0);
+        raw_reply r = raw_exchange(fd[i], keep, strlen(keep), 3000);
+        if (r.status != 200 || r.closed)
+            fail_msg("keep-alive connection %d: status %d, closed %d", i, r.status, r.closed);
+        raw_reply_free(&r);
+    }
+    for (int round = 0; round < 3; round++) {
+        int over = raw_dial(d.port);
+        assert_true(over >= 0);
+        raw_reply r = raw_exchange(over, keep, strlen(keep), 3000);
+        close(over);
+        if (r.timed_out || r.status == 0)
+            fail_msg("over --max-conns: no answer in %.1f s (timed out %d, closed %d)", r.seconds, r.timed_out,
+                     r.closed);
+        expect_problem(&r, 503, NULL, "--max-conns");
+        char retry[32];
+        if (!raw_header(&r, "Retry-After", retry, sizeof retry))
+            fail_msg("a 503 over --max-conns without Retry-After");
+        if (r.first_response > 1.0)
+            fail_msg("the 503 came after %.2f s", r.first_response);
+        raw_reply_free(&r);
+    }
+    /* Idle connections past the limit take the 64 spare places that are answered 503; one more is closed at once
+     * (or, if the daemon has not seen them all yet, answered 503): never left waiting. */
+    enum { SPARE = 64 };
+    int idle[SPARE];
+    for (int i = 0; i < SPARE; i++) {
+        idle[i] = raw_dial(d.port);
+        assert_true(idle[i] >= 0);
+    }
+    usleep(300000);
+    raw_reply r0 = get(&d, "/livez");
+    if (r0.timed_out || !(r0.status == 503 || (r0.status == 0 && r0.closed)) || r0.seconds > 1.0)
+        fail_msg("past the spare places: status %d, closed %d, timed out %d, after %.2f s", r0.status, r0.closed,
+                 r0.timed_out, r0.seconds);
+    raw_reply_free(&r0);
+    for (int i = 0; i < SPARE; i++)
+        close(idle[i]);
+    for (int i = 0; i < N; i++) {   /* the others carry on */
+        raw_reply r = raw_exchange(fd[i], keep, strlen(keep), 3000);
+        if (r.status != 200)
+            fail_msg("keep-alive connection %d after the refusals: status %d", i, r.status);
+        raw_reply_free(&r);
+    }
+    close(fd[0]);
+    double t0 = mono_now();
+    raw_reply r = get(&d, "/livez");   /* a place is free again (its close may take a moment to be seen) */
+    while (r.status != 200 && mono_now() - t0 < 2) {
+        raw_reply_free(&r);
+        usleep(50000);
+        r = get(&d, "/livez");
+    }
+    if (r.status != 200)
+        fail_msg("with a connection closed, a new one still got %d", r.status);
+    raw_reply_free(&r);
+    for (int i = 1; i < N; i++)
+        close(fd[i]);
+    stop(&d);
+}
+
 /* ---- 413 ---- */
 
 static void an_oversized_body_with_expect_100_continue_should_get_413_before_any_byte_of_it(void **state)
@@ -1118,6 +1192,7 @@ int main(void)
         T(livez_should_answer_while_the_only_polling_thread_sends_a_heavy_stream),
         T(a_body_sent_one_byte_each_half_second_should_be_cut_off_at_the_request_timeout),
         T(slow_bodies_at_the_per_address_limit_should_not_lock_the_address_out),
+        T(a_connection_over_max_conns_should_get_a_prompt_503_while_the_others_are_served),
         T(an_oversized_body_with_expect_100_continue_should_get_413_before_any_byte_of_it),
         T(a_client_that_writes_all_its_body_before_reading_should_read_the_413_20_of_20_times),
         T(a_chunked_body_growing_over_the_limit_should_get_a_readable_413),
