@@ -43,6 +43,13 @@
  * queue unanswered. */
 #define SPARE_CONNS 64u
 
+/* The longest request target (path and query) and the most bytes of header lines pdesolidd takes: past them a 414
+ * or a 431 problem. libmicrohttpd answers with its own HTML page (no hook changes it in 0.9.75) when the request line
+ * and headers do not fit a connection's memory, so that is set well above both (it is committed only as used). */
+#define MAX_TARGET (32u << 10)
+#define MAX_HEADERS (32u << 10)
+#define CONN_MEMORY (128u << 10)
+
 /* ---- the request's key for the response cache ---- */
 
 /* Route, format, res, compress, then the body or the path's argument: the whole request, nothing cut. */
@@ -77,13 +84,15 @@ static void make_key(srv_req *r)
 
 /* What a connection carries from request to request. */
 typedef struct {
-    int nul;    /* the request's path or query held %00 */
-    int over;   /* opened beyond --max-conns: its requests are answered 503 */
+    int nul;         /* the request's path or query held %00 */
+    int over;        /* opened beyond --max-conns: its requests are answered 503 */
+    size_t target;   /* the current request's target, in bytes as sent */
 } conn_state;
 
 
 typedef struct {
     int lengths, encodings, hosts;
+    size_t bytes;      /* of the header lines: name, ": ", value, CRLF */
     srv_req *r;
     const char *bad;   /* what is wrong with a header, or NULL */
 } header_scan;
@@ -104,6 +113,7 @@ static enum MHD_Result scan_header(void *cls, enum MHD_ValueKind kind, const cha
 {
     (void)kind;
     header_scan *h = cls;
+    h->bytes += klen + vlen + 4;
     if (!h->bad && !token(key, klen))
         h->bad = "a header's name is not a token (RFC 9110: letters, digits and !#$%&'*+-.^_`|~)";
     for (size_t i = 0; value && i < vlen && !h->bad; i++)
@@ -200,6 +210,18 @@ static int admit(srv_req *r, const char *method)
         srv_problem(r, 400, NULL, "%s", h.bad ? h.bad : "an HTTP/1.1 request needs exactly one Host header");
         return 1;
     }
+    const union MHD_ConnectionInfo *ci = MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    conn_state *cs = ci ? ci->socket_context : NULL;
+    if ((cs && cs->target > MAX_TARGET) || h.bytes > MAX_HEADERS) {
+        r->decided = 1;
+        if (h.bytes > MAX_HEADERS)
+            srv_problem(r, 431, NULL, "the request's header lines are %zu bytes, more than the limit of %u", h.bytes,
+                        MAX_HEADERS);
+        else
+            srv_problem(r, 414, NULL, "the request target (path and query) is %zu bytes, more than the limit of %u",
+                        cs->target, MAX_TARGET);
+        return 0;
+    }
     int stopping = atomic_load(&s->stopping);
     if (cl > (long long)s->cfg.max_body) {
         const char *expect = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_EXPECT);
@@ -209,8 +231,6 @@ static int admit(srv_req *r, const char *method)
         /* Expect: 100-continue: the client waits, and sends nothing. Too large to discard: close. */
         return (expect && !strcasecmp(expect, "100-continue")) || cl > (long long)DRAIN_BYTES;
     }
-    const union MHD_ConnectionInfo *ci = MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
-    conn_state *cs = ci ? ci->socket_context : NULL;
     if (cs && cs->nul) {
         /* unescape() kept the %00 literal: find where, to name it. */
         cs->nul = 0;
@@ -518,6 +538,16 @@ static void connection_event(void *cls, struct MHD_Connection *conn, void **sock
     }
 }
 
+/* Notes the length of the request target as sent (the handler sees the path and the query apart, decoded). */
+static void *target_seen(void *cls, const char *uri, struct MHD_Connection *conn)
+{
+    (void)cls;
+    const union MHD_ConnectionInfo *ci = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    if (ci && ci->socket_context)
+        ((conn_state *)ci->socket_context)->target = strlen(uri);
+    return NULL;   /* the request's state is made by the handler's first call */
+}
+
 /* Past --max-conns and its spares, a new connection is closed at once. */
 static enum MHD_Result accept_policy(void *cls, const struct sockaddr *addr, socklen_t addrlen)
 {
@@ -596,7 +626,8 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
                             MHD_OPTION_THREAD_POOL_SIZE, (unsigned)(c->http_threads > 1 ? c->http_threads : 0),
                             MHD_OPTION_CONNECTION_TIMEOUT, c->timeout, MHD_OPTION_PER_IP_CONNECTION_LIMIT, c->per_ip,
                             MHD_OPTION_CONNECTION_LIMIT, (c->max_conns + SPARE_CONNS + 1) * workers,
-                            MHD_OPTION_STRICT_FOR_CLIENT, (int)0,
+                            MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)CONN_MEMORY, MHD_OPTION_URI_LOG_CALLBACK,
+                            target_seen, NULL, MHD_OPTION_STRICT_FOR_CLIENT, (int)0,
                             MHD_OPTION_UNESCAPE_CALLBACK, unescape, NULL, MHD_OPTION_NOTIFY_COMPLETED, completed, s,
                             MHD_OPTION_NOTIFY_CONNECTION, connection_event, s, MHD_OPTION_END);
     freeaddrinfo(ai);

@@ -25,7 +25,9 @@ static const struct {
     { 400, "Bad Request" },          { 403, "Forbidden" },
     { 404, "Not Found" },            { 405, "Method Not Allowed" },
     { 408, "Request Timeout" },      { 413, "Content Too Large" },
-    { 422, "Unprocessable Content" }, { 500, "Internal Server Error" },
+    { 414, "URI Too Long" },         { 422, "Unprocessable Content" },
+    { 431, "Request Header Fields Too Large" },
+    { 500, "Internal Server Error" },
     { 501, "Not Implemented" },       { 503, "Service Unavailable" },
 };
 

@@ -85,18 +85,24 @@ static char *post_body(const char *target, const char *body, size_t blen, size_t
     return with_head(head, body, blen, len);
 }
 
-static char *gen_long_url(size_t *len)
+/* GET of a target of n bytes: prefix, then 'a's. */
+static char *long_target(const char *prefix, size_t n, size_t *len)
 {
-    size_t n = 60000;
     char *u = malloc(n + 1);
     memset(u, 'a', n);
-    u[0] = '/';
+    memcpy(u, prefix, strlen(prefix));
     u[n] = '\0';
     char *r = malloc(n + 64);
     *len = (size_t)sprintf(r, "GET %s HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n", u);
     free(u);
     return r;
 }
+
+static char *gen_long_url(size_t *len) { return long_target("/", 60000, len); }
+static char *gen_url_at_limit(size_t *len) { return long_target("/", 32768, len); }
+static char *gen_url_over_limit(size_t *len) { return long_target("/", 32769, len); }
+static char *gen_page_query_over_limit(size_t *len) { return long_target("/?solid=", 33000, len); }
+static char *gen_url_past_the_buffer(size_t *len) { return long_target("/", 300000, len); }
 
 static char *gen_huge_header(size_t *len)
 {
@@ -205,7 +211,12 @@ static const row rows[] = {
     RAW(MHD, "a CR without LF ending the request line", "GET /livez HTTP/1.1\rHost: x\r\n" CLOSE "\r\n"),
     RAW(MHD, "a NUL in the request target", "GET /li\0vez HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
     RAW(MHD, "a tab between method and target", "GET\t/livez HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
-    GEN(MHD, "a 60 kB URL", gen_long_url),
+    /* -- the request target: over 32 KiB a 414 problem, up to libmicrohttpd's buffer (128 KiB) -- */
+    GEN(404, "a URL of 32 KiB, the limit: an unknown path", gen_url_at_limit),
+    GEN(414, "a URL of 32 KiB and a byte", gen_url_over_limit),
+    GEN(414, "a 60 kB URL", gen_long_url),
+    GEN(414, "a 33 kB query of the page's own (/?solid=...)", gen_page_query_over_limit),
+    GEN(MHD, "a 300 kB URL, past libmicrohttpd's buffer", gen_url_past_the_buffer),
     /* -- methods: these reach pdesolidd's router -- */
     RAW(405, "a method in lower case", "get /livez HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
     RAW(405, "an unknown method BREW", "BREW /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
@@ -228,7 +239,7 @@ static const row rows[] = {
         "GET /nowhere HTTP/1.1\r\nHost: x\r\nX-Name: caf\xc3\xa9\r\n" CLOSE "\r\n"),
     RAW(404, "an invalid UTF-8 header value on an unknown route",
         "GET /nowhere HTTP/1.1\r\nHost: x\r\nX-Name: \xc0\xaf\xff\r\n" CLOSE "\r\n"),
-    GEN(MHD, "a 40 kB header", gen_huge_header),
+    GEN(431, "a 40 kB header", gen_huge_header),
     GEN(MHD, "3000 headers", gen_many_headers),
     /* -- framing: Content-Length and Transfer-Encoding (libmicrohttpd parses both) -- */
     RAW(MHD, "Content-Length: -1", "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: -1\r\n\r\n" FIG4A),
