@@ -302,6 +302,48 @@ static void output_file_should_never_be_ignored(void **state)
     free(err);
 }
 
+/* --format and -o's extension must agree (--format obj -o x.ply wrote OBJ into x.ply): a disagreement exits 2
+ * naming both and writes nothing; a name whose extension is no format's takes --format as given. */
+static void format_and_the_output_extension_should_agree(void **state)
+{
+    (void)state;
+    char *out, *err, path[256];
+    static const struct {
+        const char *args, *file;
+        int rc;
+    } cases[] = {
+        { "--format obj -o x.ply", "x.ply", 2 },
+        { "--format stl -o x.PLY", "x.PLY", 2 },
+        { "--format json -o x.grid.json", "x.grid.json", 2 },
+        { "--format glb -o x.gltf", "x.gltf", 2 },
+        { "--format obj -o x.obj", "x.obj", 0 },
+        { "--format grid -o y.grid.json", "y.grid.json", 0 },
+        { "--format f32 -o y.bin", "y.bin", 0 },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        char args[160];
+        snprintf(args, sizeof args, "solve --preset fig4a --res 5 %s", cases[i].args);
+        int rc = run(1, args, &out, &err);
+        if (rc != cases[i].rc)
+            fail_msg("pdesolid %s: exit %d, want %d: %s", args, rc, cases[i].rc, err);
+        snprintf(path, sizeof path, "%s/%s", dir, cases[i].file);
+        if (cases[i].rc) {
+            const char *fmt = strstr(cases[i].args, "--format ") + 9;
+            char name[16];
+            snprintf(name, sizeof name, "%.*s", (int)strcspn(fmt, " "), fmt);
+            if (!strstr(err, name) || !strstr(err, cases[i].file))
+                fail_msg("pdesolid %s: the message does not name --format %s and %s: %s", args, name, cases[i].file,
+                         err);
+            if (access(path, F_OK) == 0)
+                fail_msg("pdesolid %s: wrote %s", args, cases[i].file);
+        } else if (access(path, F_OK) != 0) {
+            fail_msg("pdesolid %s: no %s", args, cases[i].file);
+        }
+        free(out);
+        free(err);
+    }
+}
+
 /* --template NAME is the request {"template": NAME, "params": {...}}: the same solid, by its id; its defaults
  * are the family's first figure (example4's is fig4a); --help lists every format of the table. */
 static void templates_should_work_from_the_command_line(void **state)
@@ -395,6 +437,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(presets_and_formats_should_work_from_the_command_line),
         cmocka_unit_test(output_file_should_never_be_ignored),
+        cmocka_unit_test(format_and_the_output_extension_should_agree),
         cmocka_unit_test(templates_should_work_from_the_command_line),
         cmocka_unit_test(eval_should_agree_with_the_independent_solution),
         cmocka_unit_test(solve_should_print_the_closed_form_and_properties),

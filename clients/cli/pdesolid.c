@@ -50,7 +50,8 @@ static const char usage[] =
     "                       mesh the skin (the defaults below)\n"
     "  --compress meshopt   gltf, glb: EXT_meshopt_compression with KHR_mesh_quantization\n"
     "  -o FILE              write to FILE instead of standard output; solve without\n"
-    "                       --format takes the format from FILE's extension\n"
+    "                       --format takes the format from FILE's extension, and\n"
+    "                       with it refuses an extension of another format\n"
     "  --server URL         solve and eval on a pdesolidd (e.g. http://127.0.0.1:8080)\n"
     "                       instead of here; the output is the same\n"
     "  -h, --help           this text\n"
@@ -307,23 +308,43 @@ static int remote(const options *o, int eval)
     return rc;
 }
 
-/*
- * The format of -o FILE without --format: the one whose extension FILE ends with (the longest, so that
- * x.grid.json is a grid). 0, or 2 with a message naming the extensions.
- */
-static int format_from_extension(options *o)
+/* The format whose extension path ends with (the longest, so that x.grid.json is a grid; x.PLY too), or NULL. */
+static const api_format_info *format_of_extension(const char *path)
 {
-    size_t n = strlen(o->out), best = 0;
+    const api_format_info *found = NULL;
+    size_t n = strlen(path), best = 0;
     for (int i = 0; i < API_FMT_COUNT; i++) {
         const api_format_info *f = api_format_info_of((api_format)i);
         size_t k = strlen(f->ext);
-        if (k < n && k > best && strcasecmp(o->out + n - k, f->ext) == 0) {   /* x.PLY too */
+        if (k < n && k > best && strcasecmp(path + n - k, f->ext) == 0) {
             best = k;
-            o->format = f->name;
+            found = f;
         }
     }
-    if (best)
+    return found;
+}
+
+/*
+ * The format of -o FILE: without --format, the one its extension names; with it, the extension must not name
+ * another (a name that ends in no format's extension takes --format as given). 0, or 2 with a message naming
+ * the extensions, or --format and FILE.
+ */
+static int format_from_extension(options *o)
+{
+    const api_format_info *f = format_of_extension(o->out);
+    if (o->format) {
+        api_format given;
+        api_error err;
+        if (!f || !strcmp(f->name, o->format) || api_format_parse(o->format, &given, &err))
+            return 0;   /* an unknown --format is named by its own check */
+        fprintf(stderr, "pdesolid: --format %s and -o %s disagree: %s is the extension of %s; drop --format, or "
+                "give a name that ends in %s's extension\n", o->format, o->out, f->ext, f->name, o->format);
+        return 2;
+    }
+    if (f) {
+        o->format = f->name;
         return 0;
+    }
     fprintf(stderr, "pdesolid: %s: no format has this extension; give --format, or end the name with one of", o->out);
     for (int i = 0; i < API_FMT_COUNT; i++)
         fprintf(stderr, "%s %s", i ? "," : "", api_format_info_of((api_format)i)->ext);
@@ -334,7 +355,7 @@ static int format_from_extension(options *o)
 static int cmd_solve(const options *oo)
 {
     options copy = *oo, *o = &copy;
-    if (o->out && !o->format && format_from_extension(o))
+    if (o->out && format_from_extension(o))
         return 2;
     if (o->compress && !o->format) {
         fprintf(stderr, "pdesolid: --compress needs a format that takes it (--format glb, or -o FILE.glb)\n");
