@@ -257,6 +257,52 @@ static void a_solid_beyond_float32_should_be_a_422_in_every_format_that_would_ov
     stop(&d);
 }
 
+/* The lines of text that hold what, each checked: it must hold want and not refuse; returns how many there are. */
+static int lines_with(const char *text, const char *what, const char *want, const char *refuse)
+{
+    int n = 0;
+    for (const char *at = strstr(text, what); at; at = strstr(at + 1, what), n++) {
+        const char *start = at, *end = at + strcspn(at, "\n");
+        while (start > text && start[-1] != '\n')
+            start--;
+        char line[1024];
+        snprintf(line, sizeof line, "%.*s", (int)(end - start), start);
+        if (!strstr(line, want) || strstr(line, refuse))
+            fail_msg("a line on %s says %s or not %s: %s", what, refuse, want, line);
+    }
+    return n;
+}
+
+/* A volume mesh over 2^22 cells is a 413 (api/volmesh.c's API_ERR_LIMIT), once the budgets let the request get so
+ * far; docs/API.md said 422, and openapi.yaml's 413 did not list it. */
+static void a_volume_mesh_over_its_cell_limit_should_be_the_413_the_docs_say(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--max-work 1e13 --max-mem-mb 100000");
+    const char *formats[] = { "msh", "vtu" };
+    for (int i = 0; i < 2; i++) {
+        char path[64];
+        snprintf(path, sizeof path, "/solve?format=%s&res=200", formats[i]);
+        reply r = post(&d, path, "{\"preset\":\"fig4a\"}");
+        expect_problem(&r, 413, NULL, "over 4194304 cells");
+        free(r.body);
+    }
+    stop(&d);
+    char *api = read_file("docs/API.md", NULL);
+    assert_non_null(api);
+    assert_true(lines_with(api, "2^22 cells", "413", "422") >= 2);   /* Resolution, and Volume meshes */
+    free(api);
+    char *yaml = read_file("docs/openapi.yaml", NULL), why[400] = "";
+    assert_non_null(yaml);
+    const char *p413 = strstr(yaml, "413 (a body over --max-body,");
+    if (p413)
+        snprintf(why, sizeof why, "%.*s", (int)strcspn(p413, ")"), p413);
+    free(yaml);
+    if (!strstr(why, "cells"))
+        fail_msg("openapi.yaml's Problem does not list the volume mesh's cells under 413: %s", why);
+}
+
 static void eval_should_agree_with_the_cli(void **state)
 {
     (void)state;
@@ -947,6 +993,7 @@ int main(void)
         cmocka_unit_test(openapi_should_be_valid_and_name_every_route),
         cmocka_unit_test(solve_should_give_every_format_as_the_core_computes_it),
         cmocka_unit_test(a_solid_beyond_float32_should_be_a_422_in_every_format_that_would_overflow),
+        cmocka_unit_test(a_volume_mesh_over_its_cell_limit_should_be_the_413_the_docs_say),
         cmocka_unit_test(eval_should_agree_with_the_cli),
         cmocka_unit_test(cache_hits_misses_and_evictions_should_show_in_metrics),
         cmocka_unit_test(concurrent_identical_requests_should_solve_once),
