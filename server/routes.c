@@ -582,11 +582,15 @@ void srv_query_init(srv_query *q)
     memset(q, 0, sizeof *q);
 }
 
+/* A control character: C0, DEL, or C1 (U+0080..U+009F, in UTF-8 C2 80..C2 9F). */
 static int bad_text(const char *s, size_t n)
 {
-    for (size_t i = 0; i < n; i++)
-        if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f)
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (c < 0x20 || c == 0x7f || (c == 0xc2 && i + 1 < n && (unsigned char)s[i + 1] >= 0x80 &&
+                                      (unsigned char)s[i + 1] <= 0x9f))
             return 1;
+    }
     return 0;
 }
 

@@ -894,6 +894,23 @@ static void the_page_should_take_a_query_of_its_own(void **state)
     reply r = http(&d, "GET", "/?solid=a%01b", NULL, 0, NULL);
     expect_problem(&r, 400, NULL, "control character");
     free(r.body);
+    /* C1 controls (U+0080..U+009F, in UTF-8 C2 80..C2 9F) as C0 ones, in a value or a name, escaped or raw;
+     * the characters after them (U+00A0, é) pass. */
+    const char *c1[] = { "/?solid=a%C2%85b", "/?solid=%c2%80", "/?solid=a%C2%9F", "/?x%C2%8Ay=1", "/?solid=a\xc2\x85" "b" };
+    for (size_t i = 0; i < sizeof c1 / sizeof *c1; i++) {
+        r = http(&d, "GET", c1[i], NULL, 0, NULL);
+        if (r.status != 400)
+            fail_msg("GET %s: %ld, not 400", c1[i], r.status);
+        expect_problem(&r, 400, NULL, "control character");
+        free(r.body);
+    }
+    const char *fine[] = { "/?solid=a%C2%A0b", "/?solid=caf%C3%A9", "/?solid=%C2%BF" };
+    for (size_t i = 0; i < sizeof fine / sizeof *fine; i++) {
+        r = http(&d, "GET", fine[i], NULL, 0, NULL);
+        if (r.status != 200)
+            fail_msg("GET %s: %ld, not 200", fine[i], r.status);
+        free(r.body);
+    }
     /* The API's routes still refuse what they do not know. */
     r = http(&d, "GET", "/presets?solid=1", NULL, 0, NULL);
     expect_problem(&r, 400, NULL, "solid");
