@@ -46,11 +46,12 @@ typedef struct {
 
 typedef struct jet_cache {
     size_t mt;
+    int only;   /* the one component a coordinate's branch and bound needs, or -1: all three */
     jc_key key[3][JC_N];
     double val[];   /* axis a, slot i: val + (a * JC_N + i) * 5 mt */
 } jet_cache;
 
-static jet_cache *jet_cache_new(const pde_solution *s)
+static jet_cache *jet_cache_new(const pde_solution *s, int what)
 {
     size_t mt = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes;
     if (mt > JC_MODES)
@@ -59,6 +60,7 @@ static jet_cache *jet_cache_new(const pde_solution *s)
     if (!jc)
         return NULL;   /* no memo: slower, not wrong */
     jc->mt = mt;
+    jc->only = what < 3 ? what : -1;
     for (int a = 0; a < 3; a++)
         for (int i = 0; i < JC_N; i++)
             jc->key[a][i].order = -1;
@@ -83,6 +85,8 @@ static const double *axis_factors(const pde_solution *s, jet_cache *jc, int a, d
     size_t o = 0;
     for (int c = 0; c < 3; c++)
         for (size_t m = 0; m < s->comp[c].nmodes; m++, o++) {
+            if (jc->only >= 0 && c != jc->only)
+                continue;   /* never read */
             const pde_mode *md = &s->comp[c].modes[m];
             double *d = out + 5 * o;
             if (a == 2)
@@ -105,8 +109,9 @@ static void jet_add(xjet *j, int c, int n, const double *fu, const double *fv, c
 }
 
 /* bound = 0: x's partials up to order at the point b->lo; 1: bounds of their magnitudes over b.
- * jc: a branch and bound's memo, or NULL. */
-static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, jet_cache *jc, xjet *j)
+ * jc: a branch and bound's memo, or NULL. only: the one component wanted (the others are left
+ * unset), or -1. */
+static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, int only, jet_cache *jc, xjet *j)
 {
     const int n = mi_count[order];
     const double *F[3] = { NULL, NULL, NULL };
@@ -116,6 +121,10 @@ static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound
     size_t o = 0;
     for (int c = 0; c < 3; c++) {
         const comp_solution *cs = &s->comp[c];
+        if (only >= 0 && c != only) {
+            o += cs->nmodes;
+            continue;
+        }
         for (int q = 0; q < n; q++)
             j->d[c][q] = 0.0;
         for (size_t m = 0; m < cs->nmodes; m++, o++) {
@@ -213,8 +222,9 @@ static void model_at(const pde_solution *s, int what, const pbox *b, jet_cache *
         c.lo[a] = c.hi[a] = 0.5 * (b->lo[a] + b->hi[a]);
     const int order = what < 3 ? 2 : 3;
     xjet pt, mx;
-    xjet_fill(s, &c, order, 0, jc, &pt);
-    xjet_fill(s, b, order + 1, 1, jc, &mx);
+    const int only = what < 3 ? what : -1;
+    xjet_fill(s, &c, order, 0, only, jc, &pt);
+    xjet_fill(s, b, order + 1, 1, only, jc, &mx);
     /* Taylor coefficients: the value, the gradient, the Hessian at the centre, the third-order bound. */
     double tp[MI3], tb[MI3];
     if (what < 3) {
@@ -258,7 +268,7 @@ double obj_magnitude(const pde_solution *s, int what)
 {
     const pbox cube = { { 0, 0, 0 }, { 1, 1, 1 } };
     xjet mx;
-    xjet_fill(s, &cube, 1, 1, NULL, &mx);
+    xjet_fill(s, &cube, 1, 1, what < 3 ? what : -1, NULL, &mx);
     if (what < 3)
         return mx.d[what][0];
     double t[MI3];
@@ -450,7 +460,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
     bb_result r = { .lower = DBL_MAX, .boxes = 0 };
     pbox p0 = { { start[0], start[1], start[2] }, { start[0], start[1], start[2] } };
     obj_model m0;
-    jet_cache *jc = jet_cache_new(s);   /* NULL: without the memo */
+    jet_cache *jc = jet_cache_new(s, what);   /* NULL: without the memo */
     model_at(s, what, &p0, jc, &m0);
     r.best = sign * m0.v;
     for (int k = 0; k < 3; k++)

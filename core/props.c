@@ -24,6 +24,8 @@
 #include "quad.h"
 
 #define POLISH_EVALS 400       /* evaluations of one compass search, at most */
+#define SIGN_BOXES 200         /* boxes to certify det J's sign where it touches 0 */
+#define QUICK_BOXES 8          /* boxes of a branch and bound from a sampled extreme, before polishing it */
 
 /*
  * Cancellation: the caller's stop() is polled once per POLL_WORK units of
@@ -473,7 +475,7 @@ static double integral_error(const quad_result *q, const quad_result *qa)
  * its Taylor models never close the gap.
  */
 static pde_status detj_separable(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
-                                 double tol, const pde_cancel *cancel, bb_result *out)
+                                 double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
 {
     pbox face = { { 0, 0, 0 }, { 1, 1, 1 } };
     face.lo[sp->axis] = 1.0;
@@ -482,7 +484,7 @@ static pde_status detj_separable(const pde_solution *s, const quad_sep *sp, doub
     if (sp->free >= 0)   /* det J is constant along it: a segment of w, a 1-D problem */
         face.lo[sp->free] = face.hi[sp->free] = at[sp->free];
     bb_result b;
-    pde_status st = bb_minimise(s, OBJ_DETJ, sign, at, &face, tol, PDE_PROPS_BOXES_J, cancel, &b);
+    pde_status st = bb_minimise(s, OBJ_DETJ, sign, at, &face, tol, budget, cancel, &b);
     if (st != PDE_OK)
         return st;
     if (sp->n * sp->ns > 1) {
@@ -492,6 +494,15 @@ static pde_status detj_separable(const pde_solution *s, const quad_sep *sp, doub
     }
     *out = b;
     return PDE_OK;
+}
+
+/* The extreme of sign * det J by branch and bound, over the face where det J separates. */
+static pde_status what_detj(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
+                            double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
+{
+    if (sp->axis >= 0)
+        return detj_separable(s, sp, sign, start, tol, budget, cancel, out);
+    return bb_minimise(s, OBJ_DETJ, sign, start, NULL, tol, budget, cancel, out);
 }
 
 pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde_props *out)
@@ -534,13 +545,12 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     const double step = 1.0 / (res - 1);
     double best[8], *at[8];
     for (int c = 0; c < 3; c++) {
-        best[2 * c] = polish(s, c, 1.0, at[2 * c] = e.lo_at[c], step, &pl);
-        best[2 * c + 1] = polish(s, c, -1.0, at[2 * c + 1] = e.hi_at[c], step, &pl);
+        best[2 * c] = e.lo[c], at[2 * c] = e.lo_at[c];
+        best[2 * c + 1] = e.hi[c], at[2 * c + 1] = e.hi_at[c];
     }
-    best[6] = polish(s, 3, 1.0, at[6] = e.jmin_at, step, &pl);
-    best[7] = polish(s, 3, -1.0, at[7] = e.jmax_at, step, &pl);
-    if (pl.stopped)
-        return PDE_ERR_CANCELLED;
+    best[6] = e.jmin, at[6] = e.jmin_at;
+    best[7] = e.jmax, at[7] = e.jmax_at;
+    /* The tolerances from the samples' extremes: no larger than the polished ones'. */
     double size = 0.0, jscale = fmax(fabs(best[6]), fabs(best[7]));
     for (int c = 0; c < 3; c++)
         size = fmax(size, best[2 * c + 1] - best[2 * c]);
@@ -548,19 +558,33 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         size = 1.0;
     if (!(jscale > 0.0))
         jscale = 1.0;
-    /* Certify each extreme from its polished point. */
+    /* Certify each extreme from its sampled point: first with a few boxes, which closes the gap where
+     * the extreme is on a face or edge along which the objective is certified monotone (fig. 1's
+     * every coordinate); else polished by a compass search, then the branch and bound's whole budget. */
     quad_sep sp;
     quad_separate(s, &sp);
+    double jlow[2], jat[2][3];   /* det J's certified lower bounds of +det J, -det J, without the pad */
     for (int o = 0; o < 8; o++) {
         const int what = o < 6 ? o / 2 : 3;
         const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
         bb_result b;
-        if (what == 3 && sp.axis >= 0) {
-            if ((st = detj_separable(s, &sp, sign, at[o], tol, cancel, &b)) != PDE_OK)
+        for (int pass = 0; pass < 2; pass++) {
+            const size_t budget = pass == 0 ? QUICK_BOXES : o < 6 ? PDE_PROPS_BOXES : PDE_PROPS_BOXES_J;
+            if (pass == 1) {
+                if (b.best < sign * best[o])   /* from the better of the sample and the boxes' centres */
+                    memcpy(at[o], b.at, sizeof b.at);
+                polish(s, what, sign, at[o], step, &pl);
+                if (pl.stopped)
+                    return PDE_ERR_CANCELLED;
+            }
+            if ((st = what == 3 ? what_detj(s, &sp, sign, at[o], tol, budget, cancel, &b)
+                                : bb_minimise(s, what, sign, at[o], NULL, tol, budget, cancel, &b)) != PDE_OK)
                 return st;
-        } else if ((st = bb_minimise(s, what, sign, at[o], NULL, tol, o < 6 ? PDE_PROPS_BOXES : PDE_PROPS_BOXES_J,
-                                     cancel, &b)) != PDE_OK)
-            return st;
+            if (b.best - b.lower <= tol)
+                break;
+        }
+        if (o >= 6)
+            jlow[o - 6] = b.lower, jat[o - 6][0] = b.at[0], jat[o - 6][1] = b.at[1], jat[o - 6][2] = b.at[2];
         /* The bound holds for the exact closed form; evaluated values may differ by their rounding. */
         const double pad = 64.0 * DBL_EPSILON * obj_magnitude(s, what);
         const double bound = sign * (b.lower - pad), gap = b.best - b.lower + pad;
@@ -575,6 +599,32 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             r.detj_gap = fmax(r.detj_gap, gap);
         }
     }
+    /* The scales from the extremes found, which the branch and bound only improved. */
+    size = 0.0, jscale = fmax(fabs(best[6]), fabs(best[7]));
+    for (int c = 0; c < 3; c++)
+        size = fmax(size, best[2 * c + 1] - best[2 * c]);
+    if (!(size > 0.0))
+        size = 1.0;
+    if (!(jscale > 0.0))
+        jscale = 1.0;
+    /* det J keeps its sign over the whole solid, up to what the integrals count as zero (1e-13 of its
+     * size): then every panel takes its tensor rule (quad_solid's jsign). Where det J touches 0 (on
+     * a face, fig. 1), the branch and bound stopped within 1e-9 of its size of 0: it goes on, for a
+     * few boxes, to certify the sign to that tighter tolerance. */
+    int jsign = 0;
+    const double jtol = 1e-13 * jscale;
+    for (int k = 0; k < 2 && !jsign; k++) {
+        const double sign = k ? -1.0 : 1.0;
+        if (jlow[k] < -jtol && fabs(best[6 + k]) <= 1e-9 * jscale) {
+            bb_result b;
+            st = what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, &b);
+            if (st != PDE_OK)
+                return st;
+            jlow[k] = fmax(jlow[k], b.lower);
+        }
+        if (jlow[k] >= -jtol)
+            jsign = k ? -1 : 1;
+    }
     /* Folds are witnessed by attained values of both signs. */
     double tol = 1e-9 * jscale;
     r.folds = best[6] < -tol && best[7] > tol;
@@ -586,7 +636,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         vol_scale *= fmax(best[2 * c + 1] - best[2 * c], 1e-3 * size);
     }
     quad_result q, qa;
-    if ((st = quad_solid(s, x0, jscale, vol_scale, 1, cancel, &q)) != PDE_OK ||
+    if ((st = quad_solid(s, x0, jscale, vol_scale, 1, jsign, cancel, &q)) != PDE_OK ||
         (st = quad_area(s, size, cancel, &r.surface_area, &qa)) != PDE_OK)
         return st;
     mass_properties(&q, x0, &r);

@@ -35,6 +35,7 @@
 #include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -82,10 +83,12 @@ typedef struct {
     const pde_cancel *cancel;
     double x0[3], jtol;
     double f[3];                 /* the integrand's frequencies (at least 1) */
+    int poly[3];                 /* the solution's degree along each axis where it is a polynomial, else -1 */
     double vscale;               /* the solid's volume, roughly: for refinement's tolerance */
     double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];   /* n-point rules on [0, 1] */
     int n[3];                    /* the current panel's points per axis (0: the flat axis) */
     int flat;                    /* the axis fixed at 1 (quad_separate), or -1 */
+    int jsign;                   /* det J's sign where certified over the whole solid (quad_solid), or 0 */
     int free;                    /* the face's parameter det J does not depend on (quad_sep), or -1 */
     /* free_panel's segments of w whose sign was certified or not, the same for every panel of the
      * other parameter: remembered, up to SEG_MEMO of them */
@@ -142,6 +145,16 @@ static void gauss_legendre(int n, double *x, double *w)
         x[i] = 0.5 * (1.0 - z), x[n - 1 - i] = 0.5 * (1.0 + z);
         w[i] = w[n - 1 - i] = 0.5 * wt;
     }
+}
+
+/* The rules of 1 .. GMAX points, computed once for every thread. */
+static double rules_x[GMAX + 1][GMAX], rules_w[GMAX + 1][GMAX];
+static pthread_once_t rules_once = PTHREAD_ONCE_INIT;
+
+static void rules_init(void)
+{
+    for (int k = 1; k <= GMAX; k++)
+        gauss_legendre(k, rules_x[k], rules_w[k]);
 }
 
 static void factor_on(const pde_mode *md, int axis, double t, double *val, double *der)
@@ -339,10 +352,23 @@ static void line_gauss_tab(qctx *q, double wt)
  * below 1e-14: (e phi / 8n)^(2n), the rule's asymptotic error. */
 static int rule_points(double phi);
 
+/* The points of a rule over a panel of width h along axis a: where the solution is a polynomial of
+ * degree d along it, the integrands (det J times up to two coordinates: five factors) are of degree
+ * at most 5 d wherever det J keeps its sign, and ceil((5 d + 1) / 2) points integrate them exactly. */
+static int poly_points(int d)
+{
+    return d < 0 ? 0 : (5 * d) / 2 + 1;
+}
+
+static int axis_points(const qctx *q, int a, double h)
+{
+    return q->poly[a] >= 0 ? poly_points(q->poly[a]) : rule_points(q->f[a] * h);
+}
+
 /* The current line over [a, b], a piece between roots, with a rule sized to the piece. */
 static void line_gauss(qctx *q, double a, double b, double wt)
 {
-    const int n = rule_points(q->f[q->k] * (b - a));
+    const int n = axis_points(q, q->k, b - a);
     double x[3], h = b - a;
     for (int i = 0; i < n; i++) {
         double j = line_eval(q, a + h * q->gx[n][i], x);
@@ -548,7 +574,7 @@ static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int dep
                 sub[s].lo[a] = mid;
             else
                 sub[s].hi[a] = mid;
-            nsub[s][a] = q->n[a] = rule_points(q->f[a] * (sub[s].hi[a] - sub[s].lo[a]));
+            nsub[s][a] = q->n[a] = axis_points(q, a, sub[s].hi[a] - sub[s].lo[a]);
         }
         definite[s] = sign_definite(q, &sub[s]);
         axis[s] = definite[s] ? (q->flat == 0 ? 1 : 0) : line_axis(q, &sub[s]);
@@ -594,6 +620,8 @@ static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
     for (int i = 0; i < q->nseg && definite < 0; i++)
         if (q->seg_lo[i] == b->lo[2] && q->seg_hi[i] == b->hi[2])
             definite = q->seg_def[i];
+    if (definite < 0 && q->jsign)
+        definite = 1;
     if (definite < 0) {   /* at any one value of the other parameter: 1/2 */
         pbox seg = *b;
         seg.lo[q->free] = seg.hi[q->free] = 0.5;
@@ -609,7 +637,7 @@ static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
             pbox c = *b;
             double part[Q_N];
             *(h ? &c.lo[2] : &c.hi[2]) = mid;
-            q->n[2] = rule_points(q->f[2] * (c.hi[2] - c.lo[2]));
+            q->n[2] = axis_points(q, 2, c.hi[2] - c.lo[2]);
             free_panel(q, &c, depth + 1, part);
             for (int e = 0; e < Q_N; e++)
                 acc[e] += part[e];
@@ -634,7 +662,7 @@ static void panel(qctx *q, const pbox *b)
             q->r.acc[e] += acc[e];
         return;
     }
-    const int definite = sign_definite(q, b);
+    const int definite = q->jsign ? 1 : sign_definite(q, b);
     int k = 0;
     if (definite) {   /* lines along the axis with the fewest points, the cheapest */
         k = q->flat == 0 ? 1 : 0;
@@ -658,6 +686,29 @@ static void panel(qctx *q, const pbox *b)
         q->r.unrefined++;
     for (int e = 0; e < Q_N; e++)
         q->r.acc[e] += acc[e];
+}
+
+/* The solution's degree along each axis where every factor along it is a polynomial (along w: every
+ * term of every h, within each slab of a loft), else -1; -1 too beyond a degree whose integrands'
+ * exact rule would need more than GMAX points. */
+static void poly_degrees(const pde_solution *s, int deg[3])
+{
+    deg[0] = deg[1] = deg[2] = 0;
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
+            const pde_mode *md = &s->comp[c].modes[m];
+            const pde_factor fa[2] = { md->u, md->v };
+            for (int a = 0; a < 2; a++)
+                if (deg[a] >= 0)
+                    deg[a] = fa[a].kind != PDE_POW ? -1 : fa[a].p > deg[a] ? (int)fa[a].p : deg[a];
+            for (size_t k = 0; k < md->nterms && deg[2] >= 0; k++) {
+                const pde_wterm *t = &md->terms[k];
+                deg[2] = t->alpha != 0.0 || t->beta != 0.0 ? -1 : t->deg > deg[2] ? t->deg : deg[2];
+            }
+        }
+    for (int a = 0; a < 3; a++)
+        if (poly_points(deg[a]) > GMAX)
+            deg[a] = -1;
 }
 
 /* The fastest change along each axis of a product of `factors` of the solution's factors, in
@@ -693,11 +744,13 @@ static int rule_points(double phi)
 }
 
 /*
- * Panels and points for an integrand that multiplies `factors` of the solution's factors. Along w,
+ * Panels and points for an integrand that multiplies `factors` of the solution's factors; exact:
+ * along an axis where the solution is a polynomial, one panel and the rule exact on the solid's
+ * integrands (poly_points). Along w,
  * panels never straddle a slab's break, where h's higher derivatives jump: each slab gets panels of
  * its own, as many as its share of the axis calls for.
  */
-static void plan_for(const pde_solution *s, double factors, qplan *p)
+static void plan_for(const pde_solution *s, double factors, int exact, qplan *p)
 {
     double f[3];
     size_t mt = 1, nslabs;
@@ -705,10 +758,13 @@ static void plan_for(const pde_solution *s, double factors, qplan *p)
         mt += s->comp[c].nmodes;
     const double *br = solution_breaks(s, &nslabs);
     frequencies(s, factors, f);
-    int want[3];
+    int want[3], deg[3];
+    poly_degrees(s, deg);
     for (int a = 0; a < 3; a++) {
         double v = ceil(f[a] / PANEL_PHASE);   /* then 12 points per panel */
         want[a] = v < 1 ? 1 : v > MAX_PANELS ? MAX_PANELS : (int)v;
+        if (exact && deg[a] >= 0)
+            want[a] = 1;   /* one panel (a slab's, along w), with a rule exact on it */
     }
     /* Bounded work: past MAX_WORK in all, the busiest axis gets fewer, wider panels, and its rule
      * more points, up to GMAX: beyond, the integrals lose digits, which p->err estimates. */
@@ -742,8 +798,8 @@ static void plan_for(const pde_solution *s, double factors, qplan *p)
             }
             for (int i = 0; i < p->np[a]; i++)
                 widest = fmax(widest, p->edge[a][i + 1] - p->edge[a][i]);
-            p->n[a] = rule_points(f[a] * widest);
-            p->phase[a] = f[a] * widest;
+            p->n[a] = exact && deg[a] >= 0 ? poly_points(deg[a]) : rule_points(f[a] * widest);
+            p->phase[a] = exact && deg[a] >= 0 ? 0.0 : f[a] * widest;
         }
         if ((double)p->np[0] * p->n[0] * p->np[1] * p->n[1] * p->np[2] * p->n[2] * (double)mt <= MAX_WORK)
             break;
@@ -756,6 +812,8 @@ static void plan_for(const pde_solution *s, double factors, qplan *p)
     /* The rules' asymptotic error on the fastest exp(i f t) of a panel, relative. */
     p->err = 0.0;
     for (int a = 0; a < 3; a++) {
+        if (p->phase[a] == 0.0)
+            continue;   /* exact */
         double e = 2 * p->n[a] * log(M_E * p->phase[a] / (8.0 * p->n[a]));
         p->err += e < -700 ? 0.0 : fmin(1.0, exp(e));
     }
@@ -764,7 +822,7 @@ static void plan_for(const pde_solution *s, double factors, qplan *p)
 void quad_panels(const pde_solution *s, int np[3], int n[3])
 {
     qplan p;
-    plan_for(s, 5.0, &p);   /* the second moments times det J: five factors */
+    plan_for(s, 5.0, 1, &p);   /* the second moments times det J: five factors */
     memcpy(np, p.np, sizeof p.np);
     memcpy(n, p.n, sizeof p.n);
 }
@@ -794,8 +852,10 @@ static qctx *qctx_new(const pde_solution *s, const pde_cancel *cancel)
     q->max_depth = OUTER_DEPTH;
     q->max_panels = REFINE_PANELS;
     q->modes = q->mt + 1;
-    for (int k = 1; k <= GMAX; k++)
-        gauss_legendre(k, q->gx[k], q->gw[k]);
+    poly_degrees(s, q->poly);
+    pthread_once(&rules_once, rules_init);
+    memcpy(q->gx, rules_x, sizeof q->gx);
+    memcpy(q->gw, rules_w, sizeof q->gw);
     return q;
 }
 
@@ -906,7 +966,7 @@ static void separable_moments(const quad_sep *sp, const double x0[3], double acc
 }
 
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
-                      const pde_cancel *cancel, quad_result *out)
+                      int jsign, const pde_cancel *cancel, quad_result *out)
 {
     qctx *q = qctx_new(s, cancel);
     if (!q)
@@ -917,8 +977,9 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     q->free = separate == 1 ? sp.free : -1;
     q->jtol = 1e-13 * jscale;
     q->vscale = vscale;
+    q->jsign = jsign;
     qplan p;
-    plan_for(s, 5.0, &p);
+    plan_for(s, 5.0, 1, &p);
     if (sp.axis >= 0) {   /* the face t = 1 alone: one panel along the flat axis, no rule */
         q->flat = sp.axis;
         q->max_depth = FLAT_DEPTH;
@@ -1225,7 +1286,7 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
         return PDE_ERR_NOMEM;
     }
     qplan p;
-    plan_for(s, 5.0, &p);
+    plan_for(s, 5.0, 1, &p);
     double f[3];
     frequencies(s, 5.0, f);
     quad_sep sp;
