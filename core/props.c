@@ -2,8 +2,8 @@
  * props.c: properties of a solved solid, from its closed form (pde.h,
  * docs/MATH.md "Properties").
  *
- * 1. Extremes: a uniform sample, a compass search from the best samples, then
- *    branch and bound (bound.h) from there, until the certified bound is
+ * 1. Extremes: a uniform sample, then branch and bound (bound.h) from its
+ *    best points, until the certified bound is
  *    within 1e-9 of the solid's size of the best value (or a box budget ends:
  *    the gap says how far it got).
  * 2. Integrals over the solid weighted by |det J| (quad.h): volume, signed
@@ -23,9 +23,7 @@
 #include "bound.h"
 #include "quad.h"
 
-#define POLISH_EVALS 400       /* evaluations of one compass search, at most */
 #define SIGN_BOXES 200         /* boxes to certify det J's sign where it touches 0 */
-#define QUICK_BOXES 8          /* boxes of a branch and bound from a sampled extreme, before polishing it */
 
 /*
  * Cancellation: the caller's stop() is polled once per POLL_WORK units of
@@ -53,53 +51,6 @@ static int poll_after(poller *p, size_t units)
         return 0;
     p->work = 0;
     return p->stopped = pde_stopped(p->cancel);
-}
-
-static double detj_at(const pde_solution *s, const double p[3])
-{
-    double xu[3], xv[3], xw[3];
-    pde_eval_d(s, p[0], p[1], p[2], NULL, xu, xv, xw);
-    return det3(xu, xv, xw);
-}
-
-/* sign * (what) at p: what 0..2 a coordinate, 3 det J. */
-static double objective(const pde_solution *s, int what, double sign, const double p[3])
-{
-    if (what == 3)
-        return sign * detj_at(s, p);
-    double x[3];
-    pde_eval(s, p[0], p[1], p[2], x);
-    return sign * x[what];
-}
-
-/* Compass search for a minimum of the objective in the unit cube, from p. */
-static double polish(const pde_solution *s, int what, double sign, double p[3], double step, poller *pl)
-{
-    if (poll_after(pl, pl->point))
-        return 0.0;
-    double best = objective(s, what, sign, p);
-    for (int evals = 0; step > 1e-7 && evals < POLISH_EVALS;) {
-        if (poll_after(pl, pl->point))
-            return 0.0;
-        int moved = 0;
-        for (int a = 0; a < 3 && !moved; a++)
-            for (int d = -1; d <= 1 && !moved; d += 2) {
-                double q[3] = { p[0], p[1], p[2] };
-                q[a] = fmin(1.0, fmax(0.0, q[a] + d * step));
-                if (q[a] == p[a])
-                    continue;
-                double f = objective(s, what, sign, q);
-                evals++;
-                if (f < best) {
-                    best = f;
-                    p[0] = q[0], p[1] = q[1], p[2] = q[2];
-                    moved = 1;
-                }
-            }
-        if (!moved)
-            step *= 0.5;
-    }
-    return sign * best;
 }
 
 typedef struct {
@@ -496,6 +447,16 @@ static pde_status detj_separable(const pde_solution *s, const quad_sep *sp, doub
     return PDE_OK;
 }
 
+/* The solid's size and det J's from the extremes best (min x, max x, ..., min det J, max det J). */
+static void scales(const double best[8], double *size, double *jscale)
+{
+    double sz = 0.0, js = fmax(fabs(best[6]), fabs(best[7]));
+    for (int c = 0; c < 3; c++)
+        sz = fmax(sz, best[2 * c + 1] - best[2 * c]);
+    *size = sz > 0.0 ? sz : 1.0;
+    *jscale = js > 0.0 ? js : 1.0;
+}
+
 /* The extreme of sign * det J by branch and bound, over the face where det J separates. */
 static pde_status what_detj(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
                             double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
@@ -542,7 +503,6 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
 
     /* Into a local result, so that a cancelled call leaves *out untouched. */
     pde_props r = { 0 };
-    const double step = 1.0 / (res - 1);
     double best[8], *at[8];
     for (int c = 0; c < 3; c++) {
         best[2 * c] = e.lo[c], at[2 * c] = e.lo_at[c];
@@ -550,17 +510,11 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     }
     best[6] = e.jmin, at[6] = e.jmin_at;
     best[7] = e.jmax, at[7] = e.jmax_at;
-    /* The tolerances from the samples' extremes: no larger than the polished ones'. */
-    double size = 0.0, jscale = fmax(fabs(best[6]), fabs(best[7]));
-    for (int c = 0; c < 3; c++)
-        size = fmax(size, best[2 * c + 1] - best[2 * c]);
-    if (!(size > 0.0))
-        size = 1.0;
-    if (!(jscale > 0.0))
-        jscale = 1.0;
-    /* Certify each extreme from its sampled point: first with a few boxes, which closes the gap where
-     * the extreme is on a face or edge along which the objective is certified monotone (fig. 1's
-     * every coordinate); else polished by a compass search, then the branch and bound's whole budget. */
+    /* The tolerances from the samples' extremes: no larger than those found by the boxes. */
+    double size, jscale;
+    scales(best, &size, &jscale);
+    /* Certify each extreme by branch and bound from its sampled point (a compass search polishing it
+     * first cost more than it saved: the boxes' centres converge on the extreme as fast). */
     quad_sep sp;
     quad_separate(s, &sp);
     double jlow[2], jat[2][3];   /* det J's certified lower bounds of +det J, -det J, without the pad */
@@ -568,21 +522,9 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         const int what = o < 6 ? o / 2 : 3;
         const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
         bb_result b;
-        for (int pass = 0; pass < 2; pass++) {
-            const size_t budget = pass == 0 ? QUICK_BOXES : o < 6 ? PDE_PROPS_BOXES : PDE_PROPS_BOXES_J;
-            if (pass == 1) {
-                if (b.best < sign * best[o])   /* from the better of the sample and the boxes' centres */
-                    memcpy(at[o], b.at, sizeof b.at);
-                polish(s, what, sign, at[o], step, &pl);
-                if (pl.stopped)
-                    return PDE_ERR_CANCELLED;
-            }
-            if ((st = what == 3 ? what_detj(s, &sp, sign, at[o], tol, budget, cancel, &b)
-                                : bb_minimise(s, what, sign, at[o], NULL, tol, budget, cancel, &b)) != PDE_OK)
-                return st;
-            if (b.best - b.lower <= tol)
-                break;
-        }
+        if ((st = what == 3 ? what_detj(s, &sp, sign, at[o], tol, PDE_PROPS_BOXES_J, cancel, &b)
+                            : bb_minimise(s, what, sign, at[o], NULL, tol, PDE_PROPS_BOXES, cancel, &b)) != PDE_OK)
+            return st;
         if (o >= 6)
             jlow[o - 6] = b.lower, jat[o - 6][0] = b.at[0], jat[o - 6][1] = b.at[1], jat[o - 6][2] = b.at[2];
         /* The bound holds for the exact closed form; evaluated values may differ by their rounding. */
@@ -600,13 +542,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         }
     }
     /* The scales from the extremes found, which the branch and bound only improved. */
-    size = 0.0, jscale = fmax(fabs(best[6]), fabs(best[7]));
-    for (int c = 0; c < 3; c++)
-        size = fmax(size, best[2 * c + 1] - best[2 * c]);
-    if (!(size > 0.0))
-        size = 1.0;
-    if (!(jscale > 0.0))
-        jscale = 1.0;
+    scales(best, &size, &jscale);
     /* det J keeps its sign over the whole solid, up to what the integrals count as zero (1e-13 of its
      * size): then every panel takes its tensor rule (quad_solid's jsign). Where det J touches 0 (on
      * a face, fig. 1), the branch and bound stopped within 1e-9 of its size of 0: it goes on, for a

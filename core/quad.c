@@ -1269,6 +1269,59 @@ static int face_separates(const pde_solution *s, const quad_sep *sp, int axis, d
 }
 
 /*
+ * A face along whose parameters the solution is a polynomial, of degrees d0 and d1 (within one slab):
+ * its element c = x_a x x_b is a polynomial of degree at most 2 d - 1 along each, so when c x nu
+ * vanishes on a grid of (2 d + 1)^2 points, to rounding, nu a unit vector, it vanishes everywhere:
+ * the face is planar, c = g nu, and |c| = |g|, a polynomial. Where g keeps its sign on the grid and
+ * at the rule's nodes, the face's area is |the integral of g| and its flux the integral of x . c, by
+ * rules exact on them (3 d / 2 + 1 points). Returns 0, with nothing set, where it does not apply.
+ */
+static int face_planar(const pde_solution *s, int axis, int side, const int d[2], double *area,
+                       double *flux)
+{
+    double x[3], ta[3], tb[3], c[2 * GMAX + 1][3], big = 0.0, nu[3] = { 0, 0, 0 };
+    const int n0 = 2 * d[0] + 1, n1 = 2 * d[1] + 1;
+    if (n0 * n1 > 2 * GMAX + 1)
+        return 0;
+    for (int i = 0; i < n0; i++)
+        for (int j = 0; j < n1; j++) {
+            double *e = c[i * n1 + j];
+            face_point(s, axis, side, n0 > 1 ? (double)i / (n0 - 1) : 0.5, n1 > 1 ? (double)j / (n1 - 1) : 0.5,
+                       x, ta, tb);
+            e[0] = ta[1] * tb[2] - ta[2] * tb[1], e[1] = ta[2] * tb[0] - ta[0] * tb[2], e[2] = ta[0] * tb[1] - ta[1] * tb[0];
+            const double m = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+            if (m > big)
+                big = m, nu[0] = e[0] / m, nu[1] = e[1] / m, nu[2] = e[2] / m;
+        }
+    const double tol = 1e-13 * big;
+    int pos = 0, neg = 0;
+    for (int k = 0; k < n0 * n1; k++) {
+        const double *e = c[k];
+        const double cx[3] = { e[1] * nu[2] - e[2] * nu[1], e[2] * nu[0] - e[0] * nu[2], e[0] * nu[1] - e[1] * nu[0] };
+        if (fabs(cx[0]) > tol || fabs(cx[1]) > tol || fabs(cx[2]) > tol)
+            return 0;
+        const double g = e[0] * nu[0] + e[1] * nu[1] + e[2] * nu[2];
+        pos |= g > tol, neg |= g < -tol;
+    }
+    const int m0 = 3 * d[0] / 2 + 1, m1 = 3 * d[1] / 2 + 1;
+    double sa = 0.0, sf = 0.0;
+    for (int i = 0; i < m0; i++)
+        for (int j = 0; j < m1; j++) {
+            face_point(s, axis, side, rules_x[m0][i], rules_x[m1][j], x, ta, tb);
+            const double e[3] = { ta[1] * tb[2] - ta[2] * tb[1], ta[2] * tb[0] - ta[0] * tb[2], ta[0] * tb[1] - ta[1] * tb[0] };
+            const double g = e[0] * nu[0] + e[1] * nu[1] + e[2] * nu[2], wt = rules_w[m0][i] * rules_w[m1][j];
+            pos |= g > tol, neg |= g < -tol;
+            sa += wt * g;
+            sf += wt * (x[0] * e[0] + x[1] * e[1] + x[2] * e[2]);
+        }
+    if (pos && neg)
+        return 0;   /* the face folds over itself: the general path locates the fold */
+    *area = fabs(sa);
+    *flux = sf;
+    return 1;
+}
+
+/*
  * The skin's area: each face's panels (sized to the element's frequencies, counted like the
  * solid's integrals as five factors') along lines that locate the cuspidal edges of a folded
  * face. Each panel is checked against its quarters and refined where they differ by more than
@@ -1293,6 +1346,8 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
     quad_separate(s, &sp);
     c->tol = 1e-11 * size * size;
     c->cancel = cancel;
+    size_t nslabs;
+    solution_breaks(s, &nslabs);
     /* Where det J separates, the faces of another axis are lines: the budget of refined panels
      * goes to the rest (fig. 3b's area 1.1e-5 -> 1.6e-8 of the reference quadrature's). */
     c->max_refined = sp.axis >= 0 ? INT_MAX : FACE_REFINE;
@@ -1310,8 +1365,14 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
              * the face is a curve or a point, its area and flux exactly 0 (quad_separate). */
             if (axis == sp.axis && side == 0 && sp.ns >= 2)
                 continue;
-            c->line = (face_line){ .q = q, .axis = axis, .side = side, .o = { o[0], o[1] } };
             double ascale = 1.0, fscale = 1.0, face = 0.0, fflux = 0.0;
+            const int d[2] = { q->poly[o[0]], q->poly[o[1]] };
+            if (d[0] >= 0 && d[1] >= 0 && (axis == 2 || nslabs == 1) && face_planar(s, axis, side, d, &face, &fflux)) {
+                flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fflux;
+                total += face;
+                continue;
+            }
+            c->line = (face_line){ .q = q, .axis = axis, .side = side, .o = { o[0], o[1] } };
             c->flat = face_separates(s, &sp, axis, &ascale, &fscale);
             const int npa = c->flat == 0 ? 1 : p.np[o[0]], npb = c->flat == 1 ? 1 : p.np[o[1]];
             for (int pa = 0; pa < npa && !c->stopped; pa++)
