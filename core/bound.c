@@ -357,10 +357,12 @@ static double lower_model(const pde_solution *s, int what, double sign, pbox *b,
         for (int k = 0; k < 3; k++) {
             if (r[k] == 0.0)
                 continue;
+            /* Non-decreasing (the derivative's lower bound >= 0, as at a face where the objective's
+             * derivative vanishes, fig. 1's z at w = 0): the minimum is on the low face. */
             double g = sign * m.g[k];
-            if (g - spread[k] > 0.0)
-                b->hi[k] = b->lo[k], moved = 1;   /* increasing: the minimum is on the low face */
-            else if (g + spread[k] < 0.0)
+            if (g - spread[k] >= 0.0)
+                b->hi[k] = b->lo[k], moved = 1;
+            else if (g + spread[k] <= 0.0)
                 b->lo[k] = b->hi[k], moved = 1;
         }
         if (!moved)

@@ -107,6 +107,17 @@ static pde_status sweep(const pde_solution *s, const double *us, size_t nu, cons
     return PDE_OK;
 }
 
+/* fmax and fmin without the library call, in the residuals' inner loops (where b may be NaN: a). */
+static inline double max2(double a, double b)
+{
+    return b > a ? b : a;
+}
+
+static inline double min2(double a, double b)
+{
+    return b < a ? b : a;
+}
+
 /*
  * The boundary residual: the largest error of x and x_w on res x res points of w = 0 and w = 1,
  * relative to the size of the problem, which must not be the solution's size alone:
@@ -185,14 +196,14 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
                         drive[k] += fabs(cs->drive[m][k] * f);
                 }
                 for (int k = 0; k < 4; k++)
-                    drive[k] = fmin(drive[k], own_size[c]);
+                    drive[k] = min2(drive[k], own_size[c]);
                 for (int side = 0; side < 2; side++) {
                     double x = row[(6 * side + c) * n + i], xw = row[(6 * side + 3 + c) * n + i];
-                    err[c] = fmax(err[c], fmax(fabs(x - d[2 * side]), fabs(xw - d[2 * side + 1])));
+                    err[c] = max2(err[c], max2(fabs(x - d[2 * side]), fabs(xw - d[2 * side + 1])));
                 }
                 for (int k = 0; k < 4; k++)
-                    sc = fmax(sc, fmax(dabs[k], drive[k]));
-                scale[c] = fmax(scale[c], sc);
+                    sc = max2(sc, max2(dabs[k], drive[k]));
+                scale[c] = max2(scale[c], sc);
             }
         }
     }
@@ -271,8 +282,8 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
                     }
                     tu *= cs->a, tv *= cs->b, tw *= cs->c;
                     double p = pde_force(s, c, (i + 0.5) / res, (j + 0.5) / res, (k + 0.5) / res);
-                    err = fmax(err, fabs(tu + tv + tw - p));
-                    scale = fmax(scale, fmax(fmax(fabs(tu), fabs(tv)), fmax(fabs(tw), fabs(p))));
+                    err = max2(err, fabs(tu + tv + tw - p));
+                    scale = max2(scale, max2(max2(fabs(tu), fabs(tv)), max2(fabs(tw), fabs(p))));
                 }
         free(tab);
         worst = fmax(worst, scale > 0.0 ? err / scale : err);
