@@ -1322,6 +1322,49 @@ static int face_planar(const pde_solution *s, int axis, int side, const int d[2]
 }
 
 /*
+ * A face repeats itself along its parameter t (u or v) when every component's modes have the factor
+ * sin(k pi t) or cos(k pi t) along t, one integer k >= 2 for all, or else the factor 1, the same
+ * kind for all of a component's modes: t -> t + 1/k flips the sign of the first kind's components,
+ * x -> D x with D = diag(+-1), so the element |x_a x x_b| is the same and the flux x . (x_a x x_b)
+ * is det D times the same (fig. 2 and 4: x, y of sin, cos(2 pi v), z of 1, k = 2). When moreover
+ * each component's factors are all odd (sin) or all even (cos, 1), t -> -t is x -> D' x with the
+ * tangent along t reversed: the element is the same again, the flux -det D' times it, and half a
+ * period is enough. Returns k (0: none), with det D in *det and -det D' in *rdet (0: no mirror).
+ */
+static int face_period(const pde_solution *s, int t, double *det, double *rdet)
+{
+    int k = 0, mirror = 1;
+    *det = 1.0, *rdet = -1.0;
+    for (int c = 0; c < 3; c++) {
+        int kind = -1, parity = -1;   /* kind 0: factors 1, 1: sin, cos of k; parity 0: even, 1: odd */
+        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
+            const pde_factor f = t == 0 ? s->comp[c].modes[m].u : s->comp[c].modes[m].v;
+            int mk;
+            if (f.kind == PDE_POW && f.p == 0.0)
+                mk = 0;
+            else if ((f.kind == PDE_SIN || f.kind == PDE_COS) && fabs(f.p) >= 2.0 && fabs(f.p) <= 1e6 &&
+                     fabs(f.p) == floor(fabs(f.p)) && (k == 0 || fabs(f.p) == k))
+                mk = 1, k = (int)fabs(f.p);
+            else
+                return 0;
+            const int mp = f.kind == PDE_SIN;
+            if ((kind >= 0 && mk != kind))
+                return 0;
+            if (parity >= 0 && mp != parity)
+                mirror = 0;
+            kind = mk, parity = mp;
+        }
+        if (kind == 1)
+            *det = -*det;
+        if (parity == 1)
+            *rdet = -*rdet;
+    }
+    if (!mirror)
+        *rdet = 0.0;
+    return k;
+}
+
+/*
  * The skin's area: each face's panels (sized to the element's frequencies, counted like the
  * solid's integrals as five factors') along lines that locate the cuspidal edges of a folded
  * face. Each panel is checked against its quarters and refined where they differ by more than
@@ -1339,7 +1382,8 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
         return PDE_ERR_NOMEM;
     }
     qplan p;
-    plan_for(s, 5.0, 1, &p);
+    plan_for(s, 5.0, 0, &p);   /* the faces' panels sized to the frequencies even along a polynomial axis: a
+                                 * curved face refines less from smaller panels (planar ones: face_planar) */
     double f[3];
     frequencies(s, 5.0, f);
     quad_sep sp;
@@ -1374,7 +1418,20 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
             }
             c->line = (face_line){ .q = q, .axis = axis, .side = side, .o = { o[0], o[1] } };
             c->flat = face_separates(s, &sp, axis, &ascale, &fscale);
-            const int npa = c->flat == 0 ? 1 : p.np[o[0]], npb = c->flat == 1 ? 1 : p.np[o[1]];
+            int npa = c->flat == 0 ? 1 : p.np[o[0]], npb = c->flat == 1 ? 1 : p.np[o[1]];
+            /* One period (half a period, mirrored) of a parameter along which the face repeats itself,
+             * reflected (face_period): per parts of the face alike. */
+            double fdet = 1.0, rdet = 0.0;
+            int per = 1, half = 1;
+            for (int k = 0; k < 2 && per == 1; k++) {
+                int *np = k ? &npb : &npa;
+                if (o[k] > 1 || (per = face_period(s, o[k], &fdet, &rdet)) < 2 || *np % per) {
+                    per = 1, fdet = 1.0, rdet = 0.0;
+                    continue;
+                }
+                half = rdet != 0.0 && *np % (2 * per) == 0 ? 2 : 1;
+                *np /= per * half;
+            }
             for (int pa = 0; pa < npa && !c->stopped; pa++)
                 for (int pb = 0; pb < npb && !c->stopped; pb++) {
                     const double *ea = p.edge[o[0]], *eb = p.edge[o[1]];
@@ -1389,8 +1446,13 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
                                 ? a : face_refine(c, lo, h, a, 0);
                 }
             /* Outward: side 1 along +axis; (o0, o1, axis) is odd for axis 1. */
-            flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fscale * fflux;
-            total += ascale * face;
+            double fsum = 0.0;   /* the periods' fluxes: det D^j times the first's, and its mirror's */
+            for (int j = 0; j < per; j++)
+                fsum += j & 1 ? fdet : 1.0;
+            if (half == 2)
+                fsum *= 1.0 + rdet;
+            flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fscale * fsum * fflux;
+            total += ascale * per * half * face;
         }
     }
     pde_status st = c->stopped ? PDE_ERR_CANCELLED : PDE_OK;
