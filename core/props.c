@@ -458,6 +458,87 @@ static pde_status detj_separable(const pde_solution *s, const quad_sep *sp, doub
     return PDE_OK;
 }
 
+/* The range of a factor over [0, 1], with where it is attained: its ends and, for sin and cos, its
+ * first two critical points (all the extremes there are: +-1). */
+typedef struct {
+    double lo, hi, at_lo, at_hi;
+} range1;
+
+static void factor_range(pde_factor f, range1 *r)
+{
+    double t[4] = { 0.0, 1.0, 2.0, 2.0 }, v, d;
+    if ((f.kind == PDE_SIN || f.kind == PDE_COS) && f.p != 0.0) {
+        const double k = fabs(f.p), c0 = f.kind == PDE_SIN ? 0.5 : 1.0;
+        t[2] = c0 / k, t[3] = (c0 + 1.0) / k;
+    }
+    r->lo = DBL_MAX, r->hi = -DBL_MAX;
+    for (int i = 0; i < 4; i++) {
+        if (t[i] > 1.0)
+            continue;
+        factor_eval(f, t[i], &v, &d);
+        if (v < r->lo)
+            r->lo = v, r->at_lo = t[i];
+        if (v > r->hi)
+            r->hi = v, r->at_hi = t[i];
+    }
+}
+
+/*
+ * The extremes of a component that is one mode, x_c = f_u(u) f_v(v) h(w) (fig. 2, 4): the product
+ * of three independent ranges, so the extremes are among the products of the ends of f_u's and
+ * f_v's (exact) and h's, which two branch and bounds certify on a segment of w (one dimension,
+ * where the cube's took hundreds of boxes: an extreme on a face where a derivative vanishes).
+ * lo, hi: the certified bounds of x_c; best[2], at[2]: the extremes found (min, max).
+ */
+static pde_status single_mode_extremes(const pde_solution *s, int c, double tol, const pde_cancel *cancel,
+                                       double bound[2], double best[2], double at[2][3])
+{
+    const pde_mode *md = &s->comp[c].modes[0];
+    range1 ru, rv;
+    factor_range(md->u, &ru);
+    factor_range(md->v, &rv);
+    /* The segment where |f_u f_v| is largest: there h's extremes are certified. */
+    const double us = fabs(ru.lo) > fabs(ru.hi) ? ru.at_lo : ru.at_hi, vs = fabs(rv.lo) > fabs(rv.hi) ? rv.at_lo : rv.at_hi;
+    double fu, fv, d;
+    factor_eval(md->u, us, &fu, &d);
+    factor_eval(md->v, vs, &fv, &d);
+    const double P = fu * fv;
+    if (!(fabs(P) > 0.0) || !isfinite(P))
+        return PDE_ERR_INVALID;   /* the caller's general path */
+    const pbox seg = { { us, vs, 0.0 }, { us, vs, 1.0 } };
+    double hb[2], hf[2], hw[2];   /* h's certified min and max, those found, and where */
+    for (int k = 0; k < 2; k++) {
+        const double sg = (P > 0) == (k == 0) ? 1.0 : -1.0;   /* sg x_c = |P| h for the min of h */
+        const double start[3] = { us, vs, 0.5 };
+        bb_result b;
+        pde_status st = bb_minimise(s, c, sg, start, &seg, tol, PDE_PROPS_BOXES, cancel, &b);
+        if (st != PDE_OK)
+            return st;
+        const double m = k == 0 ? 1.0 : -1.0;
+        hb[k] = m * b.lower / fabs(P), hf[k] = m * b.best / fabs(P), hw[k] = b.at[2];
+    }
+    /* Over the corners (ends of f_u, f_v) and h's two extremes. */
+    const double fa[2] = { ru.lo, ru.hi }, ua[2] = { ru.at_lo, ru.at_hi };
+    const double fb[2] = { rv.lo, rv.hi }, vb[2] = { rv.at_lo, rv.at_hi };
+    bound[0] = DBL_MAX, bound[1] = -DBL_MAX, best[0] = DBL_MAX, best[1] = -DBL_MAX;
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2; j++)
+            for (int k = 0; k < 2; k++) {
+                const double ab = fa[i] * fb[j], vb_ = ab * hb[k];
+                double x[3];
+                pde_eval(s, ua[i], vb[j], hw[k], x);
+                bound[0] = fmin(bound[0], vb_), bound[1] = fmax(bound[1], vb_);
+                for (int e = 0; e < 2; e++)
+                    if (e == 0 ? x[c] < best[0] : x[c] > best[1]) {
+                        best[e] = x[c];
+                        at[e][0] = ua[i], at[e][1] = vb[j], at[e][2] = hw[k];
+                    }
+            }
+    (void)hf;
+    bound[0] = fmin(bound[0], best[0]), bound[1] = fmax(bound[1], best[1]);
+    return PDE_OK;
+}
+
 /* The solid's size and det J's from the extremes best (min x, max x, ..., min det J, max det J). */
 static void scales(const double best[8], double *size, double *jscale)
 {
@@ -529,12 +610,28 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     quad_sep sp;
     quad_separate(s, &sp);
     double jlow[2], jat[2][3];   /* det J's certified lower bounds of +det J, -det J, without the pad */
+    int single[3] = { 0, 0, 0 };   /* components of one mode: both extremes from single_mode_extremes */
+    bb_result sb[3][2];
     for (int o = 0; o < 8; o++) {
         const int what = o < 6 ? o / 2 : 3;
         const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
         bb_result b;
-        if ((st = what == 3 ? what_detj(s, &sp, sign, at[o], tol, PDE_PROPS_BOXES_J, cancel, &b)
-                            : bb_minimise(s, what, sign, at[o], NULL, tol, PDE_PROPS_BOXES, cancel, &b)) != PDE_OK)
+        if (what < 3 && s->comp[what].nmodes == 1 && !(o & 1)) {
+            /* Both extremes of a component of one mode at once. */
+            double bd[2], bs[2], ba[2][3];
+            if ((st = single_mode_extremes(s, what, tol, cancel, bd, bs, ba)) == PDE_OK) {
+                single[what] = 1;
+                for (int k = 0; k < 2; k++) {
+                    sb[what][k].lower = k ? -bd[1] : bd[0], sb[what][k].best = k ? -bs[1] : bs[0];
+                    memcpy(sb[what][k].at, ba[k], sizeof ba[k]);
+                }
+            } else if (st != PDE_ERR_INVALID)
+                return st;
+        }
+        if (what < 3 && single[what])
+            b = sb[what][o & 1];
+        else if ((st = what == 3 ? what_detj(s, &sp, sign, at[o], tol, PDE_PROPS_BOXES_J, cancel, &b)
+                                 : bb_minimise(s, what, sign, at[o], NULL, tol, PDE_PROPS_BOXES, cancel, &b)) != PDE_OK)
             return st;
         if (o >= 6)
             jlow[o - 6] = b.lower, jat[o - 6][0] = b.at[0], jat[o - 6][1] = b.at[1], jat[o - 6][2] = b.at[2];
