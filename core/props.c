@@ -430,26 +430,28 @@ static double integral_error(const quad_result *q, const quad_result *qa)
 }
 
 /*
- * The extreme of sign * det J where det J separates (quad.h: det J = t^p D1, D1 det J on the face
- * t = 1, p = n ns - 1): branch and bound over that face alone, a 2-D problem, then over t exactly:
- * t^p is 1 when p = 0, else it spans [0, 1], so the minimum is min(D1's, 0), attained at t = 0 when
- * it is 0. Without this, the 3-D branch and bound meets det J = 0 on the whole face t = 0, where
- * its Taylor models never close the gap.
+ * The extreme of sign * det J (what 3) or of a coordinate where det J separates (quad.h: det J =
+ * t^p D1, D1 det J on the face t = 1, p = n ns - 1; x_c = t^(n in[c]) X_c): branch and bound over
+ * that face alone, a 2-D problem, then over t exactly: t^p is 1 when p = 0, else it spans [0, 1],
+ * so the minimum is min(D1's, 0), attained at t = 0 when it is 0; likewise t^n X_c when in[c].
+ * Without this, the 3-D branch and bound meets det J = 0 on the whole face t = 0, where its Taylor
+ * models never close the gap, and a coordinate's boxes split along t wherever X_c changes sign.
  */
-static pde_status detj_separable(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
-                                 double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
+static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, int what, double sign,
+                                    const double start[3], double tol, size_t budget, const pde_cancel *cancel,
+                                    bb_result *out)
 {
     pbox face = { { 0, 0, 0 }, { 1, 1, 1 } };
     face.lo[sp->axis] = 1.0;
     double at[3] = { start[0], start[1], start[2] };
     at[sp->axis] = 1.0;
-    if (sp->free >= 0)   /* det J is constant along it: a segment of w, a 1-D problem */
+    if (what == 3 && sp->free >= 0)   /* det J is constant along it: a segment of w, a 1-D problem */
         face.lo[sp->free] = face.hi[sp->free] = at[sp->free];
     bb_result b;
-    pde_status st = bb_minimise(s, OBJ_DETJ, sign, at, &face, tol, budget, cancel, &b);
+    pde_status st = bb_minimise(s, what, sign, at, &face, tol, budget, cancel, &b);
     if (st != PDE_OK)
         return st;
-    if (sp->n * sp->ns > 1) {
+    if (what == 3 ? sp->n * sp->ns > 1 : sp->in[what]) {
         b.lower = fmin(b.lower, 0.0);
         if (b.best >= 0.0)
             b.best = 0.0, b.at[sp->axis] = 0.0;
@@ -554,7 +556,7 @@ static pde_status what_detj(const pde_solution *s, const quad_sep *sp, double si
                             double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
 {
     if (sp->axis >= 0)
-        return detj_separable(s, sp, sign, start, tol, budget, cancel, out);
+        return separable_extreme(s, sp, 3, sign, start, tol, budget, cancel, out);
     return bb_minimise(s, OBJ_DETJ, sign, start, NULL, tol, budget, cancel, out);
 }
 
@@ -630,8 +632,9 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         }
         if (what < 3 && single[what])
             b = sb[what][o & 1];
-        else if ((st = what == 3 ? what_detj(s, &sp, sign, at[o], tol, PDE_PROPS_BOXES_J, cancel, &b)
-                                 : bb_minimise(s, what, sign, at[o], NULL, tol, PDE_PROPS_BOXES, cancel, &b)) != PDE_OK)
+        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, PDE_PROPS_BOXES_J, cancel, &b)
+                       : sp.axis >= 0 ? separable_extreme(s, &sp, what, sign, at[o], tol, PDE_PROPS_BOXES, cancel, &b)
+                                      : bb_minimise(s, what, sign, at[o], NULL, tol, PDE_PROPS_BOXES, cancel, &b)) != PDE_OK)
             return st;
         if (o >= 6)
             jlow[o - 6] = b.lower, jat[o - 6][0] = b.at[0], jat[o - 6][1] = b.at[1], jat[o - 6][2] = b.at[2];
