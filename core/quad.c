@@ -965,6 +965,90 @@ static void separable_moments(const quad_sep *sp, const double x0[3], double acc
         acc[Q_M2 + k] = M2[k] - x0[pi[k]] * M1[pj[k]] - x0[pj[k]] * M1[pi[k]] + x0[pi[k]] * x0[pj[k]] * V;
 }
 
+/*
+ * The solid repeats itself along t (u or v) when every component's modes have the factor sin(k pi t)
+ * or cos(k pi t) along t, one integer k >= 2 for all, or else the factor 1, the same kind for all of
+ * a component's modes: t -> t + 1/k flips the sign of the first kind's components, x -> D x with
+ * D = diag(+-1) (fig. 2 and 4: x, y of sin, cos(2 pi v), z of 1, k = 2). When moreover each
+ * component's factors are all sin or all cos (or 1), t -> 1/k - t maps the half period [0, 1/2k] onto
+ * the other half, with the tangent along t reversed: x -> M x, M = diag(+-1) flipping the components
+ * of cos. Returns k (0: none), D in d and M in m (m[0] = 0: no mirror).
+ */
+static int param_symmetry(const pde_solution *s, int t, int d[3], int m[3])
+{
+    int k = 0, mirror = 1;
+    d[0] = d[1] = d[2] = m[0] = m[1] = m[2] = 1;
+    for (int c = 0; c < 3; c++) {
+        int kind = -1, parity = -1;   /* kind 0: factors 1, 1: sin, cos of k; parity 1: cos */
+        for (size_t i = 0; i < s->comp[c].nmodes; i++) {
+            const pde_factor f = t == 0 ? s->comp[c].modes[i].u : s->comp[c].modes[i].v;
+            int mk;
+            if (f.kind == PDE_POW && f.p == 0.0)
+                mk = 0;
+            else if ((f.kind == PDE_SIN || f.kind == PDE_COS) && fabs(f.p) >= 2.0 && fabs(f.p) <= 1e6 &&
+                     fabs(f.p) == floor(fabs(f.p)) && (k == 0 || fabs(f.p) == k))
+                mk = 1, k = (int)fabs(f.p);
+            else
+                return 0;
+            const int mp = f.kind == PDE_COS;   /* cos(pi - a) = -cos a, sin(pi - a) = sin a */
+            if (kind >= 0 && mk != kind)
+                return 0;
+            if (parity >= 0 && mp != parity)
+                mirror = 0;
+            kind = mk, parity = mp;
+        }
+        d[c] = kind == 1 ? -1 : 1;
+        m[c] = parity == 1 ? -1 : 1;
+    }
+    if (!mirror)
+        m[0] = 0;
+    return k;
+}
+
+/*
+ * A face repeats itself where the solid does (param_symmetry): x_a x x_b -> det D D (x_a x x_b), so
+ * the element |x_a x x_b| is the same and the flux x . (x_a x x_b) det D times the same; mirrored,
+ * the same with the tangent reversed: the flux -det M times it, and half a period is enough.
+ * Returns k (0: none), with det D in *det and -det M in *rdet (0: no mirror).
+ */
+static int face_period(const pde_solution *s, int t, double *det, double *rdet)
+{
+    int d[3], m[3];
+    const int k = param_symmetry(s, t, d, m);
+    *det = d[0] * d[1] * d[2];
+    *rdet = m[0] ? -m[0] * m[1] * m[2] : 0.0;
+    return k;
+}
+
+/*
+ * The integrals over one period of t (half of one, mirrored: half = 2) extended to [0, 1]
+ * (param_symmetry), moments about the origin: the copies' |det J| is the same, their x is D^j x
+ * (the other half: M x), their det J det D^j times (-det M times) the same.
+ */
+static void period_moments(const int d[3], const int m[3], int k, int half, double acc[Q_N])
+{
+    static const int pi[6] = { 0, 1, 2, 0, 0, 1 }, pj[6] = { 0, 1, 2, 1, 2, 2 };
+    double sg[Q_N];   /* the sign each entry takes under x -> diag(e) x */
+    for (int pass = 0; pass < 2; pass++) {
+        const int *e = pass == 0 ? m : d;
+        if (pass == 0 && half == 1)
+            continue;
+        sg[Q_VOL] = 1;
+        for (int c = 0; c < 3; c++)
+            sg[Q_M1 + c] = e[c];
+        for (int q = 0; q < 6; q++)
+            sg[Q_M2 + q] = e[pi[q]] * e[pj[q]];
+        sg[Q_SIGNED] = (pass == 0 ? -1 : 1) * e[0] * e[1] * e[2];
+        const int copies = pass == 0 ? 2 : k;
+        for (int q = 0; q < Q_N; q++) {
+            double sum = 0.0, f = 1.0;
+            for (int j = 0; j < copies; j++, f *= sg[q])
+                sum += f;
+            acc[q] *= sum;
+        }
+    }
+}
+
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
                       int jsign, const pde_cancel *cancel, quad_result *out)
 {
@@ -991,6 +1075,15 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     memcpy(q->n, p.n, sizeof p.n);
     q->r.err = p.err;
     frequencies(s, 5.0, q->f);
+    /* Where det J separates (moments about the origin), one period of a parameter along which the
+     * solid repeats itself, or half of one mirrored: the rest by symmetry (period_moments). */
+    int sd[3], sm[3], per = 0, half = 1, pt = -1;
+    for (int t = 0; t < 2 && sp.axis >= 0 && pt < 0; t++)
+        if (t != sp.axis && (per = param_symmetry(s, t, sd, sm)) > 1 && p.np[t] % per == 0) {
+            pt = t;
+            half = sm[0] && p.np[t] % (2 * per) == 0 ? 2 : 1;
+            p.np[t] /= per * half;
+        }
     for (int i = 0; i < p.np[0]; i++)
         for (int j = 0; j < p.np[1]; j++)
             for (int l = 0; l < p.np[2] && !q->stopped; l++) {
@@ -1000,6 +1093,10 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
             }
     pde_status st = q->stopped ? PDE_ERR_CANCELLED : PDE_OK;
     if (st == PDE_OK) {
+        if (pt >= 0) {
+            period_moments(sd, sm, per, half, q->r.acc);
+            q->r.refine_left *= per * half, q->r.refine_change *= per * half;
+        }
         if (sp.axis >= 0)
             separable_moments(&sp, x0, q->r.acc);
         *out = q->r;
@@ -1319,49 +1416,6 @@ static int face_planar(const pde_solution *s, int axis, int side, const int d[2]
     *area = fabs(sa);
     *flux = sf;
     return 1;
-}
-
-/*
- * A face repeats itself along its parameter t (u or v) when every component's modes have the factor
- * sin(k pi t) or cos(k pi t) along t, one integer k >= 2 for all, or else the factor 1, the same
- * kind for all of a component's modes: t -> t + 1/k flips the sign of the first kind's components,
- * x -> D x with D = diag(+-1), so the element |x_a x x_b| is the same and the flux x . (x_a x x_b)
- * is det D times the same (fig. 2 and 4: x, y of sin, cos(2 pi v), z of 1, k = 2). When moreover
- * each component's factors are all odd (sin) or all even (cos, 1), t -> -t is x -> D' x with the
- * tangent along t reversed: the element is the same again, the flux -det D' times it, and half a
- * period is enough. Returns k (0: none), with det D in *det and -det D' in *rdet (0: no mirror).
- */
-static int face_period(const pde_solution *s, int t, double *det, double *rdet)
-{
-    int k = 0, mirror = 1;
-    *det = 1.0, *rdet = -1.0;
-    for (int c = 0; c < 3; c++) {
-        int kind = -1, parity = -1;   /* kind 0: factors 1, 1: sin, cos of k; parity 0: even, 1: odd */
-        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
-            const pde_factor f = t == 0 ? s->comp[c].modes[m].u : s->comp[c].modes[m].v;
-            int mk;
-            if (f.kind == PDE_POW && f.p == 0.0)
-                mk = 0;
-            else if ((f.kind == PDE_SIN || f.kind == PDE_COS) && fabs(f.p) >= 2.0 && fabs(f.p) <= 1e6 &&
-                     fabs(f.p) == floor(fabs(f.p)) && (k == 0 || fabs(f.p) == k))
-                mk = 1, k = (int)fabs(f.p);
-            else
-                return 0;
-            const int mp = f.kind == PDE_SIN;
-            if ((kind >= 0 && mk != kind))
-                return 0;
-            if (parity >= 0 && mp != parity)
-                mirror = 0;
-            kind = mk, parity = mp;
-        }
-        if (kind == 1)
-            *det = -*det;
-        if (parity == 1)
-            *rdet = -*rdet;
-    }
-    if (!mirror)
-        *rdet = 0.0;
-    return k;
 }
 
 /*
