@@ -281,7 +281,7 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
                         tw += a * b * h4[m * n + k];
                     }
                     tu *= cs->a, tv *= cs->b, tw *= cs->c;
-                    double p = pde_force(s, c, (i + 0.5) / res, (j + 0.5) / res, (k + 0.5) / res);
+                    double p = cs->nfterms ? pde_force(s, c, (i + 0.5) / res, (j + 0.5) / res, (k + 0.5) / res) : 0.0;
                     err = max2(err, fabs(tu + tv + tw - p));
                     scale = max2(scale, max2(max2(fabs(tu), fabs(tv)), max2(fabs(tw), fabs(p))));
                 }
