@@ -46,11 +46,12 @@ typedef struct {
 
 typedef struct jet_cache {
     size_t mt;
+    int only;   /* the one component a coordinate's branch and bound needs, or -1: all three */
     jc_key key[3][JC_N];
     double val[];   /* axis a, slot i: val + (a * JC_N + i) * 5 mt */
 } jet_cache;
 
-static jet_cache *jet_cache_new(const pde_solution *s)
+static jet_cache *jet_cache_new(const pde_solution *s, int what)
 {
     size_t mt = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes;
     if (mt > JC_MODES)
@@ -59,10 +60,51 @@ static jet_cache *jet_cache_new(const pde_solution *s)
     if (!jc)
         return NULL;   /* no memo: slower, not wrong */
     jc->mt = mt;
+    jc->only = what < 3 ? what : -1;
     for (int a = 0; a < 3; a++)
         for (int i = 0; i < JC_N; i++)
             jc->key[a][i].order = -1;
     return jc;
+}
+
+/*
+ * Bounds of |h^(k)| over [w0, w1], k = 0..n: mode_h_bounds, which bounds each term about w = 0,
+ * except where h is a polynomial (every term's alpha and beta 0, one slab: fig. 1): from its
+ * Taylor coefficients b_j at the interval's centre c, |h^(k)| <= sum_(j >= k) j!/(j - k)! |b_j|
+ * r^(j - k), which tightens as the interval shrinks (about 0, h = 3 w^2 - 2 w^3 is bounded by 5 on
+ * [0.9, 1], at the centre by 1.0003).
+ */
+enum { H_POLY_DEG = 40 };
+
+static void h_bounds(const pde_mode *m, double w0, double w1, int n, double *d)
+{
+    int deg = 0;
+    for (size_t i = 0; i < m->nterms; i++) {
+        const pde_wterm *t = &m->terms[i];
+        if (m->nslabs > 1 || t->alpha != 0.0 || t->beta != 0.0 || t->deg > H_POLY_DEG) {
+            mode_h_bounds(m, w0, w1, n, d);
+            return;
+        }
+        deg = t->deg > deg ? t->deg : deg;
+    }
+    double b[H_POLY_DEG + 1] = { 0 };
+    for (size_t i = 0; i < m->nterms; i++)
+        for (int k = 0; k <= m->terms[i].deg; k++)
+            b[k] += m->terms[i].A[k];
+    const double c = 0.5 * (w0 + w1), r = 0.5 * (w1 - w0);
+    for (int i = 0; i < deg; i++)   /* Taylor shift to c: b[j] = h^(j)(c) / j! */
+        for (int k = deg - 1; k >= i; k--)
+            b[k] += c * b[k + 1];
+    for (int k = 0; k <= n; k++) {
+        double sum = 0.0;
+        for (int j = deg; j >= k; j--) {   /* Horner in r over the falling factorials */
+            double f = 1.0;
+            for (int i = 0; i < k; i++)
+                f *= j - i;
+            sum = sum * r + f * fabs(b[j]);
+        }
+        d[k] = sum;
+    }
 }
 
 /* Every mode's factor of axis a, derivatives 0..order at lo (bound 0) or their bounds over [lo, hi],
@@ -83,10 +125,12 @@ static const double *axis_factors(const pde_solution *s, jet_cache *jc, int a, d
     size_t o = 0;
     for (int c = 0; c < 3; c++)
         for (size_t m = 0; m < s->comp[c].nmodes; m++, o++) {
+            if (jc->only >= 0 && c != jc->only)
+                continue;   /* never read */
             const pde_mode *md = &s->comp[c].modes[m];
             double *d = out + 5 * o;
             if (a == 2)
-                bound ? mode_h_bounds(md, lo, hi, order, d) : mode_h_derivs(md, lo, order, d);
+                bound ? h_bounds(md, lo, hi, order, d) : mode_h_derivs(md, lo, order, d);
             else
                 bound ? factor_bounds(a ? md->v : md->u, lo, hi, order, d)
                       : factor_derivs(a ? md->v : md->u, lo, order, d);
@@ -104,9 +148,11 @@ static void jet_add(xjet *j, int c, int n, const double *fu, const double *fv, c
     }
 }
 
-/* bound = 0: x's partials up to order at the point b->lo; 1: bounds of their magnitudes over b.
- * jc: a branch and bound's memo, or NULL. */
-static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, jet_cache *jc, xjet *j)
+/* bound = 0: x's partials up to order at the point b->lo; 1: bounds of their magnitudes over b; 2:
+ * the same from the sums of the magnitudes of h's terms (mode_h_bounds), the scale of their rounding.
+ * jc: a branch and bound's memo, or NULL. only: the one component wanted (the others are left
+ * unset), or -1. */
+static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, int only, jet_cache *jc, xjet *j)
 {
     const int n = mi_count[order];
     const double *F[3] = { NULL, NULL, NULL };
@@ -116,6 +162,10 @@ static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound
     size_t o = 0;
     for (int c = 0; c < 3; c++) {
         const comp_solution *cs = &s->comp[c];
+        if (only >= 0 && c != only) {
+            o += cs->nmodes;
+            continue;
+        }
         for (int q = 0; q < n; q++)
             j->d[c][q] = 0.0;
         for (size_t m = 0; m < cs->nmodes; m++, o++) {
@@ -128,7 +178,7 @@ static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound
             if (bound) {
                 factor_bounds(md->u, b->lo[0], b->hi[0], order, fu);
                 factor_bounds(md->v, b->lo[1], b->hi[1], order, fv);
-                mode_h_bounds(md, b->lo[2], b->hi[2], order, h);
+                (bound == 2 ? mode_h_bounds : h_bounds)(md, b->lo[2], b->hi[2], order, h);
             } else {
                 factor_derivs(md->u, b->lo[0], order, fu);
                 factor_derivs(md->v, b->lo[1], order, fv);
@@ -161,10 +211,13 @@ static const unsigned char conv[84][3] = {
 };
 static const int conv_n[4] = { 1, 7, 28, 84 };
 
-static void series_mul(const double *a, const double *b, double *out, int K)
+/* Inlined with a constant K and unrolled: the table's indices become constants (a box's det J
+ * model multiplies 18 series; the table's loads were most of its cost). */
+static inline __attribute__((always_inline)) void series_mul(const double *a, const double *b, double *out, int K)
 {
     for (int q = 0; q < mi_count[K]; q++)
         out[q] = 0.0;
+#pragma GCC unroll 84
     for (int i = 0; i < conv_n[K]; i++)
         out[conv[i][0]] += a[conv[i][1]] * b[conv[i][2]];
 }
@@ -174,7 +227,7 @@ static void series_mul(const double *a, const double *b, double *out, int K)
  * a, whose series coefficients are x_r's derivatives at index e_a + b over b!. With a bound jet
  * (bound = 1), every term counts positively: the result bounds the series of det J term by term.
  */
-static void detj_series(const xjet *j, int K, int bound, double *out)
+static inline __attribute__((always_inline)) void detj_series(const xjet *j, int K, int bound, double *out)
 {
     /* For q < MI3: the index of q + e_a (mi), and n_u! n_v! n_w! of q. */
     static const unsigned char up[3][MI3] = {
@@ -213,8 +266,9 @@ static void model_at(const pde_solution *s, int what, const pbox *b, jet_cache *
         c.lo[a] = c.hi[a] = 0.5 * (b->lo[a] + b->hi[a]);
     const int order = what < 3 ? 2 : 3;
     xjet pt, mx;
-    xjet_fill(s, &c, order, 0, jc, &pt);
-    xjet_fill(s, b, order + 1, 1, jc, &mx);
+    const int only = what < 3 ? what : -1;
+    xjet_fill(s, &c, order, 0, only, jc, &pt);
+    xjet_fill(s, b, order + 1, 1, only, jc, &mx);
     /* Taylor coefficients: the value, the gradient, the Hessian at the centre, the third-order bound. */
     double tp[MI3], tb[MI3];
     if (what < 3) {
@@ -258,7 +312,7 @@ double obj_magnitude(const pde_solution *s, int what)
 {
     const pbox cube = { { 0, 0, 0 }, { 1, 1, 1 } };
     xjet mx;
-    xjet_fill(s, &cube, 1, 1, NULL, &mx);
+    xjet_fill(s, &cube, 1, 2, what < 3 ? what : -1, NULL, &mx);
     if (what < 3)
         return mx.d[what][0];
     double t[MI3];
@@ -347,10 +401,12 @@ static double lower_model(const pde_solution *s, int what, double sign, pbox *b,
         for (int k = 0; k < 3; k++) {
             if (r[k] == 0.0)
                 continue;
+            /* Non-decreasing (the derivative's lower bound >= 0, as at a face where the objective's
+             * derivative vanishes, fig. 1's z at w = 0): the minimum is on the low face. */
             double g = sign * m.g[k];
-            if (g - spread[k] > 0.0)
-                b->hi[k] = b->lo[k], moved = 1;   /* increasing: the minimum is on the low face */
-            else if (g + spread[k] < 0.0)
+            if (g - spread[k] >= 0.0)
+                b->hi[k] = b->lo[k], moved = 1;
+            else if (g + spread[k] <= 0.0)
                 b->lo[k] = b->hi[k], moved = 1;
         }
         if (!moved)
@@ -450,7 +506,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
     bb_result r = { .lower = DBL_MAX, .boxes = 0 };
     pbox p0 = { { start[0], start[1], start[2] }, { start[0], start[1], start[2] } };
     obj_model m0;
-    jet_cache *jc = jet_cache_new(s);   /* NULL: without the memo */
+    jet_cache *jc = jet_cache_new(s, what);   /* NULL: without the memo */
     model_at(s, what, &p0, jc, &m0);
     r.best = sign * m0.v;
     for (int k = 0; k < 3; k++)

@@ -2,8 +2,8 @@
  * props.c: properties of a solved solid, from its closed form (pde.h,
  * docs/MATH.md "Properties").
  *
- * 1. Extremes: a uniform sample, a compass search from the best samples, then
- *    branch and bound (bound.h) from there, until the certified bound is
+ * 1. Extremes: a uniform sample, then branch and bound (bound.h) from its
+ *    best points, until the certified bound is
  *    within 1e-9 of the solid's size of the best value (or a box budget ends:
  *    the gap says how far it got).
  * 2. Integrals over the solid weighted by |det J| (quad.h): volume, signed
@@ -23,7 +23,7 @@
 #include "bound.h"
 #include "quad.h"
 
-#define POLISH_EVALS 400       /* evaluations of one compass search, at most */
+#define SIGN_BOXES 200         /* boxes to certify det J's sign where it touches 0 */
 
 /*
  * Cancellation: the caller's stop() is polled once per POLL_WORK units of
@@ -51,53 +51,6 @@ static int poll_after(poller *p, size_t units)
         return 0;
     p->work = 0;
     return p->stopped = pde_stopped(p->cancel);
-}
-
-static double detj_at(const pde_solution *s, const double p[3])
-{
-    double xu[3], xv[3], xw[3];
-    pde_eval_d(s, p[0], p[1], p[2], NULL, xu, xv, xw);
-    return det3(xu, xv, xw);
-}
-
-/* sign * (what) at p: what 0..2 a coordinate, 3 det J. */
-static double objective(const pde_solution *s, int what, double sign, const double p[3])
-{
-    if (what == 3)
-        return sign * detj_at(s, p);
-    double x[3];
-    pde_eval(s, p[0], p[1], p[2], x);
-    return sign * x[what];
-}
-
-/* Compass search for a minimum of the objective in the unit cube, from p. */
-static double polish(const pde_solution *s, int what, double sign, double p[3], double step, poller *pl)
-{
-    if (poll_after(pl, pl->point))
-        return 0.0;
-    double best = objective(s, what, sign, p);
-    for (int evals = 0; step > 1e-7 && evals < POLISH_EVALS;) {
-        if (poll_after(pl, pl->point))
-            return 0.0;
-        int moved = 0;
-        for (int a = 0; a < 3 && !moved; a++)
-            for (int d = -1; d <= 1 && !moved; d += 2) {
-                double q[3] = { p[0], p[1], p[2] };
-                q[a] = fmin(1.0, fmax(0.0, q[a] + d * step));
-                if (q[a] == p[a])
-                    continue;
-                double f = objective(s, what, sign, q);
-                evals++;
-                if (f < best) {
-                    best = f;
-                    p[0] = q[0], p[1] = q[1], p[2] = q[2];
-                    moved = 1;
-                }
-            }
-        if (!moved)
-            step *= 0.5;
-    }
-    return sign * best;
 }
 
 typedef struct {
@@ -152,6 +105,17 @@ static pde_status sweep(const pde_solution *s, const double *us, size_t nu, cons
     }
     pde_grid_free(g);
     return PDE_OK;
+}
+
+/* fmax and fmin without the library call, in the residuals' inner loops (where b may be NaN: a). */
+static inline double max2(double a, double b)
+{
+    return b > a ? b : a;
+}
+
+static inline double min2(double a, double b)
+{
+    return b < a ? b : a;
 }
 
 /*
@@ -232,14 +196,14 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
                         drive[k] += fabs(cs->drive[m][k] * f);
                 }
                 for (int k = 0; k < 4; k++)
-                    drive[k] = fmin(drive[k], own_size[c]);
+                    drive[k] = min2(drive[k], own_size[c]);
                 for (int side = 0; side < 2; side++) {
                     double x = row[(6 * side + c) * n + i], xw = row[(6 * side + 3 + c) * n + i];
-                    err[c] = fmax(err[c], fmax(fabs(x - d[2 * side]), fabs(xw - d[2 * side + 1])));
+                    err[c] = max2(err[c], max2(fabs(x - d[2 * side]), fabs(xw - d[2 * side + 1])));
                 }
                 for (int k = 0; k < 4; k++)
-                    sc = fmax(sc, fmax(dabs[k], drive[k]));
-                scale[c] = fmax(scale[c], sc);
+                    sc = max2(sc, max2(dabs[k], drive[k]));
+                scale[c] = max2(scale[c], sc);
             }
         }
     }
@@ -317,9 +281,9 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
                         tw += a * b * h4[m * n + k];
                     }
                     tu *= cs->a, tv *= cs->b, tw *= cs->c;
-                    double p = pde_force(s, c, (i + 0.5) / res, (j + 0.5) / res, (k + 0.5) / res);
-                    err = fmax(err, fabs(tu + tv + tw - p));
-                    scale = fmax(scale, fmax(fmax(fabs(tu), fabs(tv)), fmax(fabs(tw), fabs(p))));
+                    double p = cs->nfterms ? pde_force(s, c, (i + 0.5) / res, (j + 0.5) / res, (k + 0.5) / res) : 0.0;
+                    err = max2(err, fabs(tu + tv + tw - p));
+                    scale = max2(scale, max2(max2(fabs(tu), fabs(tv)), max2(fabs(tw), fabs(p))));
                 }
         free(tab);
         worst = fmax(worst, scale > 0.0 ? err / scale : err);
@@ -466,32 +430,134 @@ static double integral_error(const quad_result *q, const quad_result *qa)
 }
 
 /*
- * The extreme of sign * det J where det J separates (quad.h: det J = t^p D1, D1 det J on the face
- * t = 1, p = n ns - 1): branch and bound over that face alone, a 2-D problem, then over t exactly:
- * t^p is 1 when p = 0, else it spans [0, 1], so the minimum is min(D1's, 0), attained at t = 0 when
- * it is 0. Without this, the 3-D branch and bound meets det J = 0 on the whole face t = 0, where
- * its Taylor models never close the gap.
+ * The extreme of sign * det J (what 3) or of a coordinate where det J separates (quad.h: det J =
+ * t^p D1, D1 det J on the face t = 1, p = n ns - 1; x_c = t^(n in[c]) X_c): branch and bound over
+ * that face alone, a 2-D problem, then over t exactly: t^p is 1 when p = 0, else it spans [0, 1],
+ * so the minimum is min(D1's, 0), attained at t = 0 when it is 0; likewise t^n X_c when in[c].
+ * Without this, the 3-D branch and bound meets det J = 0 on the whole face t = 0, where its Taylor
+ * models never close the gap, and a coordinate's boxes split along t wherever X_c changes sign.
  */
-static pde_status detj_separable(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
-                                 double tol, const pde_cancel *cancel, bb_result *out)
+static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, int what, double sign,
+                                    const double start[3], double tol, size_t budget, const pde_cancel *cancel,
+                                    bb_result *out)
 {
     pbox face = { { 0, 0, 0 }, { 1, 1, 1 } };
     face.lo[sp->axis] = 1.0;
     double at[3] = { start[0], start[1], start[2] };
     at[sp->axis] = 1.0;
-    if (sp->free >= 0)   /* det J is constant along it: a segment of w, a 1-D problem */
+    if (what == 3 && sp->free >= 0)   /* det J is constant along it: a segment of w, a 1-D problem */
         face.lo[sp->free] = face.hi[sp->free] = at[sp->free];
     bb_result b;
-    pde_status st = bb_minimise(s, OBJ_DETJ, sign, at, &face, tol, PDE_PROPS_BOXES_J, cancel, &b);
+    pde_status st = bb_minimise(s, what, sign, at, &face, tol, budget, cancel, &b);
     if (st != PDE_OK)
         return st;
-    if (sp->n * sp->ns > 1) {
+    if (what == 3 ? sp->n * sp->ns > 1 : sp->in[what]) {
         b.lower = fmin(b.lower, 0.0);
         if (b.best >= 0.0)
             b.best = 0.0, b.at[sp->axis] = 0.0;
     }
     *out = b;
     return PDE_OK;
+}
+
+/* The range of a factor over [0, 1], with where it is attained: its ends and, for sin and cos, its
+ * first two critical points (all the extremes there are: +-1). */
+typedef struct {
+    double lo, hi, at_lo, at_hi;
+} range1;
+
+static void factor_range(pde_factor f, range1 *r)
+{
+    double t[4] = { 0.0, 1.0, 2.0, 2.0 }, v, d;
+    if ((f.kind == PDE_SIN || f.kind == PDE_COS) && f.p != 0.0) {
+        const double k = fabs(f.p), c0 = f.kind == PDE_SIN ? 0.5 : 1.0;
+        t[2] = c0 / k, t[3] = (c0 + 1.0) / k;
+    }
+    r->lo = DBL_MAX, r->hi = -DBL_MAX;
+    for (int i = 0; i < 4; i++) {
+        if (t[i] > 1.0)
+            continue;
+        factor_eval(f, t[i], &v, &d);
+        if (v < r->lo)
+            r->lo = v, r->at_lo = t[i];
+        if (v > r->hi)
+            r->hi = v, r->at_hi = t[i];
+    }
+}
+
+/*
+ * The extremes of a component that is one mode, x_c = f_u(u) f_v(v) h(w) (fig. 2, 4): the product
+ * of three independent ranges, so the extremes are among the products of the ends of f_u's and
+ * f_v's (exact) and h's, which two branch and bounds certify on a segment of w (one dimension,
+ * where the cube's took hundreds of boxes: an extreme on a face where a derivative vanishes).
+ * lo, hi: the certified bounds of x_c; best[2], at[2]: the extremes found (min, max).
+ */
+static pde_status single_mode_extremes(const pde_solution *s, int c, double tol, const pde_cancel *cancel,
+                                       double bound[2], double best[2], double at[2][3])
+{
+    const pde_mode *md = &s->comp[c].modes[0];
+    range1 ru, rv;
+    factor_range(md->u, &ru);
+    factor_range(md->v, &rv);
+    /* The segment where |f_u f_v| is largest: there h's extremes are certified. */
+    const double us = fabs(ru.lo) > fabs(ru.hi) ? ru.at_lo : ru.at_hi, vs = fabs(rv.lo) > fabs(rv.hi) ? rv.at_lo : rv.at_hi;
+    double fu, fv, d;
+    factor_eval(md->u, us, &fu, &d);
+    factor_eval(md->v, vs, &fv, &d);
+    const double P = fu * fv;
+    if (!(fabs(P) > 0.0) || !isfinite(P))
+        return PDE_ERR_INVALID;   /* the caller's general path */
+    const pbox seg = { { us, vs, 0.0 }, { us, vs, 1.0 } };
+    double hb[2], hf[2], hw[2];   /* h's certified min and max, those found, and where */
+    for (int k = 0; k < 2; k++) {
+        const double sg = (P > 0) == (k == 0) ? 1.0 : -1.0;   /* sg x_c = |P| h for the min of h */
+        const double start[3] = { us, vs, 0.5 };
+        bb_result b;
+        pde_status st = bb_minimise(s, c, sg, start, &seg, tol, PDE_PROPS_BOXES, cancel, &b);
+        if (st != PDE_OK)
+            return st;
+        const double m = k == 0 ? 1.0 : -1.0;
+        hb[k] = m * b.lower / fabs(P), hf[k] = m * b.best / fabs(P), hw[k] = b.at[2];
+    }
+    /* Over the corners (ends of f_u, f_v) and h's two extremes. */
+    const double fa[2] = { ru.lo, ru.hi }, ua[2] = { ru.at_lo, ru.at_hi };
+    const double fb[2] = { rv.lo, rv.hi }, vb[2] = { rv.at_lo, rv.at_hi };
+    bound[0] = DBL_MAX, bound[1] = -DBL_MAX, best[0] = DBL_MAX, best[1] = -DBL_MAX;
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2; j++)
+            for (int k = 0; k < 2; k++) {
+                const double ab = fa[i] * fb[j], vb_ = ab * hb[k];
+                double x[3];
+                pde_eval(s, ua[i], vb[j], hw[k], x);
+                bound[0] = fmin(bound[0], vb_), bound[1] = fmax(bound[1], vb_);
+                for (int e = 0; e < 2; e++)
+                    if (e == 0 ? x[c] < best[0] : x[c] > best[1]) {
+                        best[e] = x[c];
+                        at[e][0] = ua[i], at[e][1] = vb[j], at[e][2] = hw[k];
+                    }
+            }
+    (void)hf;
+    bound[0] = fmin(bound[0], best[0]), bound[1] = fmax(bound[1], best[1]);
+    return PDE_OK;
+}
+
+/* The solid's size and det J's from the extremes best (min x, max x, ..., min det J, max det J). */
+static void scales(const double best[8], double *size, double *jscale)
+{
+    double sz = 0.0, js = fmax(fabs(best[6]), fabs(best[7]));
+    for (int c = 0; c < 3; c++)
+        sz = fmax(sz, best[2 * c + 1] - best[2 * c]);
+    *size = sz > 0.0 ? sz : 1.0;
+    *jscale = js > 0.0 ? js : 1.0;
+}
+
+/* The extreme of sign * det J by branch and bound, over the face where det J separates. */
+static pde_status what_detj(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
+                            double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
+{
+    if (sp->axis >= 0)
+        return separable_extreme(s, sp, 3, sign, start, tol, budget, cancel, out);
+    return bb_minimise(s, OBJ_DETJ, sign, start, NULL, tol, budget, cancel, out);
 }
 
 pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde_props *out)
@@ -531,36 +597,47 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
 
     /* Into a local result, so that a cancelled call leaves *out untouched. */
     pde_props r = { 0 };
-    const double step = 1.0 / (res - 1);
     double best[8], *at[8];
     for (int c = 0; c < 3; c++) {
-        best[2 * c] = polish(s, c, 1.0, at[2 * c] = e.lo_at[c], step, &pl);
-        best[2 * c + 1] = polish(s, c, -1.0, at[2 * c + 1] = e.hi_at[c], step, &pl);
+        best[2 * c] = e.lo[c], at[2 * c] = e.lo_at[c];
+        best[2 * c + 1] = e.hi[c], at[2 * c + 1] = e.hi_at[c];
     }
-    best[6] = polish(s, 3, 1.0, at[6] = e.jmin_at, step, &pl);
-    best[7] = polish(s, 3, -1.0, at[7] = e.jmax_at, step, &pl);
-    if (pl.stopped)
-        return PDE_ERR_CANCELLED;
-    double size = 0.0, jscale = fmax(fabs(best[6]), fabs(best[7]));
-    for (int c = 0; c < 3; c++)
-        size = fmax(size, best[2 * c + 1] - best[2 * c]);
-    if (!(size > 0.0))
-        size = 1.0;
-    if (!(jscale > 0.0))
-        jscale = 1.0;
-    /* Certify each extreme from its polished point. */
+    best[6] = e.jmin, at[6] = e.jmin_at;
+    best[7] = e.jmax, at[7] = e.jmax_at;
+    /* The tolerances from the samples' extremes: no larger than those found by the boxes. */
+    double size, jscale;
+    scales(best, &size, &jscale);
+    /* Certify each extreme by branch and bound from its sampled point (a compass search polishing it
+     * first cost more than it saved: the boxes' centres converge on the extreme as fast). */
     quad_sep sp;
     quad_separate(s, &sp);
+    double jlow[2], jat[2][3];   /* det J's certified lower bounds of +det J, -det J, without the pad */
+    int single[3] = { 0, 0, 0 };   /* components of one mode: both extremes from single_mode_extremes */
+    bb_result sb[3][2];
     for (int o = 0; o < 8; o++) {
         const int what = o < 6 ? o / 2 : 3;
         const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
         bb_result b;
-        if (what == 3 && sp.axis >= 0) {
-            if ((st = detj_separable(s, &sp, sign, at[o], tol, cancel, &b)) != PDE_OK)
+        if (what < 3 && s->comp[what].nmodes == 1 && !(o & 1)) {
+            /* Both extremes of a component of one mode at once. */
+            double bd[2], bs[2], ba[2][3];
+            if ((st = single_mode_extremes(s, what, tol, cancel, bd, bs, ba)) == PDE_OK) {
+                single[what] = 1;
+                for (int k = 0; k < 2; k++) {
+                    sb[what][k].lower = k ? -bd[1] : bd[0], sb[what][k].best = k ? -bs[1] : bs[0];
+                    memcpy(sb[what][k].at, ba[k], sizeof ba[k]);
+                }
+            } else if (st != PDE_ERR_INVALID)
                 return st;
-        } else if ((st = bb_minimise(s, what, sign, at[o], NULL, tol, o < 6 ? PDE_PROPS_BOXES : PDE_PROPS_BOXES_J,
-                                     cancel, &b)) != PDE_OK)
+        }
+        if (what < 3 && single[what])
+            b = sb[what][o & 1];
+        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, PDE_PROPS_BOXES_J, cancel, &b)
+                       : sp.axis >= 0 ? separable_extreme(s, &sp, what, sign, at[o], tol, PDE_PROPS_BOXES, cancel, &b)
+                                      : bb_minimise(s, what, sign, at[o], NULL, tol, PDE_PROPS_BOXES, cancel, &b)) != PDE_OK)
             return st;
+        if (o >= 6)
+            jlow[o - 6] = b.lower, jat[o - 6][0] = b.at[0], jat[o - 6][1] = b.at[1], jat[o - 6][2] = b.at[2];
         /* The bound holds for the exact closed form; evaluated values may differ by their rounding. */
         const double pad = 64.0 * DBL_EPSILON * obj_magnitude(s, what);
         const double bound = sign * (b.lower - pad), gap = b.best - b.lower + pad;
@@ -575,6 +652,26 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             r.detj_gap = fmax(r.detj_gap, gap);
         }
     }
+    /* The scales from the extremes found, which the branch and bound only improved. */
+    scales(best, &size, &jscale);
+    /* det J keeps its sign over the whole solid, up to what the integrals count as zero (1e-13 of its
+     * size): then every panel takes its tensor rule (quad_solid's jsign). Where det J touches 0 (on
+     * a face, fig. 1), the branch and bound stopped within 1e-9 of its size of 0: it goes on, for a
+     * few boxes, to certify the sign to that tighter tolerance. */
+    int jsign = 0;
+    const double jtol = 1e-13 * jscale;
+    for (int k = 0; k < 2 && !jsign; k++) {
+        const double sign = k ? -1.0 : 1.0;
+        if (jlow[k] < -jtol && fabs(best[6 + k]) <= 1e-9 * jscale) {
+            bb_result b;
+            st = what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, &b);
+            if (st != PDE_OK)
+                return st;
+            jlow[k] = fmax(jlow[k], b.lower);
+        }
+        if (jlow[k] >= -jtol)
+            jsign = k ? -1 : 1;
+    }
     /* Folds are witnessed by attained values of both signs. */
     double tol = 1e-9 * jscale;
     r.folds = best[6] < -tol && best[7] > tol;
@@ -586,7 +683,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         vol_scale *= fmax(best[2 * c + 1] - best[2 * c], 1e-3 * size);
     }
     quad_result q, qa;
-    if ((st = quad_solid(s, x0, jscale, vol_scale, 1, cancel, &q)) != PDE_OK ||
+    if ((st = quad_solid(s, x0, jscale, vol_scale, 1, jsign, cancel, &q)) != PDE_OK ||
         (st = quad_area(s, size, cancel, &r.surface_area, &qa)) != PDE_OK)
         return st;
     mass_properties(&q, x0, &r);

@@ -35,6 +35,7 @@
 #include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -82,10 +83,12 @@ typedef struct {
     const pde_cancel *cancel;
     double x0[3], jtol;
     double f[3];                 /* the integrand's frequencies (at least 1) */
+    int poly[3];                 /* the solution's degree along each axis where it is a polynomial, else -1 */
     double vscale;               /* the solid's volume, roughly: for refinement's tolerance */
     double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];   /* n-point rules on [0, 1] */
     int n[3];                    /* the current panel's points per axis (0: the flat axis) */
     int flat;                    /* the axis fixed at 1 (quad_separate), or -1 */
+    int jsign;                   /* det J's sign where certified over the whole solid (quad_solid), or 0 */
     int free;                    /* the face's parameter det J does not depend on (quad_sep), or -1 */
     /* free_panel's segments of w whose sign was certified or not, the same for every panel of the
      * other parameter: remembered, up to SEG_MEMO of them */
@@ -142,6 +145,16 @@ static void gauss_legendre(int n, double *x, double *w)
         x[i] = 0.5 * (1.0 - z), x[n - 1 - i] = 0.5 * (1.0 + z);
         w[i] = w[n - 1 - i] = 0.5 * wt;
     }
+}
+
+/* The rules of 1 .. GMAX points, computed once for every thread. */
+static double rules_x[GMAX + 1][GMAX], rules_w[GMAX + 1][GMAX];
+static pthread_once_t rules_once = PTHREAD_ONCE_INIT;
+
+static void rules_init(void)
+{
+    for (int k = 1; k <= GMAX; k++)
+        gauss_legendre(k, rules_x[k], rules_w[k]);
 }
 
 static void factor_on(const pde_mode *md, int axis, double t, double *val, double *der)
@@ -339,10 +352,23 @@ static void line_gauss_tab(qctx *q, double wt)
  * below 1e-14: (e phi / 8n)^(2n), the rule's asymptotic error. */
 static int rule_points(double phi);
 
+/* The points of a rule over a panel of width h along axis a: where the solution is a polynomial of
+ * degree d along it, the integrands (det J times up to two coordinates: five factors) are of degree
+ * at most 5 d wherever det J keeps its sign, and ceil((5 d + 1) / 2) points integrate them exactly. */
+static int poly_points(int d)
+{
+    return d < 0 ? 0 : (5 * d) / 2 + 1;
+}
+
+static int axis_points(const qctx *q, int a, double h)
+{
+    return q->poly[a] >= 0 ? poly_points(q->poly[a]) : rule_points(q->f[a] * h);
+}
+
 /* The current line over [a, b], a piece between roots, with a rule sized to the piece. */
 static void line_gauss(qctx *q, double a, double b, double wt)
 {
-    const int n = rule_points(q->f[q->k] * (b - a));
+    const int n = axis_points(q, q->k, b - a);
     double x[3], h = b - a;
     for (int i = 0; i < n; i++) {
         double j = line_eval(q, a + h * q->gx[n][i], x);
@@ -594,6 +620,8 @@ static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
     for (int i = 0; i < q->nseg && definite < 0; i++)
         if (q->seg_lo[i] == b->lo[2] && q->seg_hi[i] == b->hi[2])
             definite = q->seg_def[i];
+    if (definite < 0 && q->jsign)
+        definite = 1;
     if (definite < 0) {   /* at any one value of the other parameter: 1/2 */
         pbox seg = *b;
         seg.lo[q->free] = seg.hi[q->free] = 0.5;
@@ -609,7 +637,7 @@ static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
             pbox c = *b;
             double part[Q_N];
             *(h ? &c.lo[2] : &c.hi[2]) = mid;
-            q->n[2] = rule_points(q->f[2] * (c.hi[2] - c.lo[2]));
+            q->n[2] = axis_points(q, 2, c.hi[2] - c.lo[2]);
             free_panel(q, &c, depth + 1, part);
             for (int e = 0; e < Q_N; e++)
                 acc[e] += part[e];
@@ -634,7 +662,7 @@ static void panel(qctx *q, const pbox *b)
             q->r.acc[e] += acc[e];
         return;
     }
-    const int definite = sign_definite(q, b);
+    const int definite = q->jsign ? 1 : sign_definite(q, b);
     int k = 0;
     if (definite) {   /* lines along the axis with the fewest points, the cheapest */
         k = q->flat == 0 ? 1 : 0;
@@ -658,6 +686,29 @@ static void panel(qctx *q, const pbox *b)
         q->r.unrefined++;
     for (int e = 0; e < Q_N; e++)
         q->r.acc[e] += acc[e];
+}
+
+/* The solution's degree along each axis where every factor along it is a polynomial (along w: every
+ * term of every h, within each slab of a loft), else -1; -1 too beyond a degree whose integrands'
+ * exact rule would need more than GMAX points. */
+static void poly_degrees(const pde_solution *s, int deg[3])
+{
+    deg[0] = deg[1] = deg[2] = 0;
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
+            const pde_mode *md = &s->comp[c].modes[m];
+            const pde_factor fa[2] = { md->u, md->v };
+            for (int a = 0; a < 2; a++)
+                if (deg[a] >= 0)
+                    deg[a] = fa[a].kind != PDE_POW ? -1 : fa[a].p > deg[a] ? (int)fa[a].p : deg[a];
+            for (size_t k = 0; k < md->nterms && deg[2] >= 0; k++) {
+                const pde_wterm *t = &md->terms[k];
+                deg[2] = t->alpha != 0.0 || t->beta != 0.0 ? -1 : t->deg > deg[2] ? t->deg : deg[2];
+            }
+        }
+    for (int a = 0; a < 3; a++)
+        if (poly_points(deg[a]) > GMAX)
+            deg[a] = -1;
 }
 
 /* The fastest change along each axis of a product of `factors` of the solution's factors, in
@@ -693,11 +744,13 @@ static int rule_points(double phi)
 }
 
 /*
- * Panels and points for an integrand that multiplies `factors` of the solution's factors. Along w,
+ * Panels and points for an integrand that multiplies `factors` of the solution's factors; exact:
+ * along an axis where the solution is a polynomial, one panel and the rule exact on the solid's
+ * integrands (poly_points). Along w,
  * panels never straddle a slab's break, where h's higher derivatives jump: each slab gets panels of
  * its own, as many as its share of the axis calls for.
  */
-static void plan_for(const pde_solution *s, double factors, qplan *p)
+static void plan_for(const pde_solution *s, double factors, int exact, qplan *p)
 {
     double f[3];
     size_t mt = 1, nslabs;
@@ -705,10 +758,13 @@ static void plan_for(const pde_solution *s, double factors, qplan *p)
         mt += s->comp[c].nmodes;
     const double *br = solution_breaks(s, &nslabs);
     frequencies(s, factors, f);
-    int want[3];
+    int want[3], deg[3];
+    poly_degrees(s, deg);
     for (int a = 0; a < 3; a++) {
         double v = ceil(f[a] / PANEL_PHASE);   /* then 12 points per panel */
         want[a] = v < 1 ? 1 : v > MAX_PANELS ? MAX_PANELS : (int)v;
+        if (exact && deg[a] >= 0)
+            want[a] = 1;   /* one panel (a slab's, along w), with a rule exact on it */
     }
     /* Bounded work: past MAX_WORK in all, the busiest axis gets fewer, wider panels, and its rule
      * more points, up to GMAX: beyond, the integrals lose digits, which p->err estimates. */
@@ -742,8 +798,8 @@ static void plan_for(const pde_solution *s, double factors, qplan *p)
             }
             for (int i = 0; i < p->np[a]; i++)
                 widest = fmax(widest, p->edge[a][i + 1] - p->edge[a][i]);
-            p->n[a] = rule_points(f[a] * widest);
-            p->phase[a] = f[a] * widest;
+            p->n[a] = exact && deg[a] >= 0 ? poly_points(deg[a]) : rule_points(f[a] * widest);
+            p->phase[a] = exact && deg[a] >= 0 ? 0.0 : f[a] * widest;
         }
         if ((double)p->np[0] * p->n[0] * p->np[1] * p->n[1] * p->np[2] * p->n[2] * (double)mt <= MAX_WORK)
             break;
@@ -756,6 +812,8 @@ static void plan_for(const pde_solution *s, double factors, qplan *p)
     /* The rules' asymptotic error on the fastest exp(i f t) of a panel, relative. */
     p->err = 0.0;
     for (int a = 0; a < 3; a++) {
+        if (p->phase[a] == 0.0)
+            continue;   /* exact */
         double e = 2 * p->n[a] * log(M_E * p->phase[a] / (8.0 * p->n[a]));
         p->err += e < -700 ? 0.0 : fmin(1.0, exp(e));
     }
@@ -764,7 +822,7 @@ static void plan_for(const pde_solution *s, double factors, qplan *p)
 void quad_panels(const pde_solution *s, int np[3], int n[3])
 {
     qplan p;
-    plan_for(s, 5.0, &p);   /* the second moments times det J: five factors */
+    plan_for(s, 5.0, 1, &p);   /* the second moments times det J: five factors */
     memcpy(np, p.np, sizeof p.np);
     memcpy(n, p.n, sizeof p.n);
 }
@@ -794,8 +852,10 @@ static qctx *qctx_new(const pde_solution *s, const pde_cancel *cancel)
     q->max_depth = OUTER_DEPTH;
     q->max_panels = REFINE_PANELS;
     q->modes = q->mt + 1;
-    for (int k = 1; k <= GMAX; k++)
-        gauss_legendre(k, q->gx[k], q->gw[k]);
+    poly_degrees(s, q->poly);
+    pthread_once(&rules_once, rules_init);
+    memcpy(q->gx, rules_x, sizeof q->gx);
+    memcpy(q->gw, rules_w, sizeof q->gw);
     return q;
 }
 
@@ -905,8 +965,92 @@ static void separable_moments(const quad_sep *sp, const double x0[3], double acc
         acc[Q_M2 + k] = M2[k] - x0[pi[k]] * M1[pj[k]] - x0[pj[k]] * M1[pi[k]] + x0[pi[k]] * x0[pj[k]] * V;
 }
 
+/*
+ * The solid repeats itself along t (u or v) when every component's modes have the factor sin(k pi t)
+ * or cos(k pi t) along t, one integer k >= 2 for all, or else the factor 1, the same kind for all of
+ * a component's modes: t -> t + 1/k flips the sign of the first kind's components, x -> D x with
+ * D = diag(+-1) (fig. 2 and 4: x, y of sin, cos(2 pi v), z of 1, k = 2). When moreover each
+ * component's factors are all sin or all cos (or 1), t -> 1/k - t maps the half period [0, 1/2k] onto
+ * the other half, with the tangent along t reversed: x -> M x, M = diag(+-1) flipping the components
+ * of cos. Returns k (0: none), D in d and M in m (m[0] = 0: no mirror).
+ */
+static int param_symmetry(const pde_solution *s, int t, int d[3], int m[3])
+{
+    int k = 0, mirror = 1;
+    d[0] = d[1] = d[2] = m[0] = m[1] = m[2] = 1;
+    for (int c = 0; c < 3; c++) {
+        int kind = -1, parity = -1;   /* kind 0: factors 1, 1: sin, cos of k; parity 1: cos */
+        for (size_t i = 0; i < s->comp[c].nmodes; i++) {
+            const pde_factor f = t == 0 ? s->comp[c].modes[i].u : s->comp[c].modes[i].v;
+            int mk;
+            if (f.kind == PDE_POW && f.p == 0.0)
+                mk = 0;
+            else if ((f.kind == PDE_SIN || f.kind == PDE_COS) && fabs(f.p) >= 2.0 && fabs(f.p) <= 1e6 &&
+                     fabs(f.p) == floor(fabs(f.p)) && (k == 0 || fabs(f.p) == k))
+                mk = 1, k = (int)fabs(f.p);
+            else
+                return 0;
+            const int mp = f.kind == PDE_COS;   /* cos(pi - a) = -cos a, sin(pi - a) = sin a */
+            if (kind >= 0 && mk != kind)
+                return 0;
+            if (parity >= 0 && mp != parity)
+                mirror = 0;
+            kind = mk, parity = mp;
+        }
+        d[c] = kind == 1 ? -1 : 1;
+        m[c] = parity == 1 ? -1 : 1;
+    }
+    if (!mirror)
+        m[0] = 0;
+    return k;
+}
+
+/*
+ * A face repeats itself where the solid does (param_symmetry): x_a x x_b -> det D D (x_a x x_b), so
+ * the element |x_a x x_b| is the same and the flux x . (x_a x x_b) det D times the same; mirrored,
+ * the same with the tangent reversed: the flux -det M times it, and half a period is enough.
+ * Returns k (0: none), with det D in *det and -det M in *rdet (0: no mirror).
+ */
+static int face_period(const pde_solution *s, int t, double *det, double *rdet)
+{
+    int d[3], m[3];
+    const int k = param_symmetry(s, t, d, m);
+    *det = d[0] * d[1] * d[2];
+    *rdet = m[0] ? -m[0] * m[1] * m[2] : 0.0;
+    return k;
+}
+
+/*
+ * The integrals over one period of t (half of one, mirrored: half = 2) extended to [0, 1]
+ * (param_symmetry), moments about the origin: the copies' |det J| is the same, their x is D^j x
+ * (the other half: M x), their det J det D^j times (-det M times) the same.
+ */
+static void period_moments(const int d[3], const int m[3], int k, int half, double acc[Q_N])
+{
+    static const int pi[6] = { 0, 1, 2, 0, 0, 1 }, pj[6] = { 0, 1, 2, 1, 2, 2 };
+    double sg[Q_N];   /* the sign each entry takes under x -> diag(e) x */
+    for (int pass = 0; pass < 2; pass++) {
+        const int *e = pass == 0 ? m : d;
+        if (pass == 0 && half == 1)
+            continue;
+        sg[Q_VOL] = 1;
+        for (int c = 0; c < 3; c++)
+            sg[Q_M1 + c] = e[c];
+        for (int q = 0; q < 6; q++)
+            sg[Q_M2 + q] = e[pi[q]] * e[pj[q]];
+        sg[Q_SIGNED] = (pass == 0 ? -1 : 1) * e[0] * e[1] * e[2];
+        const int copies = pass == 0 ? 2 : k;
+        for (int q = 0; q < Q_N; q++) {
+            double sum = 0.0, f = 1.0;
+            for (int j = 0; j < copies; j++, f *= sg[q])
+                sum += f;
+            acc[q] *= sum;
+        }
+    }
+}
+
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
-                      const pde_cancel *cancel, quad_result *out)
+                      int jsign, const pde_cancel *cancel, quad_result *out)
 {
     qctx *q = qctx_new(s, cancel);
     if (!q)
@@ -917,8 +1061,13 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     q->free = separate == 1 ? sp.free : -1;
     q->jtol = 1e-13 * jscale;
     q->vscale = vscale;
+    q->jsign = jsign;
+    /* One exact panel along a polynomial axis, except in 3-D where det J may change sign: there lines
+     * along one axis are integrated across the others, where they are not polynomials (lines that
+     * touch det J's zero set), and the refinement's budget (REFINE_PANELS) covers the same panels as
+     * before (fig. 3c's volume was 6e-8 off with them, 5e-6 with one panel along u); so are octants. */
     qplan p;
-    plan_for(s, 5.0, &p);
+    plan_for(s, 5.0, jsign != 0 || sp.axis >= 0, &p);
     if (sp.axis >= 0) {   /* the face t = 1 alone: one panel along the flat axis, no rule */
         q->flat = sp.axis;
         q->max_depth = FLAT_DEPTH;
@@ -930,6 +1079,15 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     memcpy(q->n, p.n, sizeof p.n);
     q->r.err = p.err;
     frequencies(s, 5.0, q->f);
+    /* Where det J separates (moments about the origin), one period of a parameter along which the
+     * solid repeats itself, or half of one mirrored: the rest by symmetry (period_moments). */
+    int sd[3], sm[3], per = 0, half = 1, pt = -1;
+    for (int t = 0; t < 2 && sp.axis >= 0 && pt < 0; t++)
+        if (t != sp.axis && (per = param_symmetry(s, t, sd, sm)) > 1 && p.np[t] % per == 0) {
+            pt = t;
+            half = sm[0] && p.np[t] % (2 * per) == 0 ? 2 : 1;
+            p.np[t] /= per * half;
+        }
     for (int i = 0; i < p.np[0]; i++)
         for (int j = 0; j < p.np[1]; j++)
             for (int l = 0; l < p.np[2] && !q->stopped; l++) {
@@ -939,6 +1097,10 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
             }
     pde_status st = q->stopped ? PDE_ERR_CANCELLED : PDE_OK;
     if (st == PDE_OK) {
+        if (pt >= 0) {
+            period_moments(sd, sm, per, half, q->r.acc);
+            q->r.refine_left *= per * half, q->r.refine_change *= per * half;
+        }
         if (sp.axis >= 0)
             separable_moments(&sp, x0, q->r.acc);
         *out = q->r;
@@ -1208,6 +1370,59 @@ static int face_separates(const pde_solution *s, const quad_sep *sp, int axis, d
 }
 
 /*
+ * A face along whose parameters the solution is a polynomial, of degrees d0 and d1 (within one slab):
+ * its element c = x_a x x_b is a polynomial of degree at most 2 d - 1 along each, so when c x nu
+ * vanishes on a grid of (2 d + 1)^2 points, to rounding, nu a unit vector, it vanishes everywhere:
+ * the face is planar, c = g nu, and |c| = |g|, a polynomial. Where g keeps its sign on the grid and
+ * at the rule's nodes, the face's area is |the integral of g| and its flux the integral of x . c, by
+ * rules exact on them (3 d / 2 + 1 points). Returns 0, with nothing set, where it does not apply.
+ */
+static int face_planar(const pde_solution *s, int axis, int side, const int d[2], double *area,
+                       double *flux)
+{
+    double x[3], ta[3], tb[3], c[2 * GMAX + 1][3], big = 0.0, nu[3] = { 0, 0, 0 };
+    const int n0 = 2 * d[0] + 1, n1 = 2 * d[1] + 1;
+    if (n0 * n1 > 2 * GMAX + 1)
+        return 0;
+    for (int i = 0; i < n0; i++)
+        for (int j = 0; j < n1; j++) {
+            double *e = c[i * n1 + j];
+            face_point(s, axis, side, n0 > 1 ? (double)i / (n0 - 1) : 0.5, n1 > 1 ? (double)j / (n1 - 1) : 0.5,
+                       x, ta, tb);
+            e[0] = ta[1] * tb[2] - ta[2] * tb[1], e[1] = ta[2] * tb[0] - ta[0] * tb[2], e[2] = ta[0] * tb[1] - ta[1] * tb[0];
+            const double m = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+            if (m > big)
+                big = m, nu[0] = e[0] / m, nu[1] = e[1] / m, nu[2] = e[2] / m;
+        }
+    const double tol = 1e-13 * big;
+    int pos = 0, neg = 0;
+    for (int k = 0; k < n0 * n1; k++) {
+        const double *e = c[k];
+        const double cx[3] = { e[1] * nu[2] - e[2] * nu[1], e[2] * nu[0] - e[0] * nu[2], e[0] * nu[1] - e[1] * nu[0] };
+        if (fabs(cx[0]) > tol || fabs(cx[1]) > tol || fabs(cx[2]) > tol)
+            return 0;
+        const double g = e[0] * nu[0] + e[1] * nu[1] + e[2] * nu[2];
+        pos |= g > tol, neg |= g < -tol;
+    }
+    const int m0 = 3 * d[0] / 2 + 1, m1 = 3 * d[1] / 2 + 1;
+    double sa = 0.0, sf = 0.0;
+    for (int i = 0; i < m0; i++)
+        for (int j = 0; j < m1; j++) {
+            face_point(s, axis, side, rules_x[m0][i], rules_x[m1][j], x, ta, tb);
+            const double e[3] = { ta[1] * tb[2] - ta[2] * tb[1], ta[2] * tb[0] - ta[0] * tb[2], ta[0] * tb[1] - ta[1] * tb[0] };
+            const double g = e[0] * nu[0] + e[1] * nu[1] + e[2] * nu[2], wt = rules_w[m0][i] * rules_w[m1][j];
+            pos |= g > tol, neg |= g < -tol;
+            sa += wt * g;
+            sf += wt * (x[0] * e[0] + x[1] * e[1] + x[2] * e[2]);
+        }
+    if (pos && neg)
+        return 0;   /* the face folds over itself: the general path locates the fold */
+    *area = fabs(sa);
+    *flux = sf;
+    return 1;
+}
+
+/*
  * The skin's area: each face's panels (sized to the element's frequencies, counted like the
  * solid's integrals as five factors') along lines that locate the cuspidal edges of a folded
  * face. Each panel is checked against its quarters and refined where they differ by more than
@@ -1225,13 +1440,16 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
         return PDE_ERR_NOMEM;
     }
     qplan p;
-    plan_for(s, 5.0, &p);
+    plan_for(s, 5.0, 0, &p);   /* the faces' panels sized to the frequencies even along a polynomial axis: a
+                                 * curved face refines less from smaller panels (planar ones: face_planar) */
     double f[3];
     frequencies(s, 5.0, f);
     quad_sep sp;
     quad_separate(s, &sp);
     c->tol = 1e-11 * size * size;
     c->cancel = cancel;
+    size_t nslabs;
+    solution_breaks(s, &nslabs);
     /* Where det J separates, the faces of another axis are lines: the budget of refined panels
      * goes to the rest (fig. 3b's area 1.1e-5 -> 1.6e-8 of the reference quadrature's). */
     c->max_refined = sp.axis >= 0 ? INT_MAX : FACE_REFINE;
@@ -1249,10 +1467,29 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
              * the face is a curve or a point, its area and flux exactly 0 (quad_separate). */
             if (axis == sp.axis && side == 0 && sp.ns >= 2)
                 continue;
-            c->line = (face_line){ .q = q, .axis = axis, .side = side, .o = { o[0], o[1] } };
             double ascale = 1.0, fscale = 1.0, face = 0.0, fflux = 0.0;
+            const int d[2] = { q->poly[o[0]], q->poly[o[1]] };
+            if (d[0] >= 0 && d[1] >= 0 && (axis == 2 || nslabs == 1) && face_planar(s, axis, side, d, &face, &fflux)) {
+                flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fflux;
+                total += face;
+                continue;
+            }
+            c->line = (face_line){ .q = q, .axis = axis, .side = side, .o = { o[0], o[1] } };
             c->flat = face_separates(s, &sp, axis, &ascale, &fscale);
-            const int npa = c->flat == 0 ? 1 : p.np[o[0]], npb = c->flat == 1 ? 1 : p.np[o[1]];
+            int npa = c->flat == 0 ? 1 : p.np[o[0]], npb = c->flat == 1 ? 1 : p.np[o[1]];
+            /* One period (half a period, mirrored) of a parameter along which the face repeats itself,
+             * reflected (face_period): per parts of the face alike. */
+            double fdet = 1.0, rdet = 0.0;
+            int per = 1, half = 1;
+            for (int k = 0; k < 2 && per == 1; k++) {
+                int *np = k ? &npb : &npa;
+                if (o[k] > 1 || (per = face_period(s, o[k], &fdet, &rdet)) < 2 || *np % per) {
+                    per = 1, fdet = 1.0, rdet = 0.0;
+                    continue;
+                }
+                half = rdet != 0.0 && *np % (2 * per) == 0 ? 2 : 1;
+                *np /= per * half;
+            }
             for (int pa = 0; pa < npa && !c->stopped; pa++)
                 for (int pb = 0; pb < npb && !c->stopped; pb++) {
                     const double *ea = p.edge[o[0]], *eb = p.edge[o[1]];
@@ -1267,8 +1504,13 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
                                 ? a : face_refine(c, lo, h, a, 0);
                 }
             /* Outward: side 1 along +axis; (o0, o1, axis) is odd for axis 1. */
-            flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fscale * fflux;
-            total += ascale * face;
+            double fsum = 0.0;   /* the periods' fluxes: det D^j times the first's, and its mirror's */
+            for (int j = 0; j < per; j++)
+                fsum += j & 1 ? fdet : 1.0;
+            if (half == 2)
+                fsum *= 1.0 + rdet;
+            flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fscale * fsum * fflux;
+            total += ascale * per * half * face;
         }
     }
     pde_status st = c->stopped ? PDE_ERR_CANCELLED : PDE_OK;

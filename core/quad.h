@@ -49,13 +49,15 @@ typedef struct {
 
 void quad_separate(const pde_solution *s, quad_sep *sep);
 
-/* jscale: the size of det J over the solid, for what counts as zero; vscale: the size of the
+/* jscale: the size of det J over the solid, for what counts as zero; jsign: +1 or -1 where det J
+ * is certified to keep that sign over the whole cube (up to 1e-13 jscale; pde_properties' branch and
+ * bound), so that every panel takes its tensor rule, else 0; vscale: the size of the
  * volume (jscale will do), for the refinement's tolerance. separate: where det J separates
  * (quad_separate), integrate over the face t = 1 only, and along w alone where det J does not
  * depend on the face's other parameter (pde_properties); 2: the face without that (tests); 0: over
  * the cube (tests). */
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
-                      const pde_cancel *cancel, quad_result *out);
+                      int jsign, const pde_cancel *cancel, quad_result *out);
 
 /* The area of the skin; size: the solid's extent, for deciding that two faces coincide. Its panels
  * are the solid's, and so is its rules' error. info->acc[Q_SIGNED] is the signed volume computed

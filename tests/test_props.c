@@ -652,12 +652,12 @@ static void separable_integrals_should_equal_the_adaptive_integrals_over_the_cub
         assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
         const double x0[3] = { 0.1, -0.2, 0.7 }, jscale = fmax(fabs(p.detj_min_found), fabs(p.detj_max_found));
         quad_result fast, cube;
-        assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 1, NULL, &fast), PDE_OK);
-        assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 0, NULL, &cube), PDE_OK);
+        assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 1, 0, NULL, &fast), PDE_OK);
+        assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 0, 0, NULL, &cube), PDE_OK);
         /* det J constant along v (quad_sep's free): lines along w alone, against the face's own path */
         assert_int_equal(sp.free, 1);
         quad_result face;
-        assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 2, NULL, &face), PDE_OK);
+        assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 2, 0, NULL, &face), PDE_OK);
         double scale[Q_N];   /* each integral against its size: |det J| times |r|^k */
         const double size = cbrt(p.volume) + 1.0;
         for (int e = 0; e < Q_N; e++)
