@@ -23,14 +23,21 @@
  * 4. If the enclosed volume comes out negative (the parametrisation reverses
  *    orientation, as x = u sin 2pi v, y = u cos 2pi v does), every triangle
  *    is flipped.
- * 5. Vertices are (point, face) pairs. A vertex's normal is the face's
- *    x_a x x_b from the closed form, and its det J is det(x_u, x_v, x_w);
- *    where a vertex joins several samples of its face, or x_a x x_b vanishes
- *    (a collapsed row's point), the normal is the area-weighted mean of its
- *    triangles' instead.
- * Every pass is linear in the samples.
+ * 5. Vertices are (point, face) pairs, made face by face in sample order and
+ *    packed down over the samples' own data (a vertex never comes after its
+ *    sample), so the mesh's arrays are the sampling's. A vertex's normal is
+ *    the face's x_a x x_b from the closed form, and its det J is
+ *    det(x_u, x_v, x_w); where a vertex joins several samples of its face,
+ *    or x_a x x_b vanishes (a collapsed row's point), the normal is the
+ *    area-weighted mean of its triangles' instead. A sample joined with no
+ *    other (almost all) skips every map: its vertex and position id are the
+ *    next ones.
+ * Every pass is linear in the samples. Memory: one block for the mesh (32
+ * bytes a sample, 12 a triangle) and one of scratch (13 bytes a sample),
+ * both kept for the next build (api_mesh_free).
  */
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -119,6 +126,9 @@ static int sample_faces(const pde_solution *sol, const face f[2], const unsigned
     const size_t na = f[0].na, m = 6 * nmax;
     float *x = d, *xd[3] = { d + m, d + 2 * m, d + 3 * m };   /* x, then x_u, x_v, x_w */
     float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    float lo12[12], hi12[12], sum12[12];
+    for (int l = 0; l < 12; l++)
+        lo12[l] = INFINITY, hi12[l] = -INFINITY, sum12[l] = 0.0f;
     int bad = 0;
     for (size_t b = 0; b < f[0].nb && !rc; b++) {       /* a row at a time, to poll between rows */
         if ((rc = stopped(cancel)))
@@ -144,17 +154,32 @@ static int sample_faces(const pde_solution *sol, const face f[2], const unsigned
                                 (double)ta[0] * tb[1] - (double)ta[1] * tb[0] };
                 /* det(x_u, x_v, x_w) = (x_a x x_b) . x_axis, times the sign of (a, b, axis)'s order */
                 double det = n[0] * tc[0] + n[1] * tc[1] + n[2] * tc[2];
-                for (int k = 0; k < 3; k++) {
-                    const float p = x[e + k];
-                    pos[3 * a + k] = p;
-                    nrm[3 * a + k] = (float)n[k];
-                    bad |= !isfinite(p);
-                    lo[k] = p < lo[k] ? p : lo[k];
-                    hi[k] = p > hi[k] ? p : hi[k];
-                }
+                pos[3 * a] = x[e], pos[3 * a + 1] = x[e + 1], pos[3 * a + 2] = x[e + 2];
+                nrm[3 * a] = (float)n[0], nrm[3 * a + 1] = (float)n[1], nrm[3 * a + 2] = (float)n[2];
                 dj[a] = sg * (float)det;
             }
+            /* bounds over the row, 4 points (12 floats) a step, so that lane j holds axis j % 3; any
+             * NaN or infinity makes sum NaN */
+            size_t j = 0;
+            for (; j + 12 <= 3 * na; j += 12)
+                for (int l = 0; l < 12; l++) {
+                    const float p = pos[j + (size_t)l];
+                    lo12[l] = p < lo12[l] ? p : lo12[l];
+                    hi12[l] = p > hi12[l] ? p : hi12[l];
+                    sum12[l] += p * 0.0f;
+                }
+            for (; j < 3 * na; j++) {
+                const float p = pos[j];
+                lo12[j % 3] = p < lo12[j % 3] ? p : lo12[j % 3];
+                hi12[j % 3] = p > hi12[j % 3] ? p : hi12[j % 3];
+                sum12[0] += p * 0.0f;
+            }
         }
+    }
+    for (int l = 0; l < 12; l++) {
+        lo[l % 3] = lo12[l] < lo[l % 3] ? lo12[l] : lo[l % 3];
+        hi[l % 3] = hi12[l] > hi[l % 3] ? hi12[l] : hi[l % 3];
+        bad |= sum12[l] != 0.0f;
     }
     for (int k = 0; k < 3; k++) {
         out->lo[k] = lo[k] < out->lo[k] ? lo[k] : out->lo[k];
@@ -165,6 +190,54 @@ static int sample_faces(const pde_solution *sol, const face f[2], const unsigned
     pde_grid_free(g1);
     free(d);
     return rc;
+}
+
+/* ---- memory: two blocks kept for the next build ---- */
+
+/*
+ * A mesh takes a block for itself (pos, nrm, detj, weld, tri) and one of scratch; api_mesh_free and the
+ * end of a build give them back to two process-wide slots (atomic, so builds on any threads may share
+ * them), from which the next build takes them: fresh pages cost a page fault each (about 12 us a 4 KiB
+ * page on our VMs, more than the mesh's arithmetic), and malloc returns big blocks to the system. At
+ * most SPARE_MAX bytes a slot are kept; api_mesh_release_spares() frees them.
+ */
+enum { SPARES = 2 };
+#define SPARE_MAX ((size_t)64 << 20)
+typedef struct {
+    size_t cap;
+    size_t pad;   /* the data 16-byte aligned */
+} block_hdr;
+static _Atomic(block_hdr *) spare[SPARES];
+
+static void *block_get(size_t n)
+{
+    for (int i = 0; i < SPARES; i++) {
+        block_hdr *h = atomic_exchange(&spare[i], NULL);
+        if (h && h->cap >= n)
+            return h + 1;
+        free(h);
+    }
+    block_hdr *h = malloc(sizeof *h + n);
+    if (!h)
+        return NULL;
+    h->cap = n;
+    return h + 1;
+}
+
+static void block_put(void *p)
+{
+    if (!p)
+        return;
+    block_hdr *h = (block_hdr *)p - 1;
+    for (int i = 0; i < SPARES && h && h->cap <= SPARE_MAX; i++)
+        h = atomic_exchange(&spare[i], h);   /* the one it displaces tries the next slot */
+    free(h);
+}
+
+void api_mesh_release_spares(void)
+{
+    for (int i = 0; i < SPARES; i++)
+        free(atomic_exchange(&spare[i], NULL));
 }
 
 /* ---- union-find over the samples; a set's root is its least sample ---- */
@@ -187,9 +260,10 @@ static void join(uint32_t *up, uint32_t a, uint32_t b)
         up[a] = b;
 }
 
-static int near(const float *p, const float *q, double eps)
+/* Within eps on every axis; in float, where the difference of two close floats is exact. */
+static inline int near(const float *p, const float *q, float eps)
 {
-    return fabs((double)p[0] - q[0]) <= eps && fabs((double)p[1] - q[1]) <= eps && fabs((double)p[2] - q[2]) <= eps;
+    return (fabsf(p[0] - q[0]) <= eps) & (fabsf(p[1] - q[1]) <= eps) & (fabsf(p[2] - q[2]) <= eps);
 }
 
 /* The triple in increasing order; returns the parity of the sorting permutation. */
@@ -211,22 +285,12 @@ static void cross(const double a[3], const double b[3], double c[3])
     c[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-/* Twice the area vector of triangle (p, q, r). */
-static void tri_normal(const float *p, const float *q, const float *r, double n[3])
-{
-    double a[3], b[3];
-    for (int k = 0; k < 3; k++) {
-        a[k] = (double)q[k] - p[k];
-        b[k] = (double)r[k] - p[k];
-    }
-    cross(a, b, n);
-}
-
 /*
  * Cell v00 (a sample index; na samples to a row) of a face: its triangles' normals (twice their area
  * vectors) in the unreversed winding, (v00, v10, v11) and (v00, v11, v01), and six times the signed
  * volume of the tetrahedra (0, triangle) in the face's winding (sgn -1 when it reverses), as
- * x_00 . n, so the volume costs a dot product on the normal.
+ * x_00 . n, so the volume costs a dot product on the normal. In double, where the products of float
+ * differences are exact, so a collapsed triangle's area is 0.
  */
 static inline void cell_normals(const float *restrict pos, size_t v00, size_t na, double sgn, double n[2][3],
                                 double vol[2])
@@ -258,12 +322,44 @@ void api_mesh_free(api_mesh *m)
 {
     if (!m)
         return;
-    free(m->pos);
-    free(m->nrm);
-    free(m->detj);
-    free(m->tri);
-    free(m->weld);
+    block_put(m->pos);   /* the one block: pos, nrm, detj, weld, tri */
     memset(m, 0, sizeof *m);
+}
+
+/* A sample's flags: joined with another sample; used by a live triangle of its face; and, on a cell's
+ * v00, which of the cell's two triangles live. */
+enum { SHARED = 1, USED = 2, LIVE0 = 4, LIVE1 = 8 };
+
+/* vof[r] while face f's vertices are made: the face has one (TAG1) or several (TAG2) samples at root r
+ * and no vertex there yet; vertex ids of earlier faces are below the face's first, tags above any id. */
+#define TAG1(f) (UINT32_MAX - 2u * (uint32_t)(f) - 1u)
+#define TAG2(f) (UINT32_MAX - 2u * (uint32_t)(f) - 2u)
+#define TAGMIN (UINT32_MAX - 13u)
+
+/* Growable accumulators of the area-weighted normals of the vertices marked NaN. */
+typedef struct {
+    double *acc;
+    size_t n, cap;
+} nan_acc;
+
+/* Marks vertex v's normal for the area-weighted mean of its triangles: NaN in x, its accumulator's
+ * index in y's bits. 0, or -1 out of memory. */
+static int mark_nan(float *nrm, uint32_t v, nan_acc *a)
+{
+    if (isnan(nrm[3 * v]))
+        return 0;
+    if (a->n == a->cap) {
+        size_t cap = a->cap ? 2 * a->cap : 256;
+        double *p = realloc(a->acc, 3 * cap * sizeof *p);
+        if (!p)
+            return -1;
+        a->acc = p, a->cap = cap;
+    }
+    const uint32_t i = (uint32_t)a->n++;
+    a->acc[3 * i] = a->acc[3 * i + 1] = a->acc[3 * i + 2] = 0.0;
+    nrm[3 * v] = NAN;
+    memcpy(&nrm[3 * v + 1], &i, 4);
+    return 0;
 }
 
 int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_mesh *out,
@@ -290,19 +386,29 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             nraw += f->na * f->nb;
             ntraw += 2 * (f->na - 1) * (f->nb - 1);
         }
-    samples raw = { malloc(3 * nraw * sizeof(float)), malloc(3 * nraw * sizeof(float)), malloc(nraw * sizeof(float)),
-                    { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY }, 0 };
-    uint32_t *up = malloc(nraw * sizeof *up);
-    uint32_t *vof = malloc(nraw * sizeof *vof);    /* this face's vertex at each root, or UINT32_MAX */
-    uint32_t *pid = malloc(nraw * sizeof *pid);    /* the position id of each root, or UINT32_MAX */
-    uint8_t *live = malloc(ntraw);
-    double *acc = NULL;
-    uint32_t *vsam = NULL;    /* each vertex's sample */
+    /* The mesh's block holds every sample's position, normal and det J until step 5 packs the
+     * vertices down over them (a vertex is never after its sample). */
+    float *blk = block_get(nraw * 32 + ntraw * 12 + 16);
+    uint32_t *up = block_get(nraw * 13 + 16);
+    uint32_t *vof = up ? up + nraw : NULL;     /* step 5: a root's vertex in the face, or a tag */
+    uint32_t *pid = up ? vof + nraw : NULL;    /* step 5: a shared root's position id, or UINT32_MAX */
+    uint8_t *flag = up ? (uint8_t *)(pid + nraw) : NULL;
+    nan_acc nacc = { NULL, 0, 0 };
     int rc = -1, cancelled = 0;
     const char *why = "out of memory building the mesh";
     api_status why_status = API_ERR_NOMEM;
-    if (!raw.pos || !raw.nrm || !raw.detj || !up || !vof || !pid || !live)
+    if (!blk || !up) {
+        block_put(up);
+        up = NULL;
         goto done;
+    }
+    out->pos = blk;
+    out->nrm = blk + 3 * nraw;
+    out->detj = blk + 6 * nraw;
+    out->weld = (uint32_t *)(blk + 7 * nraw);
+    out->tri = out->weld + nraw;
+    samples raw = { out->pos, out->nrm, out->detj,
+                    { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY }, 0 };
 
     /* 1. Faces. */
     for (int a = 0; a < 3; a++) {
@@ -322,41 +428,62 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         lo[k] = raw.lo[k], hi[k] = raw.hi[k];
     const double extent = fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
     const double eps = extent > 0 ? 1e-6 * extent : 1e-30;
+    const float epsf = (float)eps;
+    float *restrict P = out->pos;
 
     /* 2. Join: the cube's edges by the lattice; collapsed rows and seams where the map joins them. */
     for (size_t i = 0; i < nraw; i++)
         up[i] = (uint32_t)i;
     for (int fi = 0; fi < 6; fi++) {
         const face *f = &faces[fi];
+        const size_t na = f->na, nb = f->nb;
         int o[2];
         face_axes(f, o);
         size_t ijk[3];
         ijk[f->axis] = f->side ? res[f->axis] - 1 : 0;
-        for (size_t b = 0; b < f->nb; b++)
-            for (size_t a = 0; a < f->na; a++) {
-                const uint32_t i = (uint32_t)(f->base + b * f->na + a);
-                const float *p = raw.pos + 3 * i;
-                if (a + 1 < f->na && near(p, p + 3, eps))
-                    join(up, i, i + 1);
-                if (b + 1 < f->nb && near(p, p + 3 * f->na, eps))
-                    join(up, i, (uint32_t)(i + f->na));
-                if (a > 0 && a + 1 < f->na && b > 0 && b + 1 < f->nb)
-                    continue;
+        for (size_t b = 0; b < nb; b++) {
+            const uint32_t row = (uint32_t)(f->base + b * na);
+            const float *p = P + 3 * (size_t)row;
+            /* along the row, then to the next row */
+            for (size_t a = 0; a + 1 < na; a++)
+                if (near(p + 3 * a, p + 3 * a + 3, epsf))
+                    join(up, row + (uint32_t)a, row + (uint32_t)a + 1);
+            if (b + 1 < nb)
+                for (size_t a = 0; a < na; a++)
+                    if (near(p + 3 * a, p + 3 * (a + na), epsf))
+                        join(up, row + (uint32_t)a, (uint32_t)(row + a + na));
+            /* the neighbouring faces this row's samples lie on: its ends, or all of an edge row */
+            const int edge_row = b == 0 || b + 1 == nb;
+            for (size_t a = 0; a < na; a += edge_row || a + 1 == na ? 1 : na - 1) {
                 ijk[o[0]] = a, ijk[o[1]] = b;
-                for (int e = 0; e < 3; e++)    /* the neighbouring faces this sample lies on */
+                for (int e = 0; e < 3; e++)
                     if (e != f->axis && (ijk[e] == 0 || ijk[e] == res[e] - 1))
-                        join(up, i, (uint32_t)face_sample(&faces[2 * e + (ijk[e] != 0)], ijk));
+                        join(up, row + (uint32_t)a, (uint32_t)face_sample(&faces[2 * e + (ijk[e] != 0)], ijk));
             }
+        }
     }
     size_t seams[3] = { 0, 0, 0 };   /* samples of opposite faces joined, per axis */
     for (int a = 0; a < 3; a++) {
         const face *f0 = &faces[2 * a], *f1 = &faces[2 * a + 1];
+        const float *p0 = P + 3 * f0->base, *p1 = P + 3 * f1->base;
         for (size_t k = 0; k < f0->na * f0->nb; k++)
-            if (near(raw.pos + 3 * (f0->base + k), raw.pos + 3 * (f1->base + k), eps))
+            if (near(p0 + 3 * k, p1 + 3 * k, epsf))
                 join(up, (uint32_t)(f0->base + k), (uint32_t)(f1->base + k)), seams[a]++;
     }
-    for (size_t i = 0; i < nraw; i++)
-        up[i] = find(up, (uint32_t)i);
+    /* Roots; a joined sample takes its root's position, so that every copy of a point is the same
+     * bits (the root, the least sample, is settled before any other of its set). */
+    for (size_t i = 0; i < nraw; i++) {
+        const uint32_t r = up[up[i]];   /* up[i] < i is a root already, or points at one */
+        up[i] = r;
+        if (r == i) {
+            flag[i] = 0;
+            continue;
+        }
+        flag[i] = SHARED;
+        flag[r] |= SHARED;
+        vof[r] = pid[r] = UINT32_MAX;
+        memcpy(P + 3 * i, P + 3 * (size_t)r, 3 * sizeof *P);
+    }
     if (stopped(cancel)) {
         cancelled = 1;
         goto done;
@@ -364,25 +491,29 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
 
     /* 3. Triangles that collapse go; so do the cells of opposite faces that coincide. */
     const double tiny = 1e-12 * extent * extent, tiny2 = tiny * tiny;
-    size_t t = 0, ntri = 0;
+    size_t ntri = 0;
     double vol = 0.0;   /* six times the enclosed volume, over the live triangles */
     for (int fi = 0; fi < 6; fi++) {
         const face *f = &faces[fi];
         const double sgn = f->reverse ? -1.0 : 1.0;
         for (size_t b = 0; b + 1 < f->nb; b++) {
-            const uint32_t *restrict u0 = up + f->base + b * f->na, *restrict u1 = u0 + f->na;
-            for (size_t a = 0; a + 1 < f->na; a++, t += 2) {
-                double n[2][3], v[2];
-                cell_normals(raw.pos, f->base + b * f->na + a, f->na, sgn, n, v);
+            const size_t row = f->base + b * f->na;
+            const uint32_t *restrict u0 = up + row, *restrict u1 = u0 + f->na;
+            uint8_t *restrict fl = flag + row;
+            for (size_t a = 0; a + 1 < f->na; a++) {
                 const uint32_t r00 = u0[a], r10 = u0[a + 1], r01 = u1[a], r11 = u1[a + 1];
                 /* both triangles hold v00 and v11: (v00, v10, v11) and (v00, v11, v01), either winding */
                 const int diag = r00 != r11;
-                live[t] = diag && r10 != r00 && r10 != r11 && n[0][0] * n[0][0] + n[0][1] * n[0][1] + n[0][2] * n[0][2] > tiny2;
-                live[t + 1] = diag && r01 != r00 && r01 != r11 && n[1][0] * n[1][0] + n[1][1] * n[1][1] + n[1][2] * n[1][2] > tiny2;
-                if (live[t])
-                    vol += v[0], ntri++;
-                if (live[t + 1])
-                    vol += v[1], ntri++;
+                const int c0 = diag && r10 != r00 && r10 != r11, c1 = diag && r01 != r00 && r01 != r11;
+                if (!(c0 | c1))
+                    continue;
+                double n[2][3], v[2];
+                cell_normals(P, row + a, f->na, sgn, n, v);
+                const int l0 = c0 && n[0][0] * n[0][0] + n[0][1] * n[0][1] + n[0][2] * n[0][2] > tiny2;
+                const int l1 = c1 && n[1][0] * n[1][0] + n[1][1] * n[1][1] + n[1][2] * n[1][2] > tiny2;
+                fl[a] |= (uint8_t)(l0 * LIVE0 | l1 * LIVE1);
+                vol += (l0 ? v[0] : 0.0) + (l1 ? v[1] : 0.0);
+                ntri += (size_t)(l0 + l1);
             }
         }
     }
@@ -390,26 +521,33 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         const face *f0 = &faces[2 * a], *f1 = &faces[2 * a + 1];
         if (seams[a] < 3)
             continue;   /* no triangle of one lies on the other */
-        size_t first0 = 0;    /* the faces' first triangles */
-        for (int fi = 0; fi < 2 * a; fi++)
-            first0 += 2 * (faces[fi].na - 1) * (faces[fi].nb - 1);
-        const size_t first1 = first0 + 2 * (f0->na - 1) * (f0->nb - 1);
         for (size_t b = 0; b + 1 < f0->nb; b++)
             for (size_t c = 0; c + 1 < f0->na; c++)
                 for (int q = 0; q < 2; q++) {
-                    const size_t k = 2 * (b * (f0->na - 1) + c) + (size_t)q;
-                    if (!live[first0 + k] || !live[first1 + k])
+                    const uint8_t bit = q ? LIVE1 : LIVE0;
+                    uint8_t *l0 = flag + f0->base + b * f0->na + c, *l1 = flag + f1->base + b * f1->na + c;
+                    if (!(*l0 & bit) || !(*l1 & bit))
                         continue;
+                    /* the same roots at the cell's corners: the same points, wound the other way (the two
+                     * faces' windings differ), at the same positions, so their volumes cancel exactly */
+                    const uint32_t *u0 = up + f0->base + b * f0->na + c, *u1 = up + f1->base + b * f1->na + c;
+                    if (u0[0] == u1[0] && u0[1] == u1[1] && u0[f0->na] == u1[f0->na] && u0[f0->na + 1] == u1[f0->na + 1]) {
+                        *l0 &= (uint8_t)~bit;
+                        *l1 &= (uint8_t)~bit;
+                        ntri -= 2;
+                        continue;
+                    }
                     uint32_t s0[3], s1[3], r0[3], r1[3];
                     cell_tri(f0, c, b, q, s0);
                     cell_tri(f1, c, b, q, s1);
                     for (int i = 0; i < 3; i++)
                         s0[i] = up[s0[i]], s1[i] = up[s1[i]];
                     if (sorted(s0, r0) != sorted(s1, r1) && memcmp(r0, r1, sizeof r0) == 0) {
-                        live[first0 + k] = live[first1 + k] = 0;
+                        *l0 &= (uint8_t)~bit;
+                        *l1 &= (uint8_t)~bit;
                         double n[2][3], v0[2], v1[2];
-                        cell_normals(raw.pos, f0->base + b * f0->na + c, f0->na, f0->reverse ? -1.0 : 1.0, n, v0);
-                        cell_normals(raw.pos, f1->base + b * f1->na + c, f1->na, f1->reverse ? -1.0 : 1.0, n, v1);
+                        cell_normals(P, f0->base + b * f0->na + c, f0->na, f0->reverse ? -1.0 : 1.0, n, v0);
+                        cell_normals(P, f1->base + b * f1->na + c, f1->na, f1->reverse ? -1.0 : 1.0, n, v1);
                         vol -= v0[q] + v1[q];
                         ntri -= 2;
                     }
@@ -419,32 +557,97 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     /* 4. Outward: the enclosed volume (summed in 3) must be positive. */
     const int flip = vol < 0.0;
 
-    /* 5. Vertices, (point, face) pairs, made in the order the face's triangles first use them, at the
-     * sample that first does; a second sample of the face at the vertex's point makes it a collapsed
-     * row's point, whose normal comes from its triangles. */
-    out->pos = malloc(3 * nraw * sizeof *out->pos);
-    out->nrm = malloc(3 * nraw * sizeof *out->nrm);
-    out->detj = malloc(nraw * sizeof *out->detj);
-    out->weld = malloc(nraw * sizeof *out->weld);
-    out->tri = malloc((3 * ntri + 1) * sizeof *out->tri);
-    vsam = malloc(nraw * sizeof *vsam);
-    if (!out->pos || !out->nrm || !out->detj || !out->weld || !out->tri || !vsam)
-        goto done;
-    memset(pid, 0xff, nraw * sizeof *pid);
-    size_t nv = 0, npos = 0, k3 = 0, tri_of[7] = { 0 };
-    int has_nan[6] = { 0 };
-    t = 0;
+    /* 5. Vertices, (point, face) pairs, face by face in sample order, each at the first sample of the
+     * face that a live triangle uses, packed down over the samples; then the face's triangles. A point
+     * the face samples twice (a collapsed row's) takes its triangles' normal, as does one where
+     * x_a x x_b vanishes. */
+    size_t nv = 0, npos = 0, k3 = 0;
+    float mn[3] = { INFINITY, INFINITY, INFINITY }, mx[3] = { -INFINITY, -INFINITY, -INFINITY };
+    float *restrict N = out->nrm, *restrict J = out->detj;
+    uint32_t *restrict W = out->weld, *restrict T = out->tri;
     for (int fi = 0; fi < 6; fi++) {
         if (stopped(cancel)) {
             cancelled = 1;
             goto done;
         }
         const face *f = &faces[fi];
-        const size_t end = f->base + f->na * f->nb, first = nv;
+        const size_t na = f->na, end = f->base + na * f->nb;
+        const uint32_t first = (uint32_t)nv;
         const double sgn = (f->reverse ? -1.0 : 1.0) * (flip ? -1.0 : 1.0);
+        /* the samples the live triangles use */
+        for (size_t b = 0; b + 1 < f->nb; b++) {
+            uint8_t *restrict fl = flag + f->base + b * na;
+            for (size_t a = 0; a + 1 < na; a++) {
+                const uint8_t c = fl[a];
+                if (!(c & (LIVE0 | LIVE1)))
+                    continue;
+                fl[a] |= USED, fl[a + na + 1] |= USED;
+                if (c & LIVE0)
+                    fl[a + 1] |= USED;
+                if (c & LIVE1)
+                    fl[a + na] |= USED;
+            }
+        }
+        /* how many samples of the face each shared root has */
         for (size_t k = f->base; k < end; k++)
-            vof[up[k]] = UINT32_MAX;
-        uint32_t off[2][3];   /* the corners of a cell's triangles, from its v00, as wound in the mesh */
+            if (flag[k] & SHARED) {
+                const uint32_t r = up[k];
+                vof[r] = vof[r] == TAG1(fi) || vof[r] == TAG2(fi) ? TAG2(fi) : TAG1(fi);
+            }
+        const size_t nacc0 = nacc.n;
+        for (size_t k = f->base; k < end; k++) {
+            const uint8_t c = flag[k];
+            uint32_t v;
+            int twice = 0;
+            if (!(c & SHARED)) {
+                if (!(c & USED))
+                    continue;
+                v = (uint32_t)nv++;
+                W[v] = (uint32_t)npos++;
+            } else {
+                const uint32_t r = up[k], at = vof[r];
+                const int made = at >= first && at < TAGMIN;
+                if (!(c & USED)) {
+                    if (made && mark_nan(N, at, &nacc))
+                        goto done;
+                    continue;
+                }
+                if (made) {   /* a second sample of the face at the vertex's point */
+                    up[k] = at;
+                    if (mark_nan(N, at, &nacc))
+                        goto done;
+                    continue;
+                }
+                twice = at == TAG2(fi);
+                v = (uint32_t)nv++;
+                vof[r] = v;
+                if (pid[r] == UINT32_MAX)
+                    pid[r] = (uint32_t)npos++;
+                W[v] = pid[r];
+            }
+            up[k] = v;
+            /* the sample's data down to the vertex (v <= k) */
+            const float *p = P + 3 * k, *n = N + 3 * k;
+            const double nx = n[0], ny = n[1], nz = n[2], len = sqrt(nx * nx + ny * ny + nz * nz);
+            float q[3] = { p[0], p[1], p[2] };
+            P[3 * v] = q[0], P[3 * v + 1] = q[1], P[3 * v + 2] = q[2];
+            for (int i = 0; i < 3; i++) {
+                mn[i] = q[i] < mn[i] ? q[i] : mn[i];
+                mx[i] = q[i] > mx[i] ? q[i] : mx[i];
+            }
+            J[v] = J[k];
+            if (len > tiny) {
+                const double s = sgn / len;
+                N[3 * v] = (float)(s * nx), N[3 * v + 1] = (float)(s * ny), N[3 * v + 2] = (float)(s * nz);
+            } else {
+                N[3 * v] = 0.0f;   /* not NaN yet: mark_nan's test */
+                twice = 1;
+            }
+            if (twice && mark_nan(N, v, &nacc))
+                goto done;
+        }
+        /* the face's triangles, as wound in the mesh */
+        uint32_t off[2][3];
         for (int q = 0; q < 2; q++) {
             cell_tri(f, 0, 0, q, off[q]);
             for (int i = 0; i < 3; i++)
@@ -454,97 +657,65 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                 off[q][1] = off[q][2], off[q][2] = x;
             }
         }
-        for (size_t b = 0; b + 1 < f->nb; b++)
-            for (size_t a = 0; a + 1 < f->na; a++)
-                for (int q = 0; q < 2; q++, t++) {
-                    if (!live[t])
+        const int any_nan = nacc.n > nacc0;
+        for (size_t b = 0; b + 1 < f->nb; b++) {
+            const size_t row = f->base + b * na;
+            const uint8_t *restrict fl = flag + row;
+            const uint32_t *restrict u = up + row;
+            for (size_t a = 0; a + 1 < na; a++) {
+                const uint8_t c = fl[a];
+                if (!(c & (LIVE0 | LIVE1)))
+                    continue;
+                for (int q = 0; q < 2; q++) {
+                    if (!(c & (q ? LIVE1 : LIVE0)))
                         continue;
-                    const uint32_t v00 = (uint32_t)(f->base + b * f->na + a);
-                    const uint32_t s[3] = { v00 + off[q][0], v00 + off[q][1], v00 + off[q][2] };
-                    for (int i = 0; i < 3; i++) {
-                        const uint32_t r = up[s[i]];
-                        if (vof[r] == UINT32_MAX) {
-                            const uint32_t v = (uint32_t)nv++, k = s[i];
-                            vof[r] = v;
-                            vsam[v] = k;
-                            if (pid[r] == UINT32_MAX)
-                                pid[r] = (uint32_t)npos++;
-                            out->weld[v] = pid[r];
-                            memcpy(out->pos + 3 * v, raw.pos + 3 * r, 3 * sizeof(float));
-                            out->detj[v] = raw.detj[k];
-                            const float *n = raw.nrm + 3 * k;
-                            const double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-                            has_nan[fi] |= !(len > tiny);
-                            for (int c = 0; c < 3; c++)
-                                out->nrm[3 * v + c] = len > tiny ? (float)(sgn * n[c] / len) : NAN;
+                    const uint32_t t0 = u[a + off[q][0]], t1 = u[a + off[q][1]], t2 = u[a + off[q][2]];
+                    T[k3] = t0, T[k3 + 1] = t1, T[k3 + 2] = t2;
+                    k3 += 3;
+                    if (any_nan && (isnan(N[3 * t0]) || isnan(N[3 * t1]) || isnan(N[3 * t2]))) {
+                        double e1[3], e2[3], n[3];
+                        for (int i = 0; i < 3; i++) {
+                            e1[i] = (double)P[3 * t1 + i] - P[3 * t0 + i];
+                            e2[i] = (double)P[3 * t2 + i] - P[3 * t0 + i];
                         }
-                        out->tri[k3++] = vof[r];
+                        cross(e1, e2, n);
+                        const uint32_t t[3] = { t0, t1, t2 };
+                        for (int i = 0; i < 3; i++)
+                            if (isnan(N[3 * t[i]])) {
+                                uint32_t j;
+                                memcpy(&j, &N[3 * t[i] + 1], 4);
+                                for (int c2 = 0; c2 < 3; c2++)
+                                    nacc.acc[3 * j + c2] += n[c2];
+                            }
                     }
                 }
-        for (size_t k = f->base; k < end; k++) {
-            const uint32_t v = vof[up[k]];
-            if (v != UINT32_MAX && v >= first && vsam[v] != k)
-                out->nrm[3 * v] = NAN, has_nan[fi] = 1;
+            }
         }
-        tri_of[fi + 1] = k3 / 3;
+        /* the area-weighted normals of the face's marked vertices */
+        if (any_nan)
+            for (uint32_t v = first; v < nv; v++)
+                if (isnan(N[3 * v])) {
+                    uint32_t j;
+                    memcpy(&j, &N[3 * v + 1], 4);
+                    const double *n = nacc.acc + 3 * j, len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+                    for (int c2 = 0; c2 < 3; c2++)
+                        N[3 * v + c2] = len > 0 ? (float)(n[c2] / len) : (c2 == 2 ? 1.0f : 0.0f);
+                }
     }
-    /* Area-weighted normals for the vertices marked NaN, from their faces' triangles. */
-    acc = calloc(3 * nv + 1, sizeof *acc);
-    if (!acc)
-        goto done;
-    for (int fi = 0; fi < 6; fi++)
-        for (size_t tt = has_nan[fi] ? tri_of[fi] : tri_of[fi + 1]; tt < tri_of[fi + 1]; tt++) {
-            const uint32_t *w = &out->tri[3 * tt];
-            if (!isnan(out->nrm[3 * w[0]]) && !isnan(out->nrm[3 * w[1]]) && !isnan(out->nrm[3 * w[2]]))
-                continue;
-            double n[3];
-            tri_normal(out->pos + 3 * w[0], out->pos + 3 * w[1], out->pos + 3 * w[2], n);
-            for (int i = 0; i < 3; i++)
-                for (int c = 0; c < 3; c++)
-                    acc[3 * w[i] + c] += n[c];
-        }
     for (int c = 0; c < 3; c++)
-        out->min[c] = INFINITY, out->max[c] = -INFINITY;
-    for (size_t v = 0; v < nv; v++) {
-        if (isnan(out->nrm[3 * v])) {
-            const double *n = acc + 3 * v, len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            for (int c = 0; c < 3; c++)
-                out->nrm[3 * v + c] = len > 0 ? (float)(n[c] / len) : (c == 2 ? 1.0f : 0.0f);
-        }
-        for (int c = 0; c < 3; c++) {
-            const float x = out->pos[3 * v + c];
-            out->min[c] = x < out->min[c] ? x : out->min[c];
-            out->max[c] = x > out->max[c] ? x : out->max[c];
-        }
-    }
+        out->min[c] = mn[c], out->max[c] = mx[c];
     out->nverts = nv;
     out->ntris = ntri;
     out->npos = npos;
-    /* Down to what is used (realloc to a smaller size keeps the block where it cannot move it). */
-    float *p;
-    uint32_t *w;
-    if ((p = realloc(out->pos, (3 * nv + 1) * sizeof *p)))
-        out->pos = p;
-    if ((p = realloc(out->nrm, (3 * nv + 1) * sizeof *p)))
-        out->nrm = p;
-    if ((p = realloc(out->detj, (nv + 1) * sizeof *p)))
-        out->detj = p;
-    if ((w = realloc(out->weld, (nv + 1) * sizeof *w)))
-        out->weld = w;
     rc = 0;
 done:
     if (rc) {
+        if (!out->pos)
+            block_put(blk);
         api_mesh_free(out);
         api_fail(err, cancelled ? API_ERR_CANCELLED : why_status, "", "%s", cancelled ? "cancelled" : why);
     }
-    free(raw.pos);
-    free(raw.nrm);
-    free(raw.detj);
-    free(up);
-    free(vof);
-    free(pid);
-    free(live);
-    free(acc);
-    free(vsam);
+    block_put(up);
+    free(nacc.acc);
     return rc;
 }
