@@ -43,6 +43,10 @@
 
 #include "mesh.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 typedef struct {
     int axis, side;       /* the face axis = side */
     size_t na, nb;        /* samples along its fast and slow parameters: (v, w), (u, w) or (u, v) */
@@ -83,111 +87,133 @@ typedef struct {
     int bad;
 } samples;
 
+/* Bounds of n floats of interleaved x, y, z: lanes l of lo12, hi12 hold axis l % 3 (4 points, 12
+ * floats, a step); sum12 turns NaN on any NaN or infinity. */
+static void row_bounds(const float *restrict p, size_t n, float lo12[12], float hi12[12], float sum12[12])
+{
+    size_t j = 0;
+#if defined(__SSE2__)
+    __m128 lo[3], hi[3], sm[3];
+    const __m128 zero = _mm_setzero_ps();
+    for (int i = 0; i < 3; i++)
+        lo[i] = _mm_loadu_ps(lo12 + 4 * i), hi[i] = _mm_loadu_ps(hi12 + 4 * i), sm[i] = _mm_loadu_ps(sum12 + 4 * i);
+    for (; j + 12 <= n; j += 12)
+        for (int i = 0; i < 3; i++) {
+            const __m128 x = _mm_loadu_ps(p + j + 4 * (size_t)i);
+            lo[i] = _mm_min_ps(x, lo[i]);   /* x < lo ? x : lo, as below */
+            hi[i] = _mm_max_ps(x, hi[i]);
+            sm[i] = _mm_add_ps(sm[i], _mm_mul_ps(x, zero));
+        }
+    for (int i = 0; i < 3; i++)
+        _mm_storeu_ps(lo12 + 4 * i, lo[i]), _mm_storeu_ps(hi12 + 4 * i, hi[i]), _mm_storeu_ps(sum12 + 4 * i, sm[i]);
+#endif
+    for (; j < n; j++) {
+        const float x = p[j];
+        lo12[j % 3] = x < lo12[j % 3] ? x : lo12[j % 3];
+        hi12[j % 3] = x > hi12[j % 3] ? x : hi12[j % 3];
+        sum12[j % 3] += x * 0.0f;
+    }
+}
+
+/* What the faces' sampling shares: the plane's or row's buffers and the bounds so far. */
+typedef struct {
+    float *x, *xd[3];            /* x, then x_u, x_v, x_w, 6 max(nu, nv) floats each */
+    float lo12[12], hi12[12], sum12[12];
+} sampler;
+
 /*
- * The two faces of an axis, f[0] at 0 and f[1] at 1, na x nb samples each, fast index first, from the
- * closed form with its derivatives. One grid holds both faces' fixed parameter, so each plane's h(w)
- * and each row's coefficients serve both: u = 0, 1 is a grid of nu = 2 (a plane of w, rows along v),
- * v = 0, 1 one of nv = 2 (rows 0 and 1 of a plane), w = 0, 1 the planes 0 and 1 of the (u, v) grid,
- * one row at a time. 1 when cancelled, -1 out of memory.
+ * Face f's row b from the sampler's buffers, where its sample a is point first + a step: positions,
+ * x_a x x_b in double (the products of floats are exact) and det J.
  */
-static int sample_faces(const pde_solution *sol, const face f[2], const unsigned res[3], const pde_cancel *cancel,
+static void emit_row(const face *f, size_t b, size_t first, size_t step, sampler *sp, samples *out)
+{
+    int o[2];
+    face_axes(f, o);
+    const int axis = f->axis;
+    const size_t na = f->na, s0 = f->base + b * na;
+    float *restrict pos = out->pos + 3 * s0, *restrict nrm = out->nrm + 3 * s0, *restrict dj = out->detj + s0;
+    const float *restrict x = sp->x, *restrict ta0 = sp->xd[o[0]], *restrict tb0 = sp->xd[o[1]];
+    const float *restrict tc0 = sp->xd[axis];
+    const float sg = axis == 1 ? -1.0f : 1.0f;
+    for (size_t a = 0; a < na; a++) {
+        const size_t e = 3 * (first + a * step);
+        const float *ta = ta0 + e, *tb = tb0 + e, *tc = tc0 + e;
+        double n[3] = { (double)ta[1] * tb[2] - (double)ta[2] * tb[1], (double)ta[2] * tb[0] - (double)ta[0] * tb[2],
+                        (double)ta[0] * tb[1] - (double)ta[1] * tb[0] };
+        /* det(x_u, x_v, x_w) = (x_a x x_b) . x_axis, times the sign of (a, b, axis)'s order */
+        double det = n[0] * tc[0] + n[1] * tc[1] + n[2] * tc[2];
+        pos[3 * a] = x[e], pos[3 * a + 1] = x[e + 1], pos[3 * a + 2] = x[e + 2];
+        nrm[3 * a] = (float)n[0], nrm[3 * a + 1] = (float)n[1], nrm[3 * a + 2] = (float)n[2];
+        dj[a] = sg * (float)det;
+    }
+    row_bounds(pos, 3 * na, sp->lo12, sp->hi12, sp->sum12);
+}
+
+/*
+ * The six faces, na x nb samples each, fast index first, from the closed form with its derivatives.
+ * One grid holds both faces of an axis, so each plane's and row's coefficients serve both: u = 0, 1 is
+ * a grid of nu = 2 (a plane of w, rows along v), v = 0, 1 one of nv = 2 (rows 0 and 1 of a plane); w = 0,
+ * 1 are the (u, v) grid's planes 0 and 1, one row at a time. Polled before each face row. 1 when
+ * cancelled, -1 out of memory.
+ */
+static int sample_faces(const pde_solution *sol, const face f[6], const unsigned res[3], const pde_cancel *cancel,
                         samples *out)
 {
-    const int axis = f[0].axis;
     const size_t nu = res[0], nv = res[1], nmax = nu > nv ? nu : nv;
     double *us = malloc((nu + nv) * sizeof *us), *vs = us ? us + nu : NULL;
     float *d = malloc(4 * 3 * 2 * nmax * sizeof *d);   /* x, x_u, x_v, x_w of a plane's row(s) */
-    if (!us || !d) {
-        free(us);
-        free(d);
-        return -1;
-    }
+    pde_grid *g[4] = { NULL, NULL, NULL, NULL };      /* u = 0, 1; v = 0, 1; w = 0; w = 1 (each its own h) */
+    int rc = -1;
+    if (!us || !d)
+        goto done;
     for (size_t i = 0; i < nu; i++)
         us[i] = sample(i, nu);
     for (size_t j = 0; j < nv; j++)
         vs[j] = sample(j, nv);
     const double ends[2] = { 0.0, 1.0 };
-    pde_grid *g = NULL, *g1 = NULL;   /* g1: the plane w = 1's own grid, so neither moves between planes */
-    pde_status st;
-    if (axis == 0)
-        st = pde_grid_create(sol, ends, 2, vs, nv, &g);         /* (v, w) */
-    else if (axis == 1)
-        st = pde_grid_create(sol, us, nu, ends, 2, &g);         /* (u, w) */
-    else if ((st = pde_grid_create(sol, us, nu, vs, nv, &g)) == PDE_OK)   /* (u, v) */
-        st = pde_grid_create(sol, us, nu, vs, nv, &g1);
-    free(us);
-    if (st != PDE_OK) {
-        pde_grid_free(g);
-        free(d);
-        return -1;
-    }
-    int o[2], rc = 0;
-    face_axes(&f[0], o);
-    const size_t na = f[0].na, m = 6 * nmax;
-    float *x = d, *xd[3] = { d + m, d + 2 * m, d + 3 * m };   /* x, then x_u, x_v, x_w */
-    float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
-    float lo12[12], hi12[12], sum12[12];
+    if (pde_grid_create(sol, ends, 2, vs, nv, &g[0]) != PDE_OK || pde_grid_create(sol, us, nu, ends, 2, &g[1]) != PDE_OK ||
+        pde_grid_create(sol, us, nu, vs, nv, &g[2]) != PDE_OK || pde_grid_create(sol, us, nu, vs, nv, &g[3]) != PDE_OK)
+        goto done;
+    const size_t m = 6 * nmax;
+    sampler sp = { d, { d + m, d + 2 * m, d + 3 * m }, { 0 }, { 0 }, { 0 } };
     for (int l = 0; l < 12; l++)
-        lo12[l] = INFINITY, hi12[l] = -INFINITY, sum12[l] = 0.0f;
-    int bad = 0;
-    for (size_t b = 0; b < f[0].nb && !rc; b++) {       /* a row at a time, to poll between rows */
-        if ((rc = stopped(cancel)))
-            break;
-        if (axis == 2) {
-            pde_grid_rows(g, 0.0, b, b + 1, x, xd[0], xd[1], xd[2]);
-            pde_grid_rows(g1, 1.0, b, b + 1, x + 3 * na, xd[0] + 3 * na, xd[1] + 3 * na, xd[2] + 3 * na);
-        } else {
-            pde_grid_plane_d(g, sample(b, res[2]), x, xd[0], xd[1], xd[2]);
-        }
-        for (int side = 0; side < 2; side++) {
-            if (side && (rc = stopped(cancel)))   /* a poll per face row, as before the faces were paired */
+        sp.lo12[l] = INFINITY, sp.hi12[l] = -INFINITY;
+    rc = 0;
+    /* u = 0, 1 and v = 0, 1, plane by plane */
+    for (size_t b = 0; b < res[2] && !rc; b++) {
+        const double w = sample(b, res[2]);
+        for (int axis = 0; axis < 2 && !rc; axis++) {
+            if ((rc = stopped(cancel)))
                 break;
-            /* sample a of this side in the plane's layout: (v, u) interleaved for u = 0, 1, else by rows */
-            const size_t step = axis == 0 ? 2 : 1, first = axis == 0 ? (size_t)side : (size_t)side * na;
-            const size_t s0 = f[side].base + b * na;
-            float *restrict pos = out->pos + 3 * s0, *restrict nrm = out->nrm + 3 * s0, *restrict dj = out->detj + s0;
-            const float sg = axis == 1 ? -1.0f : 1.0f;
-            for (size_t a = 0; a < na; a++) {
-                const size_t e = 3 * (first + a * step);
-                const float *ta = xd[o[0]] + e, *tb = xd[o[1]] + e, *tc = xd[axis] + e;
-                double n[3] = { (double)ta[1] * tb[2] - (double)ta[2] * tb[1], (double)ta[2] * tb[0] - (double)ta[0] * tb[2],
-                                (double)ta[0] * tb[1] - (double)ta[1] * tb[0] };
-                /* det(x_u, x_v, x_w) = (x_a x x_b) . x_axis, times the sign of (a, b, axis)'s order */
-                double det = n[0] * tc[0] + n[1] * tc[1] + n[2] * tc[2];
-                pos[3 * a] = x[e], pos[3 * a + 1] = x[e + 1], pos[3 * a + 2] = x[e + 2];
-                nrm[3 * a] = (float)n[0], nrm[3 * a + 1] = (float)n[1], nrm[3 * a + 2] = (float)n[2];
-                dj[a] = sg * (float)det;
-            }
-            /* bounds over the row, 4 points (12 floats) a step, so that lane j holds axis j % 3; any
-             * NaN or infinity makes sum NaN */
-            size_t j = 0;
-            for (; j + 12 <= 3 * na; j += 12)
-                for (int l = 0; l < 12; l++) {
-                    const float p = pos[j + (size_t)l];
-                    lo12[l] = p < lo12[l] ? p : lo12[l];
-                    hi12[l] = p > hi12[l] ? p : hi12[l];
-                    sum12[l] += p * 0.0f;
-                }
-            for (; j < 3 * na; j++) {
-                const float p = pos[j];
-                lo12[j % 3] = p < lo12[j % 3] ? p : lo12[j % 3];
-                hi12[j % 3] = p > hi12[j % 3] ? p : hi12[j % 3];
-                sum12[0] += p * 0.0f;
+            pde_grid_plane_d(g[axis], w, sp.x, sp.xd[0], sp.xd[1], sp.xd[2]);
+            for (int side = 0; side < 2; side++) {
+                if (side && (rc = stopped(cancel)))
+                    break;
+                /* u = 0, 1: (v, u) interleaved; v = 0, 1: by rows */
+                if (axis == 0)
+                    emit_row(&f[side], b, (size_t)side, 2, &sp, out);
+                else
+                    emit_row(&f[2 + side], b, (size_t)side * nu, 1, &sp, out);
             }
         }
     }
+    /* w = 0, 1, a row at a time */
+    for (size_t b = 0; b < nv && !rc; b++)
+        for (int side = 0; side < 2; side++) {
+            if ((rc = stopped(cancel)))
+                break;
+            pde_grid_rows(g[2 + side], side ? 1.0 : 0.0, b, b + 1, sp.x, sp.xd[0], sp.xd[1], sp.xd[2]);
+            emit_row(&f[4 + side], b, 0, 1, &sp, out);
+        }
     for (int l = 0; l < 12; l++) {
-        lo[l % 3] = lo12[l] < lo[l % 3] ? lo12[l] : lo[l % 3];
-        hi[l % 3] = hi12[l] > hi[l % 3] ? hi12[l] : hi[l % 3];
-        bad |= sum12[l] != 0.0f;
+        out->lo[l % 3] = sp.lo12[l] < out->lo[l % 3] ? sp.lo12[l] : out->lo[l % 3];
+        out->hi[l % 3] = sp.hi12[l] > out->hi[l % 3] ? sp.hi12[l] : out->hi[l % 3];
+        out->bad |= sp.sum12[l] != 0.0f;
     }
-    for (int k = 0; k < 3; k++) {
-        out->lo[k] = lo[k] < out->lo[k] ? lo[k] : out->lo[k];
-        out->hi[k] = hi[k] > out->hi[k] ? hi[k] : out->hi[k];
-    }
-    out->bad |= bad;
-    pde_grid_free(g);
-    pde_grid_free(g1);
+done:
+    for (int i = 0; i < 4; i++)
+        pde_grid_free(g[i]);
+    free(us);
     free(d);
     return rc;
 }
@@ -264,6 +290,30 @@ static void join(uint32_t *up, uint32_t a, uint32_t b)
 static inline int near(const float *p, const float *q, float eps)
 {
     return (fabsf(p[0] - q[0]) <= eps) & (fabsf(p[1] - q[1]) <= eps) & (fabsf(p[2] - q[2]) <= eps);
+}
+
+/* The first sample i in [a, n) with p + 3i and q + 3i near, or n: 4 samples (12 floats) a step where
+ * SSE2 is, with near's arithmetic. */
+static size_t next_near(const float *p, const float *q, size_t a, size_t n, float eps)
+{
+#if defined(__SSE2__)
+    const __m128 e = _mm_set1_ps(eps), abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    for (; a + 4 <= n; a += 4) {
+        const float *x = p + 3 * a, *y = q + 3 * a;
+        unsigned m = 0;
+        for (int i = 0; i < 3; i++) {
+            const __m128 d = _mm_and_ps(_mm_sub_ps(_mm_loadu_ps(x + 4 * i), _mm_loadu_ps(y + 4 * i)), abs);
+            m |= (unsigned)_mm_movemask_ps(_mm_cmple_ps(d, e)) << (4 * i);
+        }
+        m &= (m >> 1) & (m >> 2) & 01111u;   /* bit 3i: all three axes of sample i */
+        if (m)
+            return a + (size_t)__builtin_ctz(m) / 3;
+    }
+#endif
+    for (; a < n; a++)
+        if (near(p + 3 * a, q + 3 * a, eps))
+            return a;
+    return n;
 }
 
 /* The triple in increasing order; returns the parity of the sorting permutation. */
@@ -411,12 +461,10 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                     { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY }, 0 };
 
     /* 1. Faces. */
-    for (int a = 0; a < 3; a++) {
-        int r = sample_faces(sol, &faces[2 * a], res, cancel, &raw);
-        if (r) {
-            cancelled = r > 0;
-            goto done;
-        }
+    const int sampled = sample_faces(sol, faces, res, cancel, &raw);
+    if (sampled) {
+        cancelled = sampled > 0;
+        goto done;
     }
     if (raw.bad) {
         why = "the solid's coordinates exceed the range of float32; no mesh can hold them";
@@ -445,13 +493,11 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             const uint32_t row = (uint32_t)(f->base + b * na);
             const float *p = P + 3 * (size_t)row;
             /* along the row, then to the next row */
-            for (size_t a = 0; a + 1 < na; a++)
-                if (near(p + 3 * a, p + 3 * a + 3, epsf))
-                    join(up, row + (uint32_t)a, row + (uint32_t)a + 1);
-            if (b + 1 < nb)
-                for (size_t a = 0; a < na; a++)
-                    if (near(p + 3 * a, p + 3 * (a + na), epsf))
-                        join(up, row + (uint32_t)a, (uint32_t)(row + a + na));
+            for (size_t a = next_near(p, p + 3, 0, na - 1, epsf); a < na - 1; a = next_near(p, p + 3, a + 1, na - 1, epsf))
+                join(up, row + (uint32_t)a, row + (uint32_t)a + 1);
+            const size_t nup = b + 1 < nb ? na : 0;
+            for (size_t a = next_near(p, p + 3 * na, 0, nup, epsf); a < nup; a = next_near(p, p + 3 * na, a + 1, nup, epsf))
+                join(up, row + (uint32_t)a, (uint32_t)(row + a + na));
             /* the neighbouring faces this row's samples lie on: its ends, or all of an edge row */
             const int edge_row = b == 0 || b + 1 == nb;
             for (size_t a = 0; a < na; a += edge_row || a + 1 == na ? 1 : na - 1) {
@@ -466,9 +512,9 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     for (int a = 0; a < 3; a++) {
         const face *f0 = &faces[2 * a], *f1 = &faces[2 * a + 1];
         const float *p0 = P + 3 * f0->base, *p1 = P + 3 * f1->base;
-        for (size_t k = 0; k < f0->na * f0->nb; k++)
-            if (near(p0 + 3 * k, p1 + 3 * k, epsf))
-                join(up, (uint32_t)(f0->base + k), (uint32_t)(f1->base + k)), seams[a]++;
+        const size_t n = f0->na * f0->nb;
+        for (size_t k = next_near(p0, p1, 0, n, epsf); k < n; k = next_near(p0, p1, k + 1, n, epsf))
+            join(up, (uint32_t)(f0->base + k), (uint32_t)(f1->base + k)), seams[a]++;
     }
     /* Roots; a joined sample takes its root's position, so that every copy of a point is the same
      * bits (the root, the least sample, is settled before any other of its set). */

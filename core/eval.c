@@ -250,6 +250,14 @@ static void emit1(float *restrict out, size_t nu, const double *restrict tab, co
 static void emit(float *out, size_t nu, const double *const tab[3], const double *const k[3],
                  const size_t nd[3])
 {
+    if (nd[0] == 1 && nd[1] == 1 && nd[2] == 1) {   /* emit1's case 1 for the three at once */
+        const double k0 = k[0][0], k1 = k[1][0], k2 = k[2][0];
+        const double *restrict t0 = tab[0], *restrict t1 = tab[1], *restrict t2 = tab[2];
+        float *restrict o = out;
+        for (size_t i = 0; i < nu; i++)
+            o[3 * i] = (float)(k0 * t0[i]), o[3 * i + 1] = (float)(k1 * t1[i]), o[3 * i + 2] = (float)(k2 * t2[i]);
+        return;
+    }
     for (int c = 0; c < 3; c++)
         emit1(out + c, nu, tab[c], k[c], nd[c]);
 }
@@ -323,11 +331,23 @@ static void grid_cols(pde_grid *g, size_t j0, size_t j1, float *const outs[4])
             const double *restrict k = ks[q], *restrict t = tab[q];
             switch (nd) {   /* dot_k's cases, the switch out of the loop */
             case 1:
+                if (nu == 2) {   /* faces u = 0, 1: both columns at once */
+                    const double t0 = t[0], t1 = t[1];
+                    for (size_t j = 0; j < n; j++)
+                        o[6 * j + c] = (float)(k[j] * t0), o[6 * j + 3 + c] = (float)(k[j] * t1);
+                    break;
+                }
                 for (size_t j = 0; j < n; j++)
                     for (size_t i = 0; i < nu; i++)
                         o[3 * (j * nu + i) + c] = (float)(k[j] * t[i]);
                 break;
             case 2:
+                if (nu == 2) {
+                    const double t0 = t[0], t1 = t[1], u0 = t[2], u1 = t[3];
+                    for (size_t j = 0; j < n; j++)
+                        o[6 * j + c] = (float)(k[j] * t0 + k[n + j] * u0), o[6 * j + 3 + c] = (float)(k[j] * t1 + k[n + j] * u1);
+                    break;
+                }
                 for (size_t j = 0; j < n; j++)
                     for (size_t i = 0; i < nu; i++)
                         o[3 * (j * nu + i) + c] = (float)(k[j] * t[i] + k[n + j] * t[nu + i]);
