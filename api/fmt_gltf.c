@@ -324,9 +324,10 @@ static int glb_fill(api_output *o)
     }
     if (s->blob_pos == s->blob_len)
         return 1;
+    /* 64 KiB a piece: it stays in cache between this write and the reader's copy */
     size_t n = s->blob_len - s->blob_pos;
-    if (n > 1 << 20)
-        n = 1 << 20;
+    if (n > 1 << 16)
+        n = 1 << 16;
     if (s->compressed) {
         if (api_out_put(o, s->blob + s->blob_pos, n))
             return -1;
