@@ -38,6 +38,7 @@
  */
 #include <math.h>
 #include <stdatomic.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -574,16 +575,21 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         goto done;
     }
 
-    /* 3. Triangles that collapse go; so do the cells of opposite faces that coincide. */
+    /* 3. Triangles that collapse go; so do the cells of opposite faces that coincide: first those whose
+     * corners are the opposite cell's points (the same positions, wound the other way: their volumes
+     * would cancel exactly), then any with the same three points in another order. */
     const double tiny = 1e-12 * extent * extent, tiny2 = tiny * tiny;
     size_t ntri = 0;
     double vol = 0.0;   /* six times the enclosed volume, over the live triangles */
     for (int fi = 0; fi < 6; fi++) {
         const face *f = &faces[fi];
         const double sgn = f->reverse ? -1.0 : 1.0;
+        /* the opposite face's samples, where the two may coincide */
+        const ptrdiff_t opp = seams[f->axis] >= 3 ? (ptrdiff_t)faces[fi ^ 1].base - (ptrdiff_t)f->base : 0;
         for (size_t b = 0; b + 1 < f->nb; b++) {
             const size_t row = f->base + b * f->na;
             const uint32_t *restrict u0 = up + row, *restrict u1 = u0 + f->na;
+            const uint32_t *o0 = u0 + opp, *o1 = u1 + opp;
             uint8_t *restrict fl = flag + row;
             for (size_t a = 0; a + 1 < f->na; a++) {
                 const uint32_t r00 = u0[a], r10 = u0[a + 1], r01 = u1[a], r11 = u1[a + 1];
@@ -591,6 +597,8 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                 const int diag = r00 != r11;
                 const int c0 = diag && r10 != r00 && r10 != r11, c1 = diag && r01 != r00 && r01 != r11;
                 if (!(c0 | c1))
+                    continue;
+                if (opp && r00 == o0[a] && r10 == o0[a + 1] && r01 == o1[a] && r11 == o1[a + 1])
                     continue;
                 const unsigned live = cell_live(P, row + a, f->na, sgn, tiny2, (unsigned)c0 | (unsigned)c1 << 1, &vol);
                 fl[a] |= (uint8_t)(live * LIVE0);   /* bits 0, 1 -> LIVE0, LIVE1 */
@@ -609,15 +617,6 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                     uint8_t *l0 = flag + f0->base + b * f0->na + c, *l1 = flag + f1->base + b * f1->na + c;
                     if (!(*l0 & bit) || !(*l1 & bit))
                         continue;
-                    /* the same roots at the cell's corners: the same points, wound the other way (the two
-                     * faces' windings differ), at the same positions, so their volumes cancel exactly */
-                    const uint32_t *u0 = up + f0->base + b * f0->na + c, *u1 = up + f1->base + b * f1->na + c;
-                    if (u0[0] == u1[0] && u0[1] == u1[1] && u0[f0->na] == u1[f0->na] && u0[f0->na + 1] == u1[f0->na + 1]) {
-                        *l0 &= (uint8_t)~bit;
-                        *l1 &= (uint8_t)~bit;
-                        ntri -= 2;
-                        continue;
-                    }
                     uint32_t s0[3], s1[3], r0[3], r1[3];
                     cell_tri(f0, c, b, q, s0);
                     cell_tri(f1, c, b, q, s1);
