@@ -601,11 +601,16 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                 if (opp && r00 == o0[a] && r10 == o0[a + 1] && r01 == o1[a] && r11 == o1[a + 1])
                     continue;
                 const unsigned live = cell_live(P, row + a, f->na, sgn, tiny2, (unsigned)c0 | (unsigned)c1 << 1, &vol);
-                fl[a] |= (uint8_t)(live * LIVE0);   /* bits 0, 1 -> LIVE0, LIVE1 */
+                if (!live)
+                    continue;
+                /* bits 0, 1 -> LIVE0, LIVE1; the corners the live triangles use */
+                fl[a] |= (uint8_t)(live * LIVE0 | USED), fl[a + f->na + 1] |= USED;
+                fl[a + 1] |= (uint8_t)(live & 1 ? USED : 0), fl[a + f->na] |= (uint8_t)(live & 2 ? USED : 0);
                 ntri += (live & 1) + (live >> 1);
             }
         }
     }
+    int reused[3] = { 0, 0, 0 };   /* the axes whose faces lost triangles here: their USED flags are stale */
     for (int a = 0; a < 3; a++) {
         const face *f0 = &faces[2 * a], *f1 = &faces[2 * a + 1];
         if (seams[a] < 3)
@@ -625,6 +630,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                     if (sorted(s0, r0) != sorted(s1, r1) && memcmp(r0, r1, sizeof r0) == 0) {
                         *l0 &= (uint8_t)~bit;
                         *l1 &= (uint8_t)~bit;
+                        reused[a] = 1;
                         double n[2][3], v0[2], v1[2];
                         cell_normals(P, f0->base + b * f0->na + c, f0->na, f0->reverse ? -1.0 : 1.0, n, v0);
                         cell_normals(P, f1->base + b * f1->na + c, f1->na, f1->reverse ? -1.0 : 1.0, n, v1);
@@ -642,7 +648,9 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
      * the face samples twice (a collapsed row's) takes its triangles' normal, as does one where
      * x_a x x_b vanishes. */
     size_t nv = 0, npos = 0, k3 = 0;
-    float mn[3] = { INFINITY, INFINITY, INFINITY }, mx[3] = { -INFINITY, -INFINITY, -INFINITY };
+    float lo12[12], hi12[12], sum12[12];   /* the vertices' bounds (row_bounds) */
+    for (int l = 0; l < 12; l++)
+        lo12[l] = INFINITY, hi12[l] = -INFINITY, sum12[l] = 0.0f;
     float *restrict N = out->nrm, *restrict J = out->detj;
     uint32_t *restrict W = out->weld, *restrict T = out->tri;
     for (int fi = 0; fi < 6; fi++) {
@@ -654,8 +662,11 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         const size_t na = f->na, end = f->base + na * f->nb;
         const uint32_t first = (uint32_t)nv;
         const double sgn = (f->reverse ? -1.0 : 1.0) * (flip ? -1.0 : 1.0);
-        /* the samples the live triangles use */
-        for (size_t b = 0; b + 1 < f->nb; b++) {
+        /* the samples the live triangles use, again where step 3 dropped some */
+        if (reused[f->axis])
+            for (size_t k = f->base; k < end; k++)
+                flag[k] &= (uint8_t)~USED;
+        for (size_t b = 0; reused[f->axis] && b + 1 < f->nb; b++) {
             uint8_t *restrict fl = flag + f->base + b * na;
             for (size_t a = 0; a + 1 < na; a++) {
                 const uint8_t c = fl[a];
@@ -709,12 +720,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             /* the sample's data down to the vertex (v <= k) */
             const float *p = P + 3 * k, *n = N + 3 * k;
             const double nx = n[0], ny = n[1], nz = n[2], len = sqrt(nx * nx + ny * ny + nz * nz);
-            float q[3] = { p[0], p[1], p[2] };
-            P[3 * v] = q[0], P[3 * v + 1] = q[1], P[3 * v + 2] = q[2];
-            for (int i = 0; i < 3; i++) {
-                mn[i] = q[i] < mn[i] ? q[i] : mn[i];
-                mx[i] = q[i] > mx[i] ? q[i] : mx[i];
-            }
+            P[3 * v] = p[0], P[3 * v + 1] = p[1], P[3 * v + 2] = p[2];
             J[v] = J[k];
             if (len > tiny) {
                 const double s = sgn / len;
@@ -726,6 +732,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             if (twice && mark_nan(N, v, &nacc))
                 goto done;
         }
+        row_bounds(P + 3 * (size_t)first, 3 * (nv - first), lo12, hi12, sum12);
         /* the face's triangles, as wound in the mesh */
         uint32_t off[2][3];
         for (int q = 0; q < 2; q++) {
@@ -783,7 +790,11 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                 }
     }
     for (int c = 0; c < 3; c++)
-        out->min[c] = mn[c], out->max[c] = mx[c];
+        out->min[c] = INFINITY, out->max[c] = -INFINITY;
+    for (int l = 0; l < 12; l++) {
+        out->min[l % 3] = lo12[l] < out->min[l % 3] ? lo12[l] : out->min[l % 3];
+        out->max[l % 3] = hi12[l] > out->max[l % 3] ? hi12[l] : out->max[l % 3];
+    }
     out->nverts = nv;
     out->ntris = ntri;
     out->npos = npos;
