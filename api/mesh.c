@@ -416,9 +416,9 @@ void api_mesh_free(api_mesh *m)
     memset(m, 0, sizeof *m);
 }
 
-/* A sample's flags: joined with another sample; used by a live triangle of its face; and, on a cell's
- * v00, which of the cell's two triangles live. */
-enum { SHARED = 1, USED = 2, LIVE0 = 4, LIVE1 = 8 };
+/* A sample's flags: joined with another sample; used by a live triangle of its face; on a cell's v00,
+ * which of the cell's two triangles live; its vertex's normal marked for its triangles' mean. */
+enum { SHARED = 1, USED = 2, LIVE0 = 4, LIVE1 = 8, NANV = 16 };
 
 /* vof[r] while face f's vertices are made: the face has one (TAG1) or several (TAG2) samples at root r
  * and no vertex there yet; vertex ids of earlier faces are below the face's first, tags above any id. */
@@ -579,7 +579,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
      * corners are the opposite cell's points (the same positions, wound the other way: their volumes
      * would cancel exactly), then any with the same three points in another order. */
     const double tiny = 1e-12 * extent * extent, tiny2 = tiny * tiny;
-    size_t ntri = 0;
+    size_t ftri[6] = { 0 };   /* each face's live triangles */
     double vol = 0.0;   /* six times the enclosed volume, over the live triangles */
     for (int fi = 0; fi < 6; fi++) {
         const face *f = &faces[fi];
@@ -606,7 +606,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                 /* bits 0, 1 -> LIVE0, LIVE1; the corners the live triangles use */
                 fl[a] |= (uint8_t)(live * LIVE0 | USED), fl[a + f->na + 1] |= USED;
                 fl[a + 1] |= (uint8_t)(live & 1 ? USED : 0), fl[a + f->na] |= (uint8_t)(live & 2 ? USED : 0);
-                ntri += (live & 1) + (live >> 1);
+                ftri[fi] += (live & 1) + (live >> 1);
             }
         }
     }
@@ -635,13 +635,14 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                         cell_normals(P, f0->base + b * f0->na + c, f0->na, f0->reverse ? -1.0 : 1.0, n, v0);
                         cell_normals(P, f1->base + b * f1->na + c, f1->na, f1->reverse ? -1.0 : 1.0, n, v1);
                         vol -= v0[q] + v1[q];
-                        ntri -= 2;
+                        ftri[2 * a]--, ftri[2 * a + 1]--;
                     }
                 }
     }
 
     /* 4. Outward: the enclosed volume (summed in 3) must be positive. */
     const int flip = vol < 0.0;
+    const size_t ntri = ftri[0] + ftri[1] + ftri[2] + ftri[3] + ftri[4] + ftri[5];
 
     /* 5. Vertices, (point, face) pairs, face by face in sample order, each at the first sample of the
      * face that a live triangle uses, packed down over the samples; then the face's triangles. A point
@@ -659,6 +660,8 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             goto done;
         }
         const face *f = &faces[fi];
+        if (!ftri[fi])
+            continue;   /* collapsed, or cancelled by its opposite: no vertex */
         const size_t na = f->na, end = f->base + na * f->nb;
         const uint32_t first = (uint32_t)nv;
         const double sgn = (f->reverse ? -1.0 : 1.0) * (flip ? -1.0 : 1.0);
@@ -729,22 +732,29 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                 N[3 * v] = 0.0f;   /* not NaN yet: mark_nan's test */
                 twice = 1;
             }
-            if (twice && mark_nan(N, v, &nacc))
-                goto done;
-        }
-        row_bounds(P + 3 * (size_t)first, 3 * (nv - first), lo12, hi12, sum12);
-        /* the face's triangles, as wound in the mesh */
-        uint32_t off[2][3];
-        for (int q = 0; q < 2; q++) {
-            cell_tri(f, 0, 0, q, off[q]);
-            for (int i = 0; i < 3; i++)
-                off[q][i] -= (uint32_t)f->base;
-            if (flip) {
-                const uint32_t x = off[q][1];
-                off[q][1] = off[q][2], off[q][2] = x;
+            if (twice) {
+                flag[k] |= NANV;
+                if (mark_nan(N, v, &nacc))
+                    goto done;
             }
         }
-        const int any_nan = nacc.n > nacc0;
+        row_bounds(P + 3 * (size_t)first, 3 * (nv - first), lo12, hi12, sum12);
+        /* the face's triangles, as wound in the mesh: corners 0-3 of a cell are v00, v10, v01, v11 */
+        unsigned char ci[2][3];
+        for (int q = 0; q < 2; q++) {
+            uint32_t t[3];
+            cell_tri(f, 0, 0, q, t);
+            for (int i = 0; i < 3; i++) {
+                const uint32_t o = t[i] - (uint32_t)f->base;   /* 0, 1, na or na + 1 */
+                ci[q][i] = (unsigned char)((o >= na ? 2 : 0) + (o == 1 || o == na + 1));
+            }
+            if (flip) {
+                const unsigned char x = ci[q][1];
+                ci[q][1] = ci[q][2], ci[q][2] = x;
+            }
+        }
+        /* a corner's vertex may have a NaN normal where its sample is joined (SHARED) or was marked (NANV) */
+        const uint8_t maybe_nan = nacc.n > nacc0 ? SHARED | NANV : 0;
         for (size_t b = 0; b + 1 < f->nb; b++) {
             const size_t row = f->base + b * na;
             const uint8_t *restrict fl = flag + row;
@@ -753,31 +763,34 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                 const uint8_t c = fl[a];
                 if (!(c & (LIVE0 | LIVE1)))
                     continue;
-                for (int q = 0; q < 2; q++) {
-                    if (!(c & (q ? LIVE1 : LIVE0)))
+                const uint32_t w[4] = { u[a], u[a + 1], u[a + na], u[a + na + 1] };
+                const uint32_t *t = T + k3;
+                if (c & LIVE0)
+                    T[k3] = w[ci[0][0]], T[k3 + 1] = w[ci[0][1]], T[k3 + 2] = w[ci[0][2]], k3 += 3;
+                if (c & LIVE1)
+                    T[k3] = w[ci[1][0]], T[k3 + 1] = w[ci[1][1]], T[k3 + 2] = w[ci[1][2]], k3 += 3;
+                if (!((c | fl[a + 1] | fl[a + na] | fl[a + na + 1]) & maybe_nan))
+                    continue;
+                for (; t < T + k3; t += 3) {
+                    if (!isnan(N[3 * t[0]]) && !isnan(N[3 * t[1]]) && !isnan(N[3 * t[2]]))
                         continue;
-                    const uint32_t t0 = u[a + off[q][0]], t1 = u[a + off[q][1]], t2 = u[a + off[q][2]];
-                    T[k3] = t0, T[k3 + 1] = t1, T[k3 + 2] = t2;
-                    k3 += 3;
-                    if (any_nan && (isnan(N[3 * t0]) || isnan(N[3 * t1]) || isnan(N[3 * t2]))) {
-                        double e1[3], e2[3], n[3];
-                        for (int i = 0; i < 3; i++) {
-                            e1[i] = (double)P[3 * t1 + i] - P[3 * t0 + i];
-                            e2[i] = (double)P[3 * t2 + i] - P[3 * t0 + i];
-                        }
-                        cross(e1, e2, n);
-                        const uint32_t t[3] = { t0, t1, t2 };
-                        for (int i = 0; i < 3; i++)
-                            if (isnan(N[3 * t[i]])) {
-                                uint32_t j;
-                                memcpy(&j, &N[3 * t[i] + 1], 4);
-                                for (int c2 = 0; c2 < 3; c2++)
-                                    nacc.acc[3 * j + c2] += n[c2];
-                            }
+                    double e1[3], e2[3], n[3];
+                    for (int i = 0; i < 3; i++) {
+                        e1[i] = (double)P[3 * t[1] + i] - P[3 * t[0] + i];
+                        e2[i] = (double)P[3 * t[2] + i] - P[3 * t[0] + i];
                     }
+                    cross(e1, e2, n);
+                    for (int i = 0; i < 3; i++)
+                        if (isnan(N[3 * t[i]])) {
+                            uint32_t j;
+                            memcpy(&j, &N[3 * t[i] + 1], 4);
+                            for (int c2 = 0; c2 < 3; c2++)
+                                nacc.acc[3 * j + c2] += n[c2];
+                        }
                 }
             }
         }
+        const int any_nan = nacc.n > nacc0;
         /* the area-weighted normals of the face's marked vertices */
         if (any_nan)
             for (uint32_t v = first; v < nv; v++)
