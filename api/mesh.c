@@ -5,12 +5,13 @@
  * The skin is the image of the parameter cube's boundary, sampled on the
  * lattice i/(n-1) of each axis, so its topology is known before any position
  * is: no position is hashed or searched for.
- * 1. The two faces of each axis are sampled on one grid with the closed
- *    form's first derivatives (pde_grid; u = 0, 1 as a grid of nu = 2, which
- *    core fills column-wise), straight into the mesh's arrays, and
- *    triangulated, wound so that each face's normal points out of the
- *    parameter cube. A joined sample then takes its root's position, so
- *    every copy of a point has the same bits.
+ * 1. The two faces of each axis are sampled on one grid (pde_grid; u = 0, 1
+ *    as a grid of nu = 2, which core fills column-wise), straight into the
+ *    mesh's arrays, and triangulated, wound so that each face's normal points
+ *    out of the parameter cube. Positions first; the closed form's first
+ *    derivatives (normal, det J) only after step 3, on the faces that keep a
+ *    triangle (fig4a drops three of six). A joined sample then takes its
+ *    root's position, so every copy of a point has the same bits.
  * 2. Samples are joined (union-find) where they are one point:
  *    - a face's edge row is its neighbour's (the cube's 12 edges): by the
  *      lattice alone;
@@ -36,6 +37,7 @@
  *    next ones.
  * Every pass is linear in the samples, and the hot ones (neighbour and seam
  * tests, bounds, a cell's area test) take 2 to 4 samples a step in SSE2
+ * (a run of near samples costs a join each, no further test)
  * where it is, with the scalar code's arithmetic, so the bits do not depend
  * on it. Memory: one block for the mesh (32 bytes a sample, 12 a triangle)
  * and one of scratch (13 bytes a sample), both kept for the next build
@@ -121,25 +123,78 @@ static void row_bounds(const float *restrict p, size_t n, float lo12[12], float 
     }
 }
 
-/* What the faces' sampling shares: the plane's or row's buffers and the bounds so far. */
+/* What the faces' sampling shares: the grids, the plane's or row's buffers and the bounds so far. One grid holds
+ * both faces of an axis, so each plane's and row's coefficients serve both: u = 0, 1 is a grid of nu = 2 (a plane
+ * of w, rows along v), v = 0, 1 one of nv = 2 (rows 0 and 1 of a plane); w = 0, 1 are the (u, v) grid's planes 0
+ * and 1, one row at a time. */
 typedef struct {
+    pde_grid *g[4];              /* u = 0, 1; v = 0, 1; w = 0; w = 1 (each its own h) */
+    double *us;                  /* the lattice of u, then of v */
     float *x, *xd[3];            /* x, then x_u, x_v, x_w, 6 max(nu, nv) floats each */
     float lo12[12], hi12[12], sum12[12];
 } sampler;
 
+static void sampler_free(sampler *sp)
+{
+    for (int i = 0; i < 4; i++)
+        pde_grid_free(sp->g[i]);
+    free(sp->us);
+    free(sp->x);
+}
+
+/* 0, or -1 out of memory (sp then holds nothing to free). */
+static int sampler_init(sampler *sp, const pde_solution *sol, const unsigned res[3])
+{
+    const size_t nu = res[0], nv = res[1], nmax = nu > nv ? nu : nv, m = 6 * nmax;
+    memset(sp, 0, sizeof *sp);
+    sp->us = malloc((nu + nv) * sizeof *sp->us);
+    sp->x = malloc(4 * m * sizeof *sp->x);
+    if (!sp->us || !sp->x)
+        goto fail;
+    double *vs = sp->us + nu;
+    for (size_t i = 0; i < nu; i++)
+        sp->us[i] = sample(i, nu);
+    for (size_t j = 0; j < nv; j++)
+        vs[j] = sample(j, nv);
+    const double ends[2] = { 0.0, 1.0 };
+    if (pde_grid_create(sol, ends, 2, vs, nv, &sp->g[0]) != PDE_OK ||
+        pde_grid_create(sol, sp->us, nu, ends, 2, &sp->g[1]) != PDE_OK ||
+        pde_grid_create(sol, sp->us, nu, vs, nv, &sp->g[2]) != PDE_OK ||
+        pde_grid_create(sol, sp->us, nu, vs, nv, &sp->g[3]) != PDE_OK)
+        goto fail;
+    for (int i = 0; i < 3; i++)
+        sp->xd[i] = sp->x + (size_t)(i + 1) * m;
+    for (int l = 0; l < 12; l++)
+        sp->lo12[l] = INFINITY, sp->hi12[l] = -INFINITY;
+    return 0;
+fail:
+    sampler_free(sp);
+    memset(sp, 0, sizeof *sp);
+    return -1;
+}
+
 /*
- * Face f's row b from the sampler's buffers, where its sample a is point first + a step: positions,
- * x_a x x_b in double (the products of floats are exact) and det J.
+ * Face f's row b from the sampler's buffers, where its sample a is point first + a step. The positions pass
+ * (derivs 0) writes positions and their bounds; the derivatives pass x_a x x_b in double (the products of
+ * floats are exact) and det J.
  */
-static void emit_row(const face *f, size_t b, size_t first, size_t step, sampler *sp, samples *out)
+static void emit_row(const face *f, size_t b, size_t first, size_t step, int derivs, sampler *sp, samples *out)
 {
     int o[2];
     face_axes(f, o);
     const int axis = f->axis;
     const size_t na = f->na, s0 = f->base + b * na;
     float *restrict pos = out->pos + 3 * s0, *restrict nrm = out->nrm + 3 * s0, *restrict dj = out->detj + s0;
-    const float *restrict x = sp->x, *restrict ta0 = sp->xd[o[0]], *restrict tb0 = sp->xd[o[1]];
-    const float *restrict tc0 = sp->xd[axis];
+    if (!derivs) {
+        const float *restrict x = sp->x;
+        for (size_t a = 0; a < na; a++) {
+            const size_t e = 3 * (first + a * step);
+            pos[3 * a] = x[e], pos[3 * a + 1] = x[e + 1], pos[3 * a + 2] = x[e + 2];
+        }
+        row_bounds(pos, 3 * na, sp->lo12, sp->hi12, sp->sum12);
+        return;
+    }
+    const float *restrict ta0 = sp->xd[o[0]], *restrict tb0 = sp->xd[o[1]], *restrict tc0 = sp->xd[axis];
     const float sg = axis == 1 ? -1.0f : 1.0f;
     for (size_t a = 0; a < na; a++) {
         const size_t e = 3 * (first + a * step);
@@ -148,79 +203,63 @@ static void emit_row(const face *f, size_t b, size_t first, size_t step, sampler
                         (double)ta[0] * tb[1] - (double)ta[1] * tb[0] };
         /* det(x_u, x_v, x_w) = (x_a x x_b) . x_axis, times the sign of (a, b, axis)'s order */
         double det = n[0] * tc[0] + n[1] * tc[1] + n[2] * tc[2];
-        pos[3 * a] = x[e], pos[3 * a + 1] = x[e + 1], pos[3 * a + 2] = x[e + 2];
         nrm[3 * a] = (float)n[0], nrm[3 * a + 1] = (float)n[1], nrm[3 * a + 2] = (float)n[2];
         dj[a] = sg * (float)det;
     }
-    row_bounds(pos, 3 * na, sp->lo12, sp->hi12, sp->sum12);
 }
 
 /*
- * The six faces, na x nb samples each, fast index first, from the closed form with its derivatives.
- * One grid holds both faces of an axis, so each plane's and row's coefficients serve both: u = 0, 1 is
- * a grid of nu = 2 (a plane of w, rows along v), v = 0, 1 one of nv = 2 (rows 0 and 1 of a plane); w = 0,
- * 1 are the (u, v) grid's planes 0 and 1, one row at a time. Polled before each face row. 1 when
- * cancelled, -1 out of memory.
+ * The six faces, na x nb samples each, fast index first, from the closed form. The positions pass (keep NULL)
+ * samples x on every face; the derivatives pass x_u, x_v, x_w, only on the faces with keep[face] != 0 (those
+ * that kept a triangle: a face dropped whole costs no derivative). Polled before each face row. 1 when
+ * cancelled.
  */
-static int sample_faces(const pde_solution *sol, const face f[6], const unsigned res[3], const pde_cancel *cancel,
-                        samples *out)
+static int sample_faces(sampler *sp, const face f[6], const unsigned res[3], const size_t *keep,
+                        const pde_cancel *cancel, samples *out)
 {
-    const size_t nu = res[0], nv = res[1], nmax = nu > nv ? nu : nv;
-    double *us = malloc((nu + nv) * sizeof *us), *vs = us ? us + nu : NULL;
-    float *d = malloc(4 * 3 * 2 * nmax * sizeof *d);   /* x, x_u, x_v, x_w of a plane's row(s) */
-    pde_grid *g[4] = { NULL, NULL, NULL, NULL };      /* u = 0, 1; v = 0, 1; w = 0; w = 1 (each its own h) */
-    int rc = -1;
-    if (!us || !d)
-        goto done;
-    for (size_t i = 0; i < nu; i++)
-        us[i] = sample(i, nu);
-    for (size_t j = 0; j < nv; j++)
-        vs[j] = sample(j, nv);
-    const double ends[2] = { 0.0, 1.0 };
-    if (pde_grid_create(sol, ends, 2, vs, nv, &g[0]) != PDE_OK || pde_grid_create(sol, us, nu, ends, 2, &g[1]) != PDE_OK ||
-        pde_grid_create(sol, us, nu, vs, nv, &g[2]) != PDE_OK || pde_grid_create(sol, us, nu, vs, nv, &g[3]) != PDE_OK)
-        goto done;
-    const size_t m = 6 * nmax;
-    sampler sp = { d, { d + m, d + 2 * m, d + 3 * m }, { 0 }, { 0 }, { 0 } };
-    for (int l = 0; l < 12; l++)
-        sp.lo12[l] = INFINITY, sp.hi12[l] = -INFINITY;
-    rc = 0;
+    const size_t nu = res[0], nv = res[1];
+    const int derivs = keep != NULL;
+    float *x = derivs ? NULL : sp->x, *xu = derivs ? sp->xd[0] : NULL, *xv = derivs ? sp->xd[1] : NULL,
+          *xw = derivs ? sp->xd[2] : NULL;
+    int rc = 0;
     /* u = 0, 1 and v = 0, 1, plane by plane */
     for (size_t b = 0; b < res[2] && !rc; b++) {
         const double w = sample(b, res[2]);
         for (int axis = 0; axis < 2 && !rc; axis++) {
+            if (derivs && !keep[2 * axis] && !keep[2 * axis + 1])
+                continue;
             if ((rc = stopped(cancel)))
                 break;
-            pde_grid_plane_d(g[axis], w, sp.x, sp.xd[0], sp.xd[1], sp.xd[2]);
+            pde_grid_plane_d(sp->g[axis], w, x, xu, xv, xw);
             for (int side = 0; side < 2; side++) {
+                if (derivs && !keep[2 * axis + side])
+                    continue;
                 if (side && (rc = stopped(cancel)))
                     break;
                 /* u = 0, 1: (v, u) interleaved; v = 0, 1: by rows */
                 if (axis == 0)
-                    emit_row(&f[side], b, (size_t)side, 2, &sp, out);
+                    emit_row(&f[side], b, (size_t)side, 2, derivs, sp, out);
                 else
-                    emit_row(&f[2 + side], b, (size_t)side * nu, 1, &sp, out);
+                    emit_row(&f[2 + side], b, (size_t)side * nu, 1, derivs, sp, out);
             }
         }
     }
     /* w = 0, 1, a row at a time */
     for (size_t b = 0; b < nv && !rc; b++)
         for (int side = 0; side < 2; side++) {
+            if (derivs && !keep[4 + side])
+                continue;
             if ((rc = stopped(cancel)))
                 break;
-            pde_grid_rows(g[2 + side], side ? 1.0 : 0.0, b, b + 1, sp.x, sp.xd[0], sp.xd[1], sp.xd[2]);
-            emit_row(&f[4 + side], b, 0, 1, &sp, out);
+            pde_grid_rows(sp->g[2 + side], side ? 1.0 : 0.0, b, b + 1, x, xu, xv, xw);
+            emit_row(&f[4 + side], b, 0, 1, derivs, sp, out);
         }
-    for (int l = 0; l < 12; l++) {
-        out->lo[l % 3] = sp.lo12[l] < out->lo[l % 3] ? sp.lo12[l] : out->lo[l % 3];
-        out->hi[l % 3] = sp.hi12[l] > out->hi[l % 3] ? sp.hi12[l] : out->hi[l % 3];
-        out->bad |= sp.sum12[l] != 0.0f;
-    }
-done:
-    for (int i = 0; i < 4; i++)
-        pde_grid_free(g[i]);
-    free(us);
-    free(d);
+    if (!derivs)
+        for (int l = 0; l < 12; l++) {
+            out->lo[l % 3] = sp->lo12[l] < out->lo[l % 3] ? sp->lo12[l] : out->lo[l % 3];
+            out->hi[l % 3] = sp->hi12[l] > out->hi[l % 3] ? sp->hi12[l] : out->hi[l % 3];
+            out->bad |= sp->sum12[l] != 0.0f;
+        }
     return rc;
 }
 
@@ -298,28 +337,32 @@ static inline int near(const float *p, const float *q, float eps)
     return (fabsf(p[0] - q[0]) <= eps) & (fabsf(p[1] - q[1]) <= eps) & (fabsf(p[2] - q[2]) <= eps);
 }
 
-/* The first sample i in [a, n) with p + 3i and q + 3i near, or n: 4 samples (12 floats) a step where
- * SSE2 is, with near's arithmetic. */
-static size_t next_near(const float *p, const float *q, size_t a, size_t n, float eps)
+/* Joins sample ip + i with iq + i for every i < n where p + 3i and q + 3i are near, in increasing i; returns
+ * how many. 4 samples (12 floats) a step where SSE2 is, with near's arithmetic; a run of near samples (a
+ * collapsed row, a seam) costs a join each and no other test. */
+static size_t join_near(uint32_t *up, const float *p, const float *q, uint32_t ip, uint32_t iq, size_t n, float eps)
 {
+    size_t i = 0, joined = 0;
 #if defined(__SSE2__)
     const __m128 e = _mm_set1_ps(eps), abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
-    for (; a + 4 <= n; a += 4) {
-        const float *x = p + 3 * a, *y = q + 3 * a;
+    for (; i + 4 <= n; i += 4) {
+        const float *x = p + 3 * i, *y = q + 3 * i;
         unsigned m = 0;
-        for (int i = 0; i < 3; i++) {
-            const __m128 d = _mm_and_ps(_mm_sub_ps(_mm_loadu_ps(x + 4 * i), _mm_loadu_ps(y + 4 * i)), abs);
-            m |= (unsigned)_mm_movemask_ps(_mm_cmple_ps(d, e)) << (4 * i);
+        for (int k = 0; k < 3; k++) {
+            const __m128 d = _mm_and_ps(_mm_sub_ps(_mm_loadu_ps(x + 4 * k), _mm_loadu_ps(y + 4 * k)), abs);
+            m |= (unsigned)_mm_movemask_ps(_mm_cmple_ps(d, e)) << (4 * k);
         }
-        m &= (m >> 1) & (m >> 2) & 01111u;   /* bit 3i: all three axes of sample i */
-        if (m)
-            return a + (size_t)__builtin_ctz(m) / 3;
+        m &= (m >> 1) & (m >> 2) & 01111u;   /* bit 3j: all three axes of sample i + j */
+        for (; m; m &= m - 1, joined++) {
+            const uint32_t j = (uint32_t)(i + (size_t)__builtin_ctz(m) / 3);
+            join(up, ip + j, iq + j);
+        }
     }
 #endif
-    for (; a < n; a++)
-        if (near(p + 3 * a, q + 3 * a, eps))
-            return a;
-    return n;
+    for (; i < n; i++)
+        if (near(p + 3 * i, q + 3 * i, eps))
+            join(up, ip + (uint32_t)i, iq + (uint32_t)i), joined++;
+    return joined;
 }
 
 /* The triple in increasing order; returns the parity of the sorting permutation. */
@@ -489,7 +532,8 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     uint32_t *pid = up ? vof + nraw : NULL;    /* step 5: a shared root's position id, or UINT32_MAX */
     uint8_t *flag = up ? (uint8_t *)(pid + nraw) : NULL;
     nan_acc nacc = { NULL, 0, 0 };
-    int rc = -1, cancelled = 0;
+    sampler sp;
+    int rc = -1, cancelled = 0, have_sp = 0;
     const char *why = "out of memory building the mesh";
     api_status why_status = API_ERR_NOMEM;
     if (!blk || !up) {
@@ -505,10 +549,12 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     samples raw = { out->pos, out->nrm, out->detj,
                     { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY }, 0 };
 
-    /* 1. Faces. */
-    const int sampled = sample_faces(sol, faces, res, cancel, &raw);
-    if (sampled) {
-        cancelled = sampled > 0;
+    /* 1. Faces: positions now, derivatives after step 3 where a face keeps a triangle. */
+    if (sampler_init(&sp, sol, res))
+        goto done;
+    have_sp = 1;
+    if (sample_faces(&sp, faces, res, NULL, cancel, &raw)) {
+        cancelled = 1;
         goto done;
     }
     if (raw.bad) {
@@ -538,11 +584,9 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             const uint32_t row = (uint32_t)(f->base + b * na);
             const float *p = P + 3 * (size_t)row;
             /* along the row, then to the next row */
-            for (size_t a = next_near(p, p + 3, 0, na - 1, epsf); a < na - 1; a = next_near(p, p + 3, a + 1, na - 1, epsf))
-                join(up, row + (uint32_t)a, row + (uint32_t)a + 1);
-            const size_t nup = b + 1 < nb ? na : 0;
-            for (size_t a = next_near(p, p + 3 * na, 0, nup, epsf); a < nup; a = next_near(p, p + 3 * na, a + 1, nup, epsf))
-                join(up, row + (uint32_t)a, (uint32_t)(row + a + na));
+            join_near(up, p, p + 3, row, row + 1, na - 1, epsf);
+            if (b + 1 < nb)
+                join_near(up, p, p + 3 * na, row, (uint32_t)(row + na), na, epsf);
             /* the neighbouring faces this row's samples lie on: its ends, or all of an edge row */
             const int edge_row = b == 0 || b + 1 == nb;
             for (size_t a = 0; a < na; a += edge_row || a + 1 == na ? 1 : na - 1) {
@@ -558,8 +602,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         const face *f0 = &faces[2 * a], *f1 = &faces[2 * a + 1];
         const float *p0 = P + 3 * f0->base, *p1 = P + 3 * f1->base;
         const size_t n = f0->na * f0->nb;
-        for (size_t k = next_near(p0, p1, 0, n, epsf); k < n; k = next_near(p0, p1, k + 1, n, epsf))
-            join(up, (uint32_t)(f0->base + k), (uint32_t)(f1->base + k)), seams[a]++;
+        seams[a] = join_near(up, p0, p1, (uint32_t)f0->base, (uint32_t)f1->base, n, epsf);
     }
     /* Roots; a joined sample takes its root's position, so that every copy of a point is the same
      * bits (the root, the least sample, is settled before any other of its set). */
@@ -643,6 +686,12 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                         ftri[2 * a]--, ftri[2 * a + 1]--;
                     }
                 }
+    }
+
+    /* 1, continued: x_a x x_b and det J on the faces that keep a triangle. */
+    if (sample_faces(&sp, faces, res, ftri, cancel, &raw)) {
+        cancelled = 1;
+        goto done;
     }
 
     /* 4. Outward: the enclosed volume (summed in 3) must be positive. */
@@ -826,5 +875,7 @@ done:
     }
     block_put(up);
     free(nacc.acc);
+    if (have_sp)
+        sampler_free(&sp);
     return rc;
 }

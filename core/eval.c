@@ -307,6 +307,7 @@ static inline float dot_k(const double *k, size_t ks, const double *t, size_t ts
 static void grid_cols(pde_grid *g, size_t j0, size_t j1, float *const outs[4])
 {
     const size_t nu = g->nu, nv = g->nv, n = j1 - j0;
+    const int xonly = !outs[1] && !outs[2] && !outs[3];   /* kv, kw unused */
     for (int c = 0; c < 3; c++) {
         const size_t nd = g->nd[c], nm = g->nm[c];
         double *restrict kx = g->col, *restrict kv = kx + nd * n, *restrict kw = kv + nd * n;
@@ -321,12 +322,15 @@ static void grid_cols(pde_grid *g, size_t j0, size_t j1, float *const outs[4])
                         continue;
                     const double h = g->h[c][m], dh = g->dh[c][m];
                     const double *restrict p = g->psi[c] + m * nv + j0 + jb, *restrict dp = g->dpsi[c] + m * nv + j0 + jb;
-                    if (nb == BLK) {
+                    if (nb == BLK && !xonly) {
                         for (size_t j = 0; j < BLK; j++) {
                             ax[j] += h * p[j];
                             av[j] += h * dp[j];
                             aw[j] += dh * p[j];
                         }
+                    } else if (nb == BLK) {   /* positions only: x's coefficients alone */
+                        for (size_t j = 0; j < BLK; j++)
+                            ax[j] += h * p[j];
                     } else {
                         for (size_t j = 0; j < nb; j++) {
                             ax[j] += h * p[j];
@@ -335,8 +339,9 @@ static void grid_cols(pde_grid *g, size_t j0, size_t j1, float *const outs[4])
                         }
                     }
                 }
-                for (size_t j = 0; j < nb; j++) {
+                for (size_t j = 0; j < nb; j++)
                     kx[d * n + jb + j] = ax[j];
+                for (size_t j = 0; j < nb && !xonly; j++) {
                     kv[d * n + jb + j] = av[j];
                     kw[d * n + jb + j] = aw[j];
                 }

@@ -778,6 +778,42 @@ static void mesh_build_should_give_the_same_mesh_in_kept_and_fresh_memory(void *
     pde_solution_free(sol);
 }
 
+/* The glb's blob is written straight into the reader's buffer (fmt.h's o->dst): the bytes must not depend on
+ * the buffer's size, down to 1 byte (smaller than a float) and odd sizes that split floats. */
+static void glb_should_be_the_same_bytes_whatever_the_reader_s_buffer(void **state)
+{
+    (void)state;
+    pde_solution *sol = solve_preset("fig4a", NULL);
+    const unsigned res[3] = { 9, 12, 7 };
+    const size_t sizes[] = { 65536, 1, 3, 5, 777, 4096 };
+    unsigned char *first = NULL;
+    size_t first_len = 0;
+    for (size_t s = 0; s < sizeof sizes / sizeof *sizes; s++) {
+        api_error err;
+        api_output *o = api_output_open(sol, "abc", NULL, API_FMT_GLB, res, NULL, &err);
+        assert_non_null(o);
+        const size_t cap = (size_t)api_output_size(o) + 65536;
+        unsigned char *buf = malloc(cap);
+        assert_non_null(buf);
+        size_t n = 0;
+        long got;
+        while ((got = api_output_read(o, (char *)buf + n, sizes[s] < cap - n ? sizes[s] : cap - n)) > 0)
+            n += (size_t)got;
+        assert_int_equal(got, 0);
+        assert_int_equal((long long)n, api_output_size(o));
+        api_output_free(o);
+        if (!first) {
+            first = buf, first_len = n;
+            continue;
+        }
+        assert_int_equal(n, first_len);
+        assert_memory_equal(buf, first, n);
+        free(buf);
+    }
+    free(first);
+    pde_solution_free(sol);
+}
+
 static void vts_should_hold_the_points_and_det_j(void **state)
 {
     (void)state;
@@ -1171,6 +1207,7 @@ int main(void)
         cmocka_unit_test(every_skin_should_be_closed_with_normals_and_det_j_from_the_closed_form),
         cmocka_unit_test(narrow_grids_should_sample_the_same_bits_as_wide_ones),
         cmocka_unit_test(mesh_build_should_give_the_same_mesh_in_kept_and_fresh_memory),
+        cmocka_unit_test(glb_should_be_the_same_bytes_whatever_the_reader_s_buffer),
         cmocka_unit_test(vts_should_hold_the_points_and_det_j),
         cmocka_unit_test(json_should_hold_the_closed_form_properties_and_id),
         cmocka_unit_test(every_output_with_properties_should_carry_each_of_them_by_name),
