@@ -631,6 +631,8 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     double vol = 0.0;   /* six times the enclosed volume, over the live triangles */
     for (int fi = 0; fi < 6; fi++) {
         const face *f = &faces[fi];
+        if (seams[f->axis] == f->na * f->nb)
+            continue;   /* every sample is its opposite's: every cell coincides with the opposite one (below) */
         const double sgn = f->reverse ? -1.0 : 1.0;
         /* the opposite face's samples, where the two may coincide */
         const ptrdiff_t opp = seams[f->axis] >= 3 ? (ptrdiff_t)faces[fi ^ 1].base - (ptrdiff_t)f->base : 0;
@@ -661,7 +663,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     int reused[3] = { 0, 0, 0 };   /* the axes whose faces lost triangles here: their USED flags are stale */
     for (int a = 0; a < 3; a++) {
         const face *f0 = &faces[2 * a], *f1 = &faces[2 * a + 1];
-        if (seams[a] < 3)
+        if (seams[a] < 3 || !ftri[2 * a] || !ftri[2 * a + 1])
             continue;   /* no triangle of one lies on the other */
         for (size_t b = 0; b + 1 < f0->nb; b++)
             for (size_t c = 0; c + 1 < f0->na; c++)
