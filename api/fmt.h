@@ -15,6 +15,11 @@
  *                         api_out_put and friends): 0 while there is more,
  *                         1 at the end (having appended nothing or the last
  *                         piece), -1 out of memory. o->buf is empty on entry.
+ *                         Where o->dst is not NULL, fill may instead write
+ *                         its piece straight into the reader's buffer: at
+ *                         most o->dst_max bytes at o->dst, their count in
+ *                         o->dst_len, appending nothing to o->buf (it saves
+ *                         the copy from o->buf; the glb's blob does this).
  *   close(st)             frees o->st (NULL: nothing to free).
  *   cost(sol, res, opts, c)  api_cost_output's estimate of open and read.
  *
@@ -41,6 +46,8 @@ struct api_output {
     long long size;                /* -1 until known */
     char *buf;                     /* the current piece: buf[pos, len) is unread */
     size_t len, pos, cap;
+    char *dst;                     /* during fill: the reader's buffer, or NULL (see fill above) */
+    size_t dst_max, dst_len;
     pde_props props;
     int have_props;
     void *st;                      /* the format's own state */

@@ -5,10 +5,13 @@
  * The skin is the image of the parameter cube's boundary, sampled on the
  * lattice i/(n-1) of each axis, so its topology is known before any position
  * is: no position is hashed or searched for.
- * 1. The two faces of each axis are sampled on one grid with the closed
- *    form's first derivatives (pde_grid; u = 0, 1 as a grid of nu = 2, which
- *    core fills column-wise), and triangulated, wound so that each face's
- *    normal points out of the parameter cube.
+ * 1. The two faces of each axis are sampled on one grid (pde_grid; u = 0, 1
+ *    as a grid of nu = 2, which core fills column-wise), straight into the
+ *    mesh's arrays, and triangulated, wound so that each face's normal points
+ *    out of the parameter cube. Positions first; the closed form's first
+ *    derivatives (normal, det J) only after step 3, on the faces that keep a
+ *    triangle (fig4a drops three of six). A joined sample then takes its
+ *    root's position, so every copy of a point has the same bits.
  * 2. Samples are joined (union-find) where they are one point:
  *    - a face's edge row is its neighbour's (the cube's 12 edges): by the
  *      lattice alone;
@@ -19,22 +22,38 @@
  * 3. Triangles with a repeated point, or no area, are dropped: faces that
  *    collapse to a line or a point go. A cell of opposite faces whose
  *    triangles join the same points lies inside the solid: both go (faces that
- *    coincide).
+ *    coincide). A face left with no triangle is not visited again.
  * 4. If the enclosed volume comes out negative (the parametrisation reverses
  *    orientation, as x = u sin 2pi v, y = u cos 2pi v does), every triangle
  *    is flipped.
- * 5. Vertices are (point, face) pairs. A vertex's normal is the face's
- *    x_a x x_b from the closed form, and its det J is det(x_u, x_v, x_w);
- *    where a vertex joins several samples of its face, or x_a x x_b vanishes
- *    (a collapsed row's point), the normal is the area-weighted mean of its
- *    triangles' instead.
- * Every pass is linear in the samples.
+ * 5. Vertices are (point, face) pairs, made face by face in sample order and
+ *    packed down over the samples' own data (a vertex never comes after its
+ *    sample), so the mesh's arrays are the sampling's. A vertex's normal is
+ *    the face's x_a x x_b from the closed form, and its det J is
+ *    det(x_u, x_v, x_w); where a vertex joins several samples of its face,
+ *    or x_a x x_b vanishes (a collapsed row's point), the normal is the
+ *    area-weighted mean of its triangles' instead. A sample joined with no
+ *    other (almost all) skips every map: its vertex and position id are the
+ *    next ones.
+ * Every pass is linear in the samples, and the hot ones (neighbour and seam
+ * tests, bounds, a cell's area test) take 2 to 4 samples a step in SSE2
+ * (a run of near samples costs a join each, no further test)
+ * where it is, with the scalar code's arithmetic, so the bits do not depend
+ * on it. Memory: one block for the mesh (32 bytes a sample, 12 a triangle)
+ * and one of scratch (13 bytes a sample), both kept for the next build
+ * (api_mesh_free): on a server, builds after the first touch no fresh page.
  */
 #include <math.h>
+#include <stdatomic.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "mesh.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 typedef struct {
     int axis, side;       /* the face axis = side */
@@ -76,95 +95,220 @@ typedef struct {
     int bad;
 } samples;
 
-/*
- * The two faces of an axis, f[0] at 0 and f[1] at 1, na x nb samples each, fast index first, from the
- * closed form with its derivatives. One grid holds both faces' fixed parameter, so each plane's h(w)
- * and each row's coefficients serve both: u = 0, 1 is a grid of nu = 2 (a plane of w, rows along v),
- * v = 0, 1 one of nv = 2 (rows 0 and 1 of a plane), w = 0, 1 the planes 0 and 1 of the (u, v) grid,
- * one row at a time. 1 when cancelled, -1 out of memory.
- */
-static int sample_faces(const pde_solution *sol, const face f[2], const unsigned res[3], const pde_cancel *cancel,
-                        samples *out)
+/* Bounds of n floats of interleaved x, y, z: lanes l of lo12, hi12 hold axis l % 3 (4 points, 12
+ * floats, a step); sum12 turns NaN on any NaN or infinity. */
+static void row_bounds(const float *restrict p, size_t n, float lo12[12], float hi12[12], float sum12[12])
 {
-    const int axis = f[0].axis;
-    const size_t nu = res[0], nv = res[1], nmax = nu > nv ? nu : nv;
-    double *us = malloc((nu + nv) * sizeof *us), *vs = us ? us + nu : NULL;
-    float *d = malloc(4 * 3 * 2 * nmax * sizeof *d);   /* x, x_u, x_v, x_w of a plane's row(s) */
-    if (!us || !d) {
-        free(us);
-        free(d);
-        return -1;
+    size_t j = 0;
+#if defined(__SSE2__)
+    __m128 lo[3], hi[3], sm[3];
+    const __m128 zero = _mm_setzero_ps();
+    for (int i = 0; i < 3; i++)
+        lo[i] = _mm_loadu_ps(lo12 + 4 * i), hi[i] = _mm_loadu_ps(hi12 + 4 * i), sm[i] = _mm_loadu_ps(sum12 + 4 * i);
+    for (; j + 12 <= n; j += 12)
+        for (int i = 0; i < 3; i++) {
+            const __m128 x = _mm_loadu_ps(p + j + 4 * (size_t)i);
+            lo[i] = _mm_min_ps(x, lo[i]);   /* x < lo ? x : lo, as below */
+            hi[i] = _mm_max_ps(x, hi[i]);
+            sm[i] = _mm_add_ps(sm[i], _mm_mul_ps(x, zero));
+        }
+    for (int i = 0; i < 3; i++)
+        _mm_storeu_ps(lo12 + 4 * i, lo[i]), _mm_storeu_ps(hi12 + 4 * i, hi[i]), _mm_storeu_ps(sum12 + 4 * i, sm[i]);
+#endif
+    for (; j < n; j++) {
+        const float x = p[j];
+        lo12[j % 3] = x < lo12[j % 3] ? x : lo12[j % 3];
+        hi12[j % 3] = x > hi12[j % 3] ? x : hi12[j % 3];
+        sum12[j % 3] += x * 0.0f;
     }
+}
+
+/* What the faces' sampling shares: the grids, the plane's or row's buffers and the bounds so far. One grid holds
+ * both faces of an axis, so each plane's and row's coefficients serve both: u = 0, 1 is a grid of nu = 2 (a plane
+ * of w, rows along v), v = 0, 1 one of nv = 2 (rows 0 and 1 of a plane); w = 0, 1 are the (u, v) grid's planes 0
+ * and 1, one row at a time. */
+typedef struct {
+    pde_grid *g[4];              /* u = 0, 1; v = 0, 1; w = 0; w = 1 (each its own h) */
+    double *us;                  /* the lattice of u, then of v */
+    float *x, *xd[3];            /* x, then x_u, x_v, x_w, 6 max(nu, nv) floats each */
+    float lo12[12], hi12[12], sum12[12];
+} sampler;
+
+static void sampler_free(sampler *sp)
+{
+    for (int i = 0; i < 4; i++)
+        pde_grid_free(sp->g[i]);
+    free(sp->us);
+    free(sp->x);
+}
+
+/* 0, or -1 out of memory (sp then holds nothing to free). */
+static int sampler_init(sampler *sp, const pde_solution *sol, const unsigned res[3])
+{
+    const size_t nu = res[0], nv = res[1], nmax = nu > nv ? nu : nv, m = 6 * nmax;
+    memset(sp, 0, sizeof *sp);
+    sp->us = malloc((nu + nv) * sizeof *sp->us);
+    sp->x = malloc(4 * m * sizeof *sp->x);
+    if (!sp->us || !sp->x)
+        goto fail;
+    double *vs = sp->us + nu;
     for (size_t i = 0; i < nu; i++)
-        us[i] = sample(i, nu);
+        sp->us[i] = sample(i, nu);
     for (size_t j = 0; j < nv; j++)
         vs[j] = sample(j, nv);
     const double ends[2] = { 0.0, 1.0 };
-    pde_grid *g = NULL, *g1 = NULL;   /* g1: the plane w = 1's own grid, so neither moves between planes */
-    pde_status st;
-    if (axis == 0)
-        st = pde_grid_create(sol, ends, 2, vs, nv, &g);         /* (v, w) */
-    else if (axis == 1)
-        st = pde_grid_create(sol, us, nu, ends, 2, &g);         /* (u, w) */
-    else if ((st = pde_grid_create(sol, us, nu, vs, nv, &g)) == PDE_OK)   /* (u, v) */
-        st = pde_grid_create(sol, us, nu, vs, nv, &g1);
-    free(us);
-    if (st != PDE_OK) {
-        pde_grid_free(g);
-        free(d);
-        return -1;
-    }
-    int o[2], rc = 0;
-    face_axes(&f[0], o);
-    const size_t na = f[0].na, m = 6 * nmax;
-    float *x = d, *xd[3] = { d + m, d + 2 * m, d + 3 * m };   /* x, then x_u, x_v, x_w */
-    float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
-    int bad = 0;
-    for (size_t b = 0; b < f[0].nb && !rc; b++) {       /* a row at a time, to poll between rows */
-        if ((rc = stopped(cancel)))
-            break;
-        if (axis == 2) {
-            pde_grid_rows(g, 0.0, b, b + 1, x, xd[0], xd[1], xd[2]);
-            pde_grid_rows(g1, 1.0, b, b + 1, x + 3 * na, xd[0] + 3 * na, xd[1] + 3 * na, xd[2] + 3 * na);
-        } else {
-            pde_grid_plane_d(g, sample(b, res[2]), x, xd[0], xd[1], xd[2]);
+    if (pde_grid_create(sol, ends, 2, vs, nv, &sp->g[0]) != PDE_OK ||
+        pde_grid_create(sol, sp->us, nu, ends, 2, &sp->g[1]) != PDE_OK ||
+        pde_grid_create(sol, sp->us, nu, vs, nv, &sp->g[2]) != PDE_OK ||
+        pde_grid_create(sol, sp->us, nu, vs, nv, &sp->g[3]) != PDE_OK)
+        goto fail;
+    for (int i = 0; i < 3; i++)
+        sp->xd[i] = sp->x + (size_t)(i + 1) * m;
+    for (int l = 0; l < 12; l++)
+        sp->lo12[l] = INFINITY, sp->hi12[l] = -INFINITY;
+    return 0;
+fail:
+    sampler_free(sp);
+    memset(sp, 0, sizeof *sp);
+    return -1;
+}
+
+/*
+ * Face f's row b from the sampler's buffers, where its sample a is point first + a step. The positions pass
+ * (derivs 0) writes positions and their bounds; the derivatives pass x_a x x_b in double (the products of
+ * floats are exact) and det J.
+ */
+static void emit_row(const face *f, size_t b, size_t first, size_t step, int derivs, sampler *sp, samples *out)
+{
+    int o[2];
+    face_axes(f, o);
+    const int axis = f->axis;
+    const size_t na = f->na, s0 = f->base + b * na;
+    float *restrict pos = out->pos + 3 * s0, *restrict nrm = out->nrm + 3 * s0, *restrict dj = out->detj + s0;
+    if (!derivs) {
+        const float *restrict x = sp->x;
+        for (size_t a = 0; a < na; a++) {
+            const size_t e = 3 * (first + a * step);
+            pos[3 * a] = x[e], pos[3 * a + 1] = x[e + 1], pos[3 * a + 2] = x[e + 2];
         }
-        for (int side = 0; side < 2; side++) {
-            if (side && (rc = stopped(cancel)))   /* a poll per face row, as before the faces were paired */
+        row_bounds(pos, 3 * na, sp->lo12, sp->hi12, sp->sum12);
+        return;
+    }
+    const float *restrict ta0 = sp->xd[o[0]], *restrict tb0 = sp->xd[o[1]], *restrict tc0 = sp->xd[axis];
+    const float sg = axis == 1 ? -1.0f : 1.0f;
+    for (size_t a = 0; a < na; a++) {
+        const size_t e = 3 * (first + a * step);
+        const float *ta = ta0 + e, *tb = tb0 + e, *tc = tc0 + e;
+        double n[3] = { (double)ta[1] * tb[2] - (double)ta[2] * tb[1], (double)ta[2] * tb[0] - (double)ta[0] * tb[2],
+                        (double)ta[0] * tb[1] - (double)ta[1] * tb[0] };
+        /* det(x_u, x_v, x_w) = (x_a x x_b) . x_axis, times the sign of (a, b, axis)'s order */
+        double det = n[0] * tc[0] + n[1] * tc[1] + n[2] * tc[2];
+        nrm[3 * a] = (float)n[0], nrm[3 * a + 1] = (float)n[1], nrm[3 * a + 2] = (float)n[2];
+        dj[a] = sg * (float)det;
+    }
+}
+
+/*
+ * The six faces, na x nb samples each, fast index first, from the closed form. The positions pass (keep NULL)
+ * samples x on every face; the derivatives pass x_u, x_v, x_w, only on the faces with keep[face] != 0 (those
+ * that kept a triangle: a face dropped whole costs no derivative). Polled before each face row. 1 when
+ * cancelled.
+ */
+static int sample_faces(sampler *sp, const face f[6], const unsigned res[3], const size_t *keep,
+                        const pde_cancel *cancel, samples *out)
+{
+    const size_t nu = res[0], nv = res[1];
+    const int derivs = keep != NULL;
+    float *x = derivs ? NULL : sp->x, *xu = derivs ? sp->xd[0] : NULL, *xv = derivs ? sp->xd[1] : NULL,
+          *xw = derivs ? sp->xd[2] : NULL;
+    int rc = 0;
+    /* u = 0, 1 and v = 0, 1, plane by plane */
+    for (size_t b = 0; b < res[2] && !rc; b++) {
+        const double w = sample(b, res[2]);
+        for (int axis = 0; axis < 2 && !rc; axis++) {
+            if (derivs && !keep[2 * axis] && !keep[2 * axis + 1])
+                continue;
+            if ((rc = stopped(cancel)))
                 break;
-            /* sample a of this side in the plane's layout: (v, u) interleaved for u = 0, 1, else by rows */
-            const size_t step = axis == 0 ? 2 : 1, first = axis == 0 ? (size_t)side : (size_t)side * na;
-            const size_t s0 = f[side].base + b * na;
-            float *restrict pos = out->pos + 3 * s0, *restrict nrm = out->nrm + 3 * s0, *restrict dj = out->detj + s0;
-            const float sg = axis == 1 ? -1.0f : 1.0f;
-            for (size_t a = 0; a < na; a++) {
-                const size_t e = 3 * (first + a * step);
-                const float *ta = xd[o[0]] + e, *tb = xd[o[1]] + e, *tc = xd[axis] + e;
-                double n[3] = { (double)ta[1] * tb[2] - (double)ta[2] * tb[1], (double)ta[2] * tb[0] - (double)ta[0] * tb[2],
-                                (double)ta[0] * tb[1] - (double)ta[1] * tb[0] };
-                /* det(x_u, x_v, x_w) = (x_a x x_b) . x_axis, times the sign of (a, b, axis)'s order */
-                double det = n[0] * tc[0] + n[1] * tc[1] + n[2] * tc[2];
-                for (int k = 0; k < 3; k++) {
-                    const float p = x[e + k];
-                    pos[3 * a + k] = p;
-                    nrm[3 * a + k] = (float)n[k];
-                    bad |= !isfinite(p);
-                    lo[k] = p < lo[k] ? p : lo[k];
-                    hi[k] = p > hi[k] ? p : hi[k];
-                }
-                dj[a] = sg * (float)det;
+            pde_grid_plane_d(sp->g[axis], w, x, xu, xv, xw);
+            for (int side = 0; side < 2; side++) {
+                if (derivs && !keep[2 * axis + side])
+                    continue;
+                if (side && (rc = stopped(cancel)))
+                    break;
+                /* u = 0, 1: (v, u) interleaved; v = 0, 1: by rows */
+                if (axis == 0)
+                    emit_row(&f[side], b, (size_t)side, 2, derivs, sp, out);
+                else
+                    emit_row(&f[2 + side], b, (size_t)side * nu, 1, derivs, sp, out);
             }
         }
     }
-    for (int k = 0; k < 3; k++) {
-        out->lo[k] = lo[k] < out->lo[k] ? lo[k] : out->lo[k];
-        out->hi[k] = hi[k] > out->hi[k] ? hi[k] : out->hi[k];
-    }
-    out->bad |= bad;
-    pde_grid_free(g);
-    pde_grid_free(g1);
-    free(d);
+    /* w = 0, 1, a row at a time */
+    for (size_t b = 0; b < nv && !rc; b++)
+        for (int side = 0; side < 2; side++) {
+            if (derivs && !keep[4 + side])
+                continue;
+            if ((rc = stopped(cancel)))
+                break;
+            pde_grid_rows(sp->g[2 + side], side ? 1.0 : 0.0, b, b + 1, x, xu, xv, xw);
+            emit_row(&f[4 + side], b, 0, 1, derivs, sp, out);
+        }
+    if (!derivs)
+        for (int l = 0; l < 12; l++) {
+            out->lo[l % 3] = sp->lo12[l] < out->lo[l % 3] ? sp->lo12[l] : out->lo[l % 3];
+            out->hi[l % 3] = sp->hi12[l] > out->hi[l % 3] ? sp->hi12[l] : out->hi[l % 3];
+            out->bad |= sp->sum12[l] != 0.0f;
+        }
     return rc;
+}
+
+/* ---- memory: two blocks kept for the next build ---- */
+
+/*
+ * A mesh takes a block for itself (pos, nrm, detj, weld, tri) and one of scratch; api_mesh_free and the
+ * end of a build give them back to two process-wide slots (atomic, so builds on any threads may share
+ * them), from which the next build takes them: fresh pages cost a page fault each (about 12 us a 4 KiB
+ * page on our VMs, more than the mesh's arithmetic), and malloc returns big blocks to the system. At
+ * most SPARE_MAX bytes a slot are kept; api_mesh_release_spares() frees them.
+ */
+enum { SPARES = 2 };
+#define SPARE_MAX ((size_t)64 << 20)
+typedef struct {
+    size_t cap;
+    size_t pad;   /* the data 16-byte aligned */
+} block_hdr;
+static _Atomic(block_hdr *) spare[SPARES];
+
+static void *block_get(size_t n)
+{
+    for (int i = 0; i < SPARES; i++) {
+        block_hdr *h = atomic_exchange(&spare[i], NULL);
+        if (h && h->cap >= n)
+            return h + 1;
+        free(h);
+    }
+    block_hdr *h = malloc(sizeof *h + n);
+    if (!h)
+        return NULL;
+    h->cap = n;
+    return h + 1;
+}
+
+static void block_put(void *p)
+{
+    if (!p)
+        return;
+    block_hdr *h = (block_hdr *)p - 1;
+    for (int i = 0; i < SPARES && h && h->cap <= SPARE_MAX; i++)
+        h = atomic_exchange(&spare[i], h);   /* the one it displaces tries the next slot */
+    free(h);
+}
+
+void api_mesh_release_spares(void)
+{
+    for (int i = 0; i < SPARES; i++)
+        free(atomic_exchange(&spare[i], NULL));
 }
 
 /* ---- union-find over the samples; a set's root is its least sample ---- */
@@ -187,9 +331,38 @@ static void join(uint32_t *up, uint32_t a, uint32_t b)
         up[a] = b;
 }
 
-static int near(const float *p, const float *q, double eps)
+/* Within eps on every axis; in float, where the difference of two close floats is exact. */
+static inline int near(const float *p, const float *q, float eps)
 {
-    return fabs((double)p[0] - q[0]) <= eps && fabs((double)p[1] - q[1]) <= eps && fabs((double)p[2] - q[2]) <= eps;
+    return (fabsf(p[0] - q[0]) <= eps) & (fabsf(p[1] - q[1]) <= eps) & (fabsf(p[2] - q[2]) <= eps);
+}
+
+/* Joins sample ip + i with iq + i for every i < n where p + 3i and q + 3i are near, in increasing i; returns
+ * how many. 4 samples (12 floats) a step where SSE2 is, with near's arithmetic; a run of near samples (a
+ * collapsed row, a seam) costs a join each and no other test. */
+static size_t join_near(uint32_t *up, const float *p, const float *q, uint32_t ip, uint32_t iq, size_t n, float eps)
+{
+    size_t i = 0, joined = 0;
+#if defined(__SSE2__)
+    const __m128 e = _mm_set1_ps(eps), abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    for (; i + 4 <= n; i += 4) {
+        const float *x = p + 3 * i, *y = q + 3 * i;
+        unsigned m = 0;
+        for (int k = 0; k < 3; k++) {
+            const __m128 d = _mm_and_ps(_mm_sub_ps(_mm_loadu_ps(x + 4 * k), _mm_loadu_ps(y + 4 * k)), abs);
+            m |= (unsigned)_mm_movemask_ps(_mm_cmple_ps(d, e)) << (4 * k);
+        }
+        m &= (m >> 1) & (m >> 2) & 01111u;   /* bit 3j: all three axes of sample i + j */
+        for (; m; m &= m - 1, joined++) {
+            const uint32_t j = (uint32_t)(i + (size_t)__builtin_ctz(m) / 3);
+            join(up, ip + j, iq + j);
+        }
+    }
+#endif
+    for (; i < n; i++)
+        if (near(p + 3 * i, q + 3 * i, eps))
+            join(up, ip + (uint32_t)i, iq + (uint32_t)i), joined++;
+    return joined;
 }
 
 /* The triple in increasing order; returns the parity of the sorting permutation. */
@@ -211,22 +384,12 @@ static void cross(const double a[3], const double b[3], double c[3])
     c[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-/* Twice the area vector of triangle (p, q, r). */
-static void tri_normal(const float *p, const float *q, const float *r, double n[3])
-{
-    double a[3], b[3];
-    for (int k = 0; k < 3; k++) {
-        a[k] = (double)q[k] - p[k];
-        b[k] = (double)r[k] - p[k];
-    }
-    cross(a, b, n);
-}
-
 /*
  * Cell v00 (a sample index; na samples to a row) of a face: its triangles' normals (twice their area
  * vectors) in the unreversed winding, (v00, v10, v11) and (v00, v11, v01), and six times the signed
  * volume of the tetrahedra (0, triangle) in the face's winding (sgn -1 when it reverses), as
- * x_00 . n, so the volume costs a dot product on the normal.
+ * x_00 . n, so the volume costs a dot product on the normal. In double, where the products of float
+ * differences are exact, so a collapsed triangle's area is 0.
  */
 static inline void cell_normals(const float *restrict pos, size_t v00, size_t na, double sgn, double n[2][3],
                                 double vol[2])
@@ -244,6 +407,45 @@ static inline void cell_normals(const float *restrict pos, size_t v00, size_t na
         vol[q] = sgn * ((double)p[0] * n[q][0] + (double)p[1] * n[q][1] + (double)p[2] * n[q][2]);
 }
 
+/*
+ * The live test of a cell's triangles q in want (bit q) with cell_normals' arithmetic: a triangle lives
+ * when |n_q|^2 > tiny2; adds the live ones' volumes to *vol. With SSE2 both at once, lane q holding
+ * n_q = e_q x d, where e_0 = e1 and e_1 = -e2 (d x e2 = -e2 x d, the same products and roundings).
+ */
+static inline unsigned cell_live(const float *restrict pos, size_t v00, size_t na, double sgn, double tiny2,
+                                 unsigned want, double *vol)
+{
+#if defined(__SSE2__)
+    const float *p = pos + 3 * v00, *p10 = p + 3, *p01 = p + 3 * na, *p11 = p01 + 3;
+    __m128d A[3], D[3];
+    for (int k = 0; k < 3; k++) {
+        const double p0 = p[k];
+        A[k] = _mm_set_pd(p0 - (double)p01[k], (double)p10[k] - p0);
+        D[k] = _mm_set1_pd((double)p11[k] - p0);
+    }
+    const __m128d nx = _mm_sub_pd(_mm_mul_pd(A[1], D[2]), _mm_mul_pd(A[2], D[1]));
+    const __m128d ny = _mm_sub_pd(_mm_mul_pd(A[2], D[0]), _mm_mul_pd(A[0], D[2]));
+    const __m128d nz = _mm_sub_pd(_mm_mul_pd(A[0], D[1]), _mm_mul_pd(A[1], D[0]));
+    const __m128d nn = _mm_add_pd(_mm_add_pd(_mm_mul_pd(nx, nx), _mm_mul_pd(ny, ny)), _mm_mul_pd(nz, nz));
+    const unsigned live = (unsigned)_mm_movemask_pd(_mm_cmpgt_pd(nn, _mm_set1_pd(tiny2))) & want;
+    if (live) {
+        const __m128d d = _mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_set1_pd(p[0]), nx), _mm_mul_pd(_mm_set1_pd(p[1]), ny)),
+                                     _mm_mul_pd(_mm_set1_pd(p[2]), nz));
+        double v[2];
+        _mm_storeu_pd(v, _mm_mul_pd(_mm_set1_pd(sgn), d));
+        *vol += (live & 1 ? v[0] : 0.0) + (live & 2 ? v[1] : 0.0);
+    }
+    return live;
+#else
+    double n[2][3], v[2];
+    cell_normals(pos, v00, na, sgn, n, v);
+    const unsigned live = ((unsigned)(n[0][0] * n[0][0] + n[0][1] * n[0][1] + n[0][2] * n[0][2] > tiny2) |
+                           (unsigned)(n[1][0] * n[1][0] + n[1][1] * n[1][1] + n[1][2] * n[1][2] > tiny2) << 1) & want;
+    *vol += (live & 1 ? v[0] : 0.0) + (live & 2 ? v[1] : 0.0);
+    return live;
+#endif
+}
+
 /* The samples of triangle q (0, 1) of cell (a, b) of face f, wound outward of the cube. */
 static void cell_tri(const face *f, size_t a, size_t b, int q, uint32_t t[3])
 {
@@ -258,12 +460,44 @@ void api_mesh_free(api_mesh *m)
 {
     if (!m)
         return;
-    free(m->pos);
-    free(m->nrm);
-    free(m->detj);
-    free(m->tri);
-    free(m->weld);
+    block_put(m->pos);   /* the one block: pos, nrm, detj, weld, tri */
     memset(m, 0, sizeof *m);
+}
+
+/* A sample's flags: joined with another sample; used by a live triangle of its face; on a cell's v00,
+ * which of the cell's two triangles live; its vertex's normal marked for its triangles' mean. */
+enum { SHARED = 1, USED = 2, LIVE0 = 4, LIVE1 = 8, NANV = 16 };
+
+/* vof[r] while face f's vertices are made: the face has one (TAG1) or several (TAG2) samples at root r
+ * and no vertex there yet; vertex ids of earlier faces are below the face's first, tags above any id. */
+#define TAG1(f) (UINT32_MAX - 2u * (uint32_t)(f) - 1u)
+#define TAG2(f) (UINT32_MAX - 2u * (uint32_t)(f) - 2u)
+#define TAGMIN (UINT32_MAX - 13u)
+
+/* Growable accumulators of the area-weighted normals of the vertices marked NaN. */
+typedef struct {
+    double *acc;
+    size_t n, cap;
+} nan_acc;
+
+/* Marks vertex v's normal for the area-weighted mean of its triangles: NaN in x, its accumulator's
+ * index in y's bits. 0, or -1 out of memory. */
+static int mark_nan(float *nrm, uint32_t v, nan_acc *a)
+{
+    if (isnan(nrm[3 * v]))
+        return 0;
+    if (a->n == a->cap) {
+        size_t cap = a->cap ? 2 * a->cap : 256;
+        double *p = realloc(a->acc, 3 * cap * sizeof *p);
+        if (!p)
+            return -1;
+        a->acc = p, a->cap = cap;
+    }
+    const uint32_t i = (uint32_t)a->n++;
+    a->acc[3 * i] = a->acc[3 * i + 1] = a->acc[3 * i + 2] = 0.0;
+    nrm[3 * v] = NAN;
+    memcpy(&nrm[3 * v + 1], &i, 4);
+    return 0;
 }
 
 int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_mesh *out,
@@ -290,27 +524,38 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             nraw += f->na * f->nb;
             ntraw += 2 * (f->na - 1) * (f->nb - 1);
         }
-    samples raw = { malloc(3 * nraw * sizeof(float)), malloc(3 * nraw * sizeof(float)), malloc(nraw * sizeof(float)),
-                    { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY }, 0 };
-    uint32_t *up = malloc(nraw * sizeof *up);
-    uint32_t *vof = malloc(nraw * sizeof *vof);    /* this face's vertex at each root, or UINT32_MAX */
-    uint32_t *pid = malloc(nraw * sizeof *pid);    /* the position id of each root, or UINT32_MAX */
-    uint8_t *live = malloc(ntraw);
-    double *acc = NULL;
-    uint32_t *vsam = NULL;    /* each vertex's sample */
-    int rc = -1, cancelled = 0;
+    /* The mesh's block holds every sample's position, normal and det J until step 5 packs the
+     * vertices down over them (a vertex is never after its sample). */
+    float *blk = block_get(nraw * 32 + ntraw * 12 + 16);
+    uint32_t *up = block_get(nraw * 13 + 16);
+    uint32_t *vof = up ? up + nraw : NULL;     /* step 5: a root's vertex in the face, or a tag */
+    uint32_t *pid = up ? vof + nraw : NULL;    /* step 5: a shared root's position id, or UINT32_MAX */
+    uint8_t *flag = up ? (uint8_t *)(pid + nraw) : NULL;
+    nan_acc nacc = { NULL, 0, 0 };
+    sampler sp;
+    int rc = -1, cancelled = 0, have_sp = 0;
     const char *why = "out of memory building the mesh";
     api_status why_status = API_ERR_NOMEM;
-    if (!raw.pos || !raw.nrm || !raw.detj || !up || !vof || !pid || !live)
+    if (!blk || !up) {
+        block_put(up);
+        up = NULL;
         goto done;
+    }
+    out->pos = blk;
+    out->nrm = blk + 3 * nraw;
+    out->detj = blk + 6 * nraw;
+    out->weld = (uint32_t *)(blk + 7 * nraw);
+    out->tri = out->weld + nraw;
+    samples raw = { out->pos, out->nrm, out->detj,
+                    { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY }, 0 };
 
-    /* 1. Faces. */
-    for (int a = 0; a < 3; a++) {
-        int r = sample_faces(sol, &faces[2 * a], res, cancel, &raw);
-        if (r) {
-            cancelled = r > 0;
-            goto done;
-        }
+    /* 1. Faces: positions now, derivatives after step 3 where a face keeps a triangle. */
+    if (sampler_init(&sp, sol, res))
+        goto done;
+    have_sp = 1;
+    if (sample_faces(&sp, faces, res, NULL, cancel, &raw)) {
+        cancelled = 1;
+        goto done;
     }
     if (raw.bad) {
         why = "the solid's coordinates exceed the range of float32; no mesh can hold them";
@@ -322,83 +567,110 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         lo[k] = raw.lo[k], hi[k] = raw.hi[k];
     const double extent = fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
     const double eps = extent > 0 ? 1e-6 * extent : 1e-30;
+    const float epsf = (float)eps;
+    float *restrict P = out->pos;
 
     /* 2. Join: the cube's edges by the lattice; collapsed rows and seams where the map joins them. */
     for (size_t i = 0; i < nraw; i++)
         up[i] = (uint32_t)i;
     for (int fi = 0; fi < 6; fi++) {
         const face *f = &faces[fi];
+        const size_t na = f->na, nb = f->nb;
         int o[2];
         face_axes(f, o);
         size_t ijk[3];
         ijk[f->axis] = f->side ? res[f->axis] - 1 : 0;
-        for (size_t b = 0; b < f->nb; b++)
-            for (size_t a = 0; a < f->na; a++) {
-                const uint32_t i = (uint32_t)(f->base + b * f->na + a);
-                const float *p = raw.pos + 3 * i;
-                if (a + 1 < f->na && near(p, p + 3, eps))
-                    join(up, i, i + 1);
-                if (b + 1 < f->nb && near(p, p + 3 * f->na, eps))
-                    join(up, i, (uint32_t)(i + f->na));
-                if (a > 0 && a + 1 < f->na && b > 0 && b + 1 < f->nb)
-                    continue;
+        for (size_t b = 0; b < nb; b++) {
+            const uint32_t row = (uint32_t)(f->base + b * na);
+            const float *p = P + 3 * (size_t)row;
+            /* along the row, then to the next row */
+            join_near(up, p, p + 3, row, row + 1, na - 1, epsf);
+            if (b + 1 < nb)
+                join_near(up, p, p + 3 * na, row, (uint32_t)(row + na), na, epsf);
+            /* the neighbouring faces this row's samples lie on: its ends, or all of an edge row */
+            const int edge_row = b == 0 || b + 1 == nb;
+            for (size_t a = 0; a < na; a += edge_row || a + 1 == na ? 1 : na - 1) {
                 ijk[o[0]] = a, ijk[o[1]] = b;
-                for (int e = 0; e < 3; e++)    /* the neighbouring faces this sample lies on */
+                for (int e = 0; e < 3; e++)
                     if (e != f->axis && (ijk[e] == 0 || ijk[e] == res[e] - 1))
-                        join(up, i, (uint32_t)face_sample(&faces[2 * e + (ijk[e] != 0)], ijk));
+                        join(up, row + (uint32_t)a, (uint32_t)face_sample(&faces[2 * e + (ijk[e] != 0)], ijk));
             }
+        }
     }
     size_t seams[3] = { 0, 0, 0 };   /* samples of opposite faces joined, per axis */
     for (int a = 0; a < 3; a++) {
         const face *f0 = &faces[2 * a], *f1 = &faces[2 * a + 1];
-        for (size_t k = 0; k < f0->na * f0->nb; k++)
-            if (near(raw.pos + 3 * (f0->base + k), raw.pos + 3 * (f1->base + k), eps))
-                join(up, (uint32_t)(f0->base + k), (uint32_t)(f1->base + k)), seams[a]++;
+        const float *p0 = P + 3 * f0->base, *p1 = P + 3 * f1->base;
+        const size_t n = f0->na * f0->nb;
+        seams[a] = join_near(up, p0, p1, (uint32_t)f0->base, (uint32_t)f1->base, n, epsf);
     }
-    for (size_t i = 0; i < nraw; i++)
-        up[i] = find(up, (uint32_t)i);
+    /* Roots; a joined sample takes its root's position, so that every copy of a point is the same
+     * bits (the root, the least sample, is settled before any other of its set). */
+    for (size_t i = 0; i < nraw; i++) {
+        const uint32_t r = up[up[i]];   /* up[i] < i is a root already, or points at one */
+        up[i] = r;
+        if (r == i) {
+            flag[i] = 0;
+            continue;
+        }
+        flag[i] = SHARED;
+        flag[r] |= SHARED;
+        vof[r] = pid[r] = UINT32_MAX;
+        memcpy(P + 3 * i, P + 3 * (size_t)r, 3 * sizeof *P);
+    }
     if (stopped(cancel)) {
         cancelled = 1;
         goto done;
     }
 
-    /* 3. Triangles that collapse go; so do the cells of opposite faces that coincide. */
+    /* 3. Triangles that collapse go; so do the cells of opposite faces that coincide: first those whose
+     * corners are the opposite cell's points (the same positions, wound the other way: their volumes
+     * would cancel exactly), then any with the same three points in another order. */
     const double tiny = 1e-12 * extent * extent, tiny2 = tiny * tiny;
-    size_t t = 0, ntri = 0;
+    size_t ftri[6] = { 0 };   /* each face's live triangles */
     double vol = 0.0;   /* six times the enclosed volume, over the live triangles */
     for (int fi = 0; fi < 6; fi++) {
         const face *f = &faces[fi];
+        if (seams[f->axis] == f->na * f->nb)
+            continue;   /* every sample is its opposite's: every cell coincides with the opposite one (below) */
         const double sgn = f->reverse ? -1.0 : 1.0;
+        /* the opposite face's samples, where the two may coincide */
+        const ptrdiff_t opp = seams[f->axis] >= 3 ? (ptrdiff_t)faces[fi ^ 1].base - (ptrdiff_t)f->base : 0;
         for (size_t b = 0; b + 1 < f->nb; b++) {
-            const uint32_t *restrict u0 = up + f->base + b * f->na, *restrict u1 = u0 + f->na;
-            for (size_t a = 0; a + 1 < f->na; a++, t += 2) {
-                double n[2][3], v[2];
-                cell_normals(raw.pos, f->base + b * f->na + a, f->na, sgn, n, v);
+            const size_t row = f->base + b * f->na;
+            const uint32_t *restrict u0 = up + row, *restrict u1 = u0 + f->na;
+            const uint32_t *o0 = u0 + opp, *o1 = u1 + opp;
+            uint8_t *restrict fl = flag + row;
+            for (size_t a = 0; a + 1 < f->na; a++) {
                 const uint32_t r00 = u0[a], r10 = u0[a + 1], r01 = u1[a], r11 = u1[a + 1];
                 /* both triangles hold v00 and v11: (v00, v10, v11) and (v00, v11, v01), either winding */
                 const int diag = r00 != r11;
-                live[t] = diag && r10 != r00 && r10 != r11 && n[0][0] * n[0][0] + n[0][1] * n[0][1] + n[0][2] * n[0][2] > tiny2;
-                live[t + 1] = diag && r01 != r00 && r01 != r11 && n[1][0] * n[1][0] + n[1][1] * n[1][1] + n[1][2] * n[1][2] > tiny2;
-                if (live[t])
-                    vol += v[0], ntri++;
-                if (live[t + 1])
-                    vol += v[1], ntri++;
+                const int c0 = diag && r10 != r00 && r10 != r11, c1 = diag && r01 != r00 && r01 != r11;
+                if (!(c0 | c1))
+                    continue;
+                if (opp && r00 == o0[a] && r10 == o0[a + 1] && r01 == o1[a] && r11 == o1[a + 1])
+                    continue;
+                const unsigned live = cell_live(P, row + a, f->na, sgn, tiny2, (unsigned)c0 | (unsigned)c1 << 1, &vol);
+                if (!live)
+                    continue;
+                /* bits 0, 1 -> LIVE0, LIVE1; the corners the live triangles use */
+                fl[a] |= (uint8_t)(live * LIVE0 | USED), fl[a + f->na + 1] |= USED;
+                fl[a + 1] |= (uint8_t)(live & 1 ? USED : 0), fl[a + f->na] |= (uint8_t)(live & 2 ? USED : 0);
+                ftri[fi] += (live & 1) + (live >> 1);
             }
         }
     }
+    int reused[3] = { 0, 0, 0 };   /* the axes whose faces lost triangles here: their USED flags are stale */
     for (int a = 0; a < 3; a++) {
         const face *f0 = &faces[2 * a], *f1 = &faces[2 * a + 1];
-        if (seams[a] < 3)
+        if (seams[a] < 3 || !ftri[2 * a] || !ftri[2 * a + 1])
             continue;   /* no triangle of one lies on the other */
-        size_t first0 = 0;    /* the faces' first triangles */
-        for (int fi = 0; fi < 2 * a; fi++)
-            first0 += 2 * (faces[fi].na - 1) * (faces[fi].nb - 1);
-        const size_t first1 = first0 + 2 * (f0->na - 1) * (f0->nb - 1);
         for (size_t b = 0; b + 1 < f0->nb; b++)
             for (size_t c = 0; c + 1 < f0->na; c++)
                 for (int q = 0; q < 2; q++) {
-                    const size_t k = 2 * (b * (f0->na - 1) + c) + (size_t)q;
-                    if (!live[first0 + k] || !live[first1 + k])
+                    const uint8_t bit = q ? LIVE1 : LIVE0;
+                    uint8_t *l0 = flag + f0->base + b * f0->na + c, *l1 = flag + f1->base + b * f1->na + c;
+                    if (!(*l0 & bit) || !(*l1 & bit))
                         continue;
                     uint32_t s0[3], s1[3], r0[3], r1[3];
                     cell_tri(f0, c, b, q, s0);
@@ -406,145 +678,206 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                     for (int i = 0; i < 3; i++)
                         s0[i] = up[s0[i]], s1[i] = up[s1[i]];
                     if (sorted(s0, r0) != sorted(s1, r1) && memcmp(r0, r1, sizeof r0) == 0) {
-                        live[first0 + k] = live[first1 + k] = 0;
+                        *l0 &= (uint8_t)~bit;
+                        *l1 &= (uint8_t)~bit;
+                        reused[a] = 1;
                         double n[2][3], v0[2], v1[2];
-                        cell_normals(raw.pos, f0->base + b * f0->na + c, f0->na, f0->reverse ? -1.0 : 1.0, n, v0);
-                        cell_normals(raw.pos, f1->base + b * f1->na + c, f1->na, f1->reverse ? -1.0 : 1.0, n, v1);
+                        cell_normals(P, f0->base + b * f0->na + c, f0->na, f0->reverse ? -1.0 : 1.0, n, v0);
+                        cell_normals(P, f1->base + b * f1->na + c, f1->na, f1->reverse ? -1.0 : 1.0, n, v1);
                         vol -= v0[q] + v1[q];
-                        ntri -= 2;
+                        ftri[2 * a]--, ftri[2 * a + 1]--;
                     }
                 }
     }
 
+    /* 1, continued: x_a x x_b and det J on the faces that keep a triangle. */
+    if (sample_faces(&sp, faces, res, ftri, cancel, &raw)) {
+        cancelled = 1;
+        goto done;
+    }
+
     /* 4. Outward: the enclosed volume (summed in 3) must be positive. */
     const int flip = vol < 0.0;
+    const size_t ntri = ftri[0] + ftri[1] + ftri[2] + ftri[3] + ftri[4] + ftri[5];
 
-    /* 5. Vertices, (point, face) pairs, made in the order the face's triangles first use them, at the
-     * sample that first does; a second sample of the face at the vertex's point makes it a collapsed
-     * row's point, whose normal comes from its triangles. */
-    out->pos = malloc(3 * nraw * sizeof *out->pos);
-    out->nrm = malloc(3 * nraw * sizeof *out->nrm);
-    out->detj = malloc(nraw * sizeof *out->detj);
-    out->weld = malloc(nraw * sizeof *out->weld);
-    out->tri = malloc((3 * ntri + 1) * sizeof *out->tri);
-    vsam = malloc(nraw * sizeof *vsam);
-    if (!out->pos || !out->nrm || !out->detj || !out->weld || !out->tri || !vsam)
-        goto done;
-    memset(pid, 0xff, nraw * sizeof *pid);
-    size_t nv = 0, npos = 0, k3 = 0, tri_of[7] = { 0 };
-    int has_nan[6] = { 0 };
-    t = 0;
+    /* 5. Vertices, (point, face) pairs, face by face in sample order, each at the first sample of the
+     * face that a live triangle uses, packed down over the samples; then the face's triangles. A point
+     * the face samples twice (a collapsed row's) takes its triangles' normal, as does one where
+     * x_a x x_b vanishes. */
+    size_t nv = 0, npos = 0, k3 = 0;
+    float lo12[12], hi12[12], sum12[12];   /* the vertices' bounds (row_bounds) */
+    for (int l = 0; l < 12; l++)
+        lo12[l] = INFINITY, hi12[l] = -INFINITY, sum12[l] = 0.0f;
+    float *restrict N = out->nrm, *restrict J = out->detj;
+    uint32_t *restrict W = out->weld, *restrict T = out->tri;
     for (int fi = 0; fi < 6; fi++) {
         if (stopped(cancel)) {
             cancelled = 1;
             goto done;
         }
         const face *f = &faces[fi];
-        const size_t end = f->base + f->na * f->nb, first = nv;
+        if (!ftri[fi])
+            continue;   /* collapsed, or cancelled by its opposite: no vertex */
+        const size_t na = f->na, end = f->base + na * f->nb;
+        const uint32_t first = (uint32_t)nv;
         const double sgn = (f->reverse ? -1.0 : 1.0) * (flip ? -1.0 : 1.0);
-        for (size_t k = f->base; k < end; k++)
-            vof[up[k]] = UINT32_MAX;
-        uint32_t off[2][3];   /* the corners of a cell's triangles, from its v00, as wound in the mesh */
-        for (int q = 0; q < 2; q++) {
-            cell_tri(f, 0, 0, q, off[q]);
-            for (int i = 0; i < 3; i++)
-                off[q][i] -= (uint32_t)f->base;
-            if (flip) {
-                const uint32_t x = off[q][1];
-                off[q][1] = off[q][2], off[q][2] = x;
+        /* the samples the live triangles use, again where step 3 dropped some */
+        if (reused[f->axis])
+            for (size_t k = f->base; k < end; k++)
+                flag[k] &= (uint8_t)~USED;
+        for (size_t b = 0; reused[f->axis] && b + 1 < f->nb; b++) {
+            uint8_t *restrict fl = flag + f->base + b * na;
+            for (size_t a = 0; a + 1 < na; a++) {
+                const uint8_t c = fl[a];
+                if (!(c & (LIVE0 | LIVE1)))
+                    continue;
+                fl[a] |= USED, fl[a + na + 1] |= USED;
+                if (c & LIVE0)
+                    fl[a + 1] |= USED;
+                if (c & LIVE1)
+                    fl[a + na] |= USED;
             }
         }
-        for (size_t b = 0; b + 1 < f->nb; b++)
-            for (size_t a = 0; a + 1 < f->na; a++)
-                for (int q = 0; q < 2; q++, t++) {
-                    if (!live[t])
-                        continue;
-                    const uint32_t v00 = (uint32_t)(f->base + b * f->na + a);
-                    const uint32_t s[3] = { v00 + off[q][0], v00 + off[q][1], v00 + off[q][2] };
-                    for (int i = 0; i < 3; i++) {
-                        const uint32_t r = up[s[i]];
-                        if (vof[r] == UINT32_MAX) {
-                            const uint32_t v = (uint32_t)nv++, k = s[i];
-                            vof[r] = v;
-                            vsam[v] = k;
-                            if (pid[r] == UINT32_MAX)
-                                pid[r] = (uint32_t)npos++;
-                            out->weld[v] = pid[r];
-                            memcpy(out->pos + 3 * v, raw.pos + 3 * r, 3 * sizeof(float));
-                            out->detj[v] = raw.detj[k];
-                            const float *n = raw.nrm + 3 * k;
-                            const double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-                            has_nan[fi] |= !(len > tiny);
-                            for (int c = 0; c < 3; c++)
-                                out->nrm[3 * v + c] = len > tiny ? (float)(sgn * n[c] / len) : NAN;
-                        }
-                        out->tri[k3++] = vof[r];
-                    }
-                }
+        /* how many samples of the face each shared root has */
+        for (size_t k = f->base; k < end; k++)
+            if (flag[k] & SHARED) {
+                const uint32_t r = up[k];
+                vof[r] = vof[r] == TAG1(fi) || vof[r] == TAG2(fi) ? TAG2(fi) : TAG1(fi);
+            }
+        const size_t nacc0 = nacc.n;
         for (size_t k = f->base; k < end; k++) {
-            const uint32_t v = vof[up[k]];
-            if (v != UINT32_MAX && v >= first && vsam[v] != k)
-                out->nrm[3 * v] = NAN, has_nan[fi] = 1;
+            const uint8_t c = flag[k];
+            uint32_t v;
+            int twice = 0;
+            if (!(c & SHARED)) {
+                if (!(c & USED))
+                    continue;
+                v = (uint32_t)nv++;
+                W[v] = (uint32_t)npos++;
+            } else {
+                const uint32_t r = up[k], at = vof[r];
+                const int made = at >= first && at < TAGMIN;
+                if (!(c & USED)) {
+                    if (made && mark_nan(N, at, &nacc))
+                        goto done;
+                    continue;
+                }
+                if (made) {   /* a second sample of the face at the vertex's point */
+                    up[k] = at;
+                    if (mark_nan(N, at, &nacc))
+                        goto done;
+                    continue;
+                }
+                twice = at == TAG2(fi);
+                v = (uint32_t)nv++;
+                vof[r] = v;
+                if (pid[r] == UINT32_MAX)
+                    pid[r] = (uint32_t)npos++;
+                W[v] = pid[r];
+            }
+            up[k] = v;
+            /* the sample's data down to the vertex (v <= k) */
+            const float *p = P + 3 * k, *n = N + 3 * k;
+            const double nx = n[0], ny = n[1], nz = n[2], len = sqrt(nx * nx + ny * ny + nz * nz);
+            P[3 * v] = p[0], P[3 * v + 1] = p[1], P[3 * v + 2] = p[2];
+            J[v] = J[k];
+            if (len > tiny) {
+                const double s = sgn / len;
+                N[3 * v] = (float)(s * nx), N[3 * v + 1] = (float)(s * ny), N[3 * v + 2] = (float)(s * nz);
+            } else {
+                N[3 * v] = 0.0f;   /* not NaN yet: mark_nan's test */
+                twice = 1;
+            }
+            if (twice) {
+                flag[k] |= NANV;
+                if (mark_nan(N, v, &nacc))
+                    goto done;
+            }
         }
-        tri_of[fi + 1] = k3 / 3;
+        row_bounds(P + 3 * (size_t)first, 3 * (nv - first), lo12, hi12, sum12);
+        /* the face's triangles, as wound in the mesh: corners 0-3 of a cell are v00, v10, v01, v11 */
+        unsigned char ci[2][3];
+        for (int q = 0; q < 2; q++) {
+            uint32_t t[3];
+            cell_tri(f, 0, 0, q, t);
+            for (int i = 0; i < 3; i++) {
+                const uint32_t o = t[i] - (uint32_t)f->base;   /* 0, 1, na or na + 1 */
+                ci[q][i] = (unsigned char)((o >= na ? 2 : 0) + (o == 1 || o == na + 1));
+            }
+            if (flip) {
+                const unsigned char x = ci[q][1];
+                ci[q][1] = ci[q][2], ci[q][2] = x;
+            }
+        }
+        /* a corner's vertex may have a NaN normal where its sample is joined (SHARED) or was marked (NANV) */
+        const uint8_t maybe_nan = nacc.n > nacc0 ? SHARED | NANV : 0;
+        for (size_t b = 0; b + 1 < f->nb; b++) {
+            const size_t row = f->base + b * na;
+            const uint8_t *restrict fl = flag + row;
+            const uint32_t *restrict u = up + row;
+            for (size_t a = 0; a + 1 < na; a++) {
+                const uint8_t c = fl[a];
+                if (!(c & (LIVE0 | LIVE1)))
+                    continue;
+                const uint32_t w[4] = { u[a], u[a + 1], u[a + na], u[a + na + 1] };
+                const uint32_t *t = T + k3;
+                if (c & LIVE0)
+                    T[k3] = w[ci[0][0]], T[k3 + 1] = w[ci[0][1]], T[k3 + 2] = w[ci[0][2]], k3 += 3;
+                if (c & LIVE1)
+                    T[k3] = w[ci[1][0]], T[k3 + 1] = w[ci[1][1]], T[k3 + 2] = w[ci[1][2]], k3 += 3;
+                if (!((c | fl[a + 1] | fl[a + na] | fl[a + na + 1]) & maybe_nan))
+                    continue;
+                for (; t < T + k3; t += 3) {
+                    if (!isnan(N[3 * t[0]]) && !isnan(N[3 * t[1]]) && !isnan(N[3 * t[2]]))
+                        continue;
+                    double e1[3], e2[3], n[3];
+                    for (int i = 0; i < 3; i++) {
+                        e1[i] = (double)P[3 * t[1] + i] - P[3 * t[0] + i];
+                        e2[i] = (double)P[3 * t[2] + i] - P[3 * t[0] + i];
+                    }
+                    cross(e1, e2, n);
+                    for (int i = 0; i < 3; i++)
+                        if (isnan(N[3 * t[i]])) {
+                            uint32_t j;
+                            memcpy(&j, &N[3 * t[i] + 1], 4);
+                            for (int c2 = 0; c2 < 3; c2++)
+                                nacc.acc[3 * j + c2] += n[c2];
+                        }
+                }
+            }
+        }
+        const int any_nan = nacc.n > nacc0;
+        /* the area-weighted normals of the face's marked vertices */
+        if (any_nan)
+            for (uint32_t v = first; v < nv; v++)
+                if (isnan(N[3 * v])) {
+                    uint32_t j;
+                    memcpy(&j, &N[3 * v + 1], 4);
+                    const double *n = nacc.acc + 3 * j, len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+                    for (int c2 = 0; c2 < 3; c2++)
+                        N[3 * v + c2] = len > 0 ? (float)(n[c2] / len) : (c2 == 2 ? 1.0f : 0.0f);
+                }
     }
-    /* Area-weighted normals for the vertices marked NaN, from their faces' triangles. */
-    acc = calloc(3 * nv + 1, sizeof *acc);
-    if (!acc)
-        goto done;
-    for (int fi = 0; fi < 6; fi++)
-        for (size_t tt = has_nan[fi] ? tri_of[fi] : tri_of[fi + 1]; tt < tri_of[fi + 1]; tt++) {
-            const uint32_t *w = &out->tri[3 * tt];
-            if (!isnan(out->nrm[3 * w[0]]) && !isnan(out->nrm[3 * w[1]]) && !isnan(out->nrm[3 * w[2]]))
-                continue;
-            double n[3];
-            tri_normal(out->pos + 3 * w[0], out->pos + 3 * w[1], out->pos + 3 * w[2], n);
-            for (int i = 0; i < 3; i++)
-                for (int c = 0; c < 3; c++)
-                    acc[3 * w[i] + c] += n[c];
-        }
     for (int c = 0; c < 3; c++)
         out->min[c] = INFINITY, out->max[c] = -INFINITY;
-    for (size_t v = 0; v < nv; v++) {
-        if (isnan(out->nrm[3 * v])) {
-            const double *n = acc + 3 * v, len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            for (int c = 0; c < 3; c++)
-                out->nrm[3 * v + c] = len > 0 ? (float)(n[c] / len) : (c == 2 ? 1.0f : 0.0f);
-        }
-        for (int c = 0; c < 3; c++) {
-            const float x = out->pos[3 * v + c];
-            out->min[c] = x < out->min[c] ? x : out->min[c];
-            out->max[c] = x > out->max[c] ? x : out->max[c];
-        }
+    for (int l = 0; l < 12; l++) {
+        out->min[l % 3] = lo12[l] < out->min[l % 3] ? lo12[l] : out->min[l % 3];
+        out->max[l % 3] = hi12[l] > out->max[l % 3] ? hi12[l] : out->max[l % 3];
     }
     out->nverts = nv;
     out->ntris = ntri;
     out->npos = npos;
-    /* Down to what is used (realloc to a smaller size keeps the block where it cannot move it). */
-    float *p;
-    uint32_t *w;
-    if ((p = realloc(out->pos, (3 * nv + 1) * sizeof *p)))
-        out->pos = p;
-    if ((p = realloc(out->nrm, (3 * nv + 1) * sizeof *p)))
-        out->nrm = p;
-    if ((p = realloc(out->detj, (nv + 1) * sizeof *p)))
-        out->detj = p;
-    if ((w = realloc(out->weld, (nv + 1) * sizeof *w)))
-        out->weld = w;
     rc = 0;
 done:
     if (rc) {
+        if (!out->pos)
+            block_put(blk);
         api_mesh_free(out);
         api_fail(err, cancelled ? API_ERR_CANCELLED : why_status, "", "%s", cancelled ? "cancelled" : why);
     }
-    free(raw.pos);
-    free(raw.nrm);
-    free(raw.detj);
-    free(up);
-    free(vof);
-    free(pid);
-    free(live);
-    free(acc);
-    free(vsam);
+    block_put(up);
+    free(nacc.acc);
+    if (have_sp)
+        sampler_free(&sp);
     return rc;
 }

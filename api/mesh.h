@@ -37,11 +37,20 @@ typedef struct {
  * (out zeroed). cancel (NULL: never) is polled between rows of the faces and
  * every few thousand points or triangles of the later passes; when it stops,
  * everything is freed and err has status API_ERR_CANCELLED. Memory peaks
- * at about 120 bytes per face sample, 6 res^2 samples in all: about 48 MB at
- * res 256 (api/cost.h estimates it).
+ * at about 70 bytes per face sample, 6 res^2 samples in all: about 28 MB at
+ * res 256 (api/cost.h estimates it); the mesh keeps 56 of them until freed.
+ * Vertices come face by face in sample order (u fastest, then v, then w).
+ *
+ * Thread-safe: builds may run on any threads at once. Their memory is two
+ * blocks, the mesh's and a build's scratch, which api_mesh_free and the end
+ * of a build keep for the next build (two blocks per process, each at most
+ * 64 MB), since fresh pages cost a page fault each.
  */
 int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_mesh *out,
                    api_error *err);
+/* Gives the mesh's block back for the next build; NULL or a zeroed mesh does nothing. */
 void api_mesh_free(api_mesh *m);
+/* Frees the blocks kept for the next build (at exit, or to hand memory back to the system). */
+void api_mesh_release_spares(void);
 
 #endif

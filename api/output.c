@@ -525,9 +525,13 @@ long api_output_read(api_output *o, char *buf, size_t max)
             if (done)
                 break;      /* one piece of work per call: a caller can poll between calls */
             o->pos = o->len = 0;
+            o->dst = buf, o->dst_max = max, o->dst_len = 0;   /* fill may write straight into buf */
             int r = o->fmt->fill(o);
+            o->dst = NULL;
             if (r < 0)
                 return -1;
+            if (o->dst_len)
+                return (long)o->dst_len;
             if (r > 0 && o->pos == o->len)
                 break;
         }

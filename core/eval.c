@@ -8,6 +8,10 @@
 #include <math.h>
 #include <stdlib.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "internal.h"
 
 void pde_eval_d(const pde_solution *sol, double u, double v, double w,
@@ -250,6 +254,29 @@ static void emit1(float *restrict out, size_t nu, const double *restrict tab, co
 static void emit(float *out, size_t nu, const double *const tab[3], const double *const k[3],
                  const size_t nd[3])
 {
+    if (nd[0] == 1 && nd[1] == 1 && nd[2] == 1) {   /* emit1's case 1 for the three at once */
+        const double k0 = k[0][0], k1 = k[1][0], k2 = k[2][0];
+        const double *restrict t0 = tab[0], *restrict t1 = tab[1], *restrict t2 = tab[2];
+        float *restrict o = out;
+        size_t i = 0;
+#if defined(__SSE2__)
+        /* two points a step: the same products, rounded to float as below, interleaved */
+        const __m128d K0 = _mm_set1_pd(k0), K1 = _mm_set1_pd(k1), K2 = _mm_set1_pd(k2);
+        for (; i + 2 <= nu; i += 2) {
+            const __m128 x = _mm_cvtpd_ps(_mm_mul_pd(K0, _mm_loadu_pd(t0 + i)));
+            const __m128 y = _mm_cvtpd_ps(_mm_mul_pd(K1, _mm_loadu_pd(t1 + i)));
+            const __m128 z = _mm_cvtpd_ps(_mm_mul_pd(K2, _mm_loadu_pd(t2 + i)));
+            const __m128 xy = _mm_unpacklo_ps(x, y);                                   /* x0 y0 x1 y1 */
+            const __m128 zx = _mm_shuffle_ps(z, xy, _MM_SHUFFLE(2, 2, 0, 0));          /* z0 z0 x1 x1 */
+            const __m128 yz = _mm_shuffle_ps(xy, z, _MM_SHUFFLE(1, 1, 3, 3));          /* y1 y1 z1 z1 */
+            _mm_storeu_ps(o + 3 * i, _mm_shuffle_ps(xy, zx, _MM_SHUFFLE(2, 0, 1, 0))); /* x0 y0 z0 x1 */
+            _mm_storel_pi((__m64 *)(void *)(o + 3 * i + 4), _mm_shuffle_ps(yz, yz, _MM_SHUFFLE(0, 0, 2, 0)));
+        }
+#endif
+        for (; i < nu; i++)
+            o[3 * i] = (float)(k0 * t0[i]), o[3 * i + 1] = (float)(k1 * t1[i]), o[3 * i + 2] = (float)(k2 * t2[i]);
+        return;
+    }
     for (int c = 0; c < 3; c++)
         emit1(out + c, nu, tab[c], k[c], nd[c]);
 }
@@ -280,6 +307,7 @@ static inline float dot_k(const double *k, size_t ks, const double *t, size_t ts
 static void grid_cols(pde_grid *g, size_t j0, size_t j1, float *const outs[4])
 {
     const size_t nu = g->nu, nv = g->nv, n = j1 - j0;
+    const int xonly = !outs[1] && !outs[2] && !outs[3];   /* kv, kw unused */
     for (int c = 0; c < 3; c++) {
         const size_t nd = g->nd[c], nm = g->nm[c];
         double *restrict kx = g->col, *restrict kv = kx + nd * n, *restrict kw = kv + nd * n;
@@ -294,12 +322,15 @@ static void grid_cols(pde_grid *g, size_t j0, size_t j1, float *const outs[4])
                         continue;
                     const double h = g->h[c][m], dh = g->dh[c][m];
                     const double *restrict p = g->psi[c] + m * nv + j0 + jb, *restrict dp = g->dpsi[c] + m * nv + j0 + jb;
-                    if (nb == BLK) {
+                    if (nb == BLK && !xonly) {
                         for (size_t j = 0; j < BLK; j++) {
                             ax[j] += h * p[j];
                             av[j] += h * dp[j];
                             aw[j] += dh * p[j];
                         }
+                    } else if (nb == BLK) {   /* positions only: x's coefficients alone */
+                        for (size_t j = 0; j < BLK; j++)
+                            ax[j] += h * p[j];
                     } else {
                         for (size_t j = 0; j < nb; j++) {
                             ax[j] += h * p[j];
@@ -308,8 +339,9 @@ static void grid_cols(pde_grid *g, size_t j0, size_t j1, float *const outs[4])
                         }
                     }
                 }
-                for (size_t j = 0; j < nb; j++) {
+                for (size_t j = 0; j < nb; j++)
                     kx[d * n + jb + j] = ax[j];
+                for (size_t j = 0; j < nb && !xonly; j++) {
                     kv[d * n + jb + j] = av[j];
                     kw[d * n + jb + j] = aw[j];
                 }
@@ -323,11 +355,23 @@ static void grid_cols(pde_grid *g, size_t j0, size_t j1, float *const outs[4])
             const double *restrict k = ks[q], *restrict t = tab[q];
             switch (nd) {   /* dot_k's cases, the switch out of the loop */
             case 1:
+                if (nu == 2) {   /* faces u = 0, 1: both columns at once */
+                    const double t0 = t[0], t1 = t[1];
+                    for (size_t j = 0; j < n; j++)
+                        o[6 * j + c] = (float)(k[j] * t0), o[6 * j + 3 + c] = (float)(k[j] * t1);
+                    break;
+                }
                 for (size_t j = 0; j < n; j++)
                     for (size_t i = 0; i < nu; i++)
                         o[3 * (j * nu + i) + c] = (float)(k[j] * t[i]);
                 break;
             case 2:
+                if (nu == 2) {
+                    const double t0 = t[0], t1 = t[1], u0 = t[2], u1 = t[3];
+                    for (size_t j = 0; j < n; j++)
+                        o[6 * j + c] = (float)(k[j] * t0 + k[n + j] * u0), o[6 * j + 3 + c] = (float)(k[j] * t1 + k[n + j] * u1);
+                    break;
+                }
                 for (size_t j = 0; j < n; j++)
                     for (size_t i = 0; i < nu; i++)
                         o[3 * (j * nu + i) + c] = (float)(k[j] * t[i] + k[n + j] * t[nu + i]);

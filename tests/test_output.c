@@ -736,6 +736,84 @@ static void every_skin_should_be_closed_with_normals_and_det_j_from_the_closed_f
     }
 }
 
+/* The mesh's memory is kept for the next build (mesh.h): a mesh built into kept blocks, while another
+ * still holds one, of another size, or after the blocks are released, is the same mesh, bit for bit. */
+static void mesh_build_should_give_the_same_mesh_in_kept_and_fresh_memory(void **state)
+{
+    (void)state;
+    pde_solution *sol = solve_preset("fig4a", NULL);
+    const unsigned res[3] = { 20, 28, 24 }, small[3] = { 6, 5, 4 };
+    api_mesh a, b, c, d;
+    api_mesh_release_spares();
+    assert_int_equal(api_mesh_build(sol, res, NULL, &a, NULL), 0);   /* fresh */
+    assert_int_equal(api_mesh_build(sol, small, NULL, &c, NULL), 0);  /* while a is held */
+    api_mesh_free(&c);
+    assert_int_equal(api_mesh_build(sol, res, NULL, &b, NULL), 0);    /* into c's kept block: too small */
+    assert_int_equal(api_mesh_build(sol, small, NULL, &c, NULL), 0);
+    api_mesh_free(&b);
+    assert_int_equal(api_mesh_build(sol, res, NULL, &d, NULL), 0);    /* into b's kept block */
+    api_mesh_release_spares();
+    for (const api_mesh *m = &d;; m = &b) {
+        assert_int_equal(m->nverts, a.nverts);
+        assert_int_equal(m->ntris, a.ntris);
+        assert_int_equal(m->npos, a.npos);
+        assert_memory_equal(m->pos, a.pos, 3 * a.nverts * sizeof *a.pos);
+        assert_memory_equal(m->nrm, a.nrm, 3 * a.nverts * sizeof *a.nrm);
+        assert_memory_equal(m->detj, a.detj, a.nverts * sizeof *a.detj);
+        assert_memory_equal(m->weld, a.weld, a.nverts * sizeof *a.weld);
+        assert_memory_equal(m->tri, a.tri, 3 * a.ntris * sizeof *a.tri);
+        assert_memory_equal(m->min, a.min, sizeof a.min);
+        assert_memory_equal(m->max, a.max, sizeof a.max);
+        if (m == &b)
+            break;
+        api_mesh_free(&d);
+        api_mesh_release_spares();
+        assert_int_equal(api_mesh_build(sol, res, NULL, &b, NULL), 0);   /* fresh again */
+    }
+    api_mesh_free(&a);
+    api_mesh_free(&b);
+    api_mesh_free(&c);
+    api_mesh_free(&c);   /* a freed mesh is zeroed: freeing it again does nothing */
+    api_mesh_release_spares();
+    pde_solution_free(sol);
+}
+
+/* The glb's blob is written straight into the reader's buffer (fmt.h's o->dst): the bytes must not depend on
+ * the buffer's size, down to 1 byte (smaller than a float) and odd sizes that split floats. */
+static void glb_should_be_the_same_bytes_whatever_the_reader_s_buffer(void **state)
+{
+    (void)state;
+    pde_solution *sol = solve_preset("fig4a", NULL);
+    const unsigned res[3] = { 9, 12, 7 };
+    const size_t sizes[] = { 65536, 1, 3, 5, 777, 4096 };
+    unsigned char *first = NULL;
+    size_t first_len = 0;
+    for (size_t s = 0; s < sizeof sizes / sizeof *sizes; s++) {
+        api_error err;
+        api_output *o = api_output_open(sol, "abc", NULL, API_FMT_GLB, res, NULL, &err);
+        assert_non_null(o);
+        const size_t cap = (size_t)api_output_size(o) + 65536;
+        unsigned char *buf = malloc(cap);
+        assert_non_null(buf);
+        size_t n = 0;
+        long got;
+        while ((got = api_output_read(o, (char *)buf + n, sizes[s] < cap - n ? sizes[s] : cap - n)) > 0)
+            n += (size_t)got;
+        assert_int_equal(got, 0);
+        assert_int_equal((long long)n, api_output_size(o));
+        api_output_free(o);
+        if (!first) {
+            first = buf, first_len = n;
+            continue;
+        }
+        assert_int_equal(n, first_len);
+        assert_memory_equal(buf, first, n);
+        free(buf);
+    }
+    free(first);
+    pde_solution_free(sol);
+}
+
 static void vts_should_hold_the_points_and_det_j(void **state)
 {
     (void)state;
@@ -1128,6 +1206,8 @@ int main(void)
         cmocka_unit_test(stl_skin_should_be_closed_and_enclose_the_computed_volume),
         cmocka_unit_test(every_skin_should_be_closed_with_normals_and_det_j_from_the_closed_form),
         cmocka_unit_test(narrow_grids_should_sample_the_same_bits_as_wide_ones),
+        cmocka_unit_test(mesh_build_should_give_the_same_mesh_in_kept_and_fresh_memory),
+        cmocka_unit_test(glb_should_be_the_same_bytes_whatever_the_reader_s_buffer),
         cmocka_unit_test(vts_should_hold_the_points_and_det_j),
         cmocka_unit_test(json_should_hold_the_closed_form_properties_and_id),
         cmocka_unit_test(every_output_with_properties_should_carry_each_of_them_by_name),
