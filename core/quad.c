@@ -822,7 +822,10 @@ static void plan_for(const pde_solution *s, double factors, int exact, qplan *p)
 void quad_panels(const pde_solution *s, int np[3], int n[3])
 {
     qplan p;
-    plan_for(s, 5.0, 1, &p);   /* the second moments times det J: five factors */
+    /* The second moments times det J: five factors. The panels of a solid whose det J may change
+     * sign (exact rules along a polynomial axis only once its sign is certified, quad_solid): an
+     * estimate made before the properties cannot know which (api/cost.c). */
+    plan_for(s, 5.0, 0, &p);
     memcpy(np, p.np, sizeof p.np);
     memcpy(n, p.n, sizeof p.n);
 }
