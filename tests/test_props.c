@@ -825,6 +825,8 @@ static void props_should_match_the_reference_quadrature_on_every_preset(void **s
         pde_props p;
         assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
         expect_props_match_reference(name, &p, r);
+        print_message("%s: surface_area %.3g off the reference\n", name,
+                      fabs(p.surface_area - r->surface_area) / r->surface_area);
         pde_solution_free(sol);
     }
     print_message("reference quadrature of %zu presets: %.2f s\n", api_preset_count(), mono_now() - t0);
