@@ -362,62 +362,11 @@ int api_out_vtk_field_data(api_output *o, const pde_props *props)
 
 /* ---- what must fit float32 ---- */
 
-/* Bounds over [0, 1] of |f| (b[0]) and |f'| (b[1]). */
-static void factor_bound(pde_factor f, double b[2])
-{
-    const double a = fabs(f.p);
-    switch (f.kind) {
-    case PDE_SIN:
-    case PDE_COS:
-        b[0] = 1.0, b[1] = a * M_PI;
-        return;
-    case PDE_EXP:
-        b[0] = fmax(1.0, exp(f.p)), b[1] = a * b[0];
-        return;
-    case PDE_SINH:
-        b[0] = sinh(a), b[1] = a * cosh(a);
-        return;
-    case PDE_COSH:
-        b[0] = cosh(a), b[1] = a * sinh(a);
-        return;
-    case PDE_POW:
-    default:
-        b[0] = 1.0, b[1] = a;
-        return;
-    }
-}
-
-/* Bounds of |h| (b[0]) and |h'| (b[1]) over [0, 1]: each slab's terms over the slab, as pde.h's pde_mode writes
- * them, exp(alpha (w - shift)) (A(w) cos(beta w) + B(w) sin(beta w)), with |w| <= 1. */
-static void h_bound(const pde_mode *m, double b[2])
-{
-    b[0] = b[1] = 0.0;
-    const size_t nslabs = m->nslabs && m->breaks && m->first ? m->nslabs : 1;
-    for (size_t s = 0; s < nslabs; s++) {
-        const double w0 = nslabs > 1 ? m->breaks[s] : 0.0, w1 = nslabs > 1 ? m->breaks[s + 1] : 1.0;
-        const size_t i0 = nslabs > 1 ? m->first[s] : 0, i1 = nslabs > 1 ? m->first[s + 1] : m->nterms;
-        double h = 0.0, dh = 0.0;
-        for (size_t i = i0; i < i1; i++) {
-            const pde_wterm *t = &m->terms[i];
-            double q0 = 0.0, q1 = 0.0;   /* |(A, B)(w)| and |(A, B)'(w)| */
-            for (int k = 0; k <= t->deg; k++) {
-                q0 += hypot(t->A[k], t->B[k]);
-                q1 += k * hypot(t->A[k], t->B[k]);
-            }
-            const double E = exp(t->alpha * ((t->alpha >= 0 ? w1 : w0) - t->shift));
-            h += E * q0;
-            dh += E * (q1 + (fabs(t->alpha) + fabs(t->beta)) * q0);
-        }
-        b[0] = fmax(b[0], h);
-        b[1] = fmax(b[1], dh);
-    }
-}
-
 /*
  * 0 if what format fi writes of the solid fits float32 everywhere on the cube (api_range), else -1 with a
- * document error naming what would overflow. Bounds of |x| and of |x_u|, |x_v|, |x_w| from the closed form:
- * each mode's largest |h| |f_u| |f_v| and derivatives, added up; the skin's normals are bounded by products of
- * two of those, det J by all three (Hadamard). Half of FLT_MAX leaves room for the rounding of what is
+ * document error naming what would overflow. Bounds of |x| and of |x_u|, |x_v|, |x_w| from the closed
+ * form (pde_solution_magnitudes); the skin's normals are bounded by products of two of those, det J by
+ * all three (Hadamard). Half of FLT_MAX leaves room for the rounding of what is
  * computed within the bound.
  */
 static int range_check(const pde_solution *sol, const api_format_info *fi, api_error *err)
@@ -425,22 +374,12 @@ static int range_check(const pde_solution *sol, const api_format_info *fi, api_e
     if (fi->range == API_RANGE_DOUBLES)
         return 0;
     const double limit = FLT_MAX / 2;
-    double x = 0.0, d[3][3] = { { 0 } };   /* d[c][a]: component c's derivative along u, v, w */
+    double mag[3][4], x = 0.0, d[3][3];   /* d[c][a]: component c's derivative along u, v, w */
+    pde_solution_magnitudes(sol, mag);
     for (int c = 0; c < 3; c++) {
-        size_t nm;
-        const pde_mode *md = pde_solution_modes(sol, c, &nm);
-        double xc = 0.0;
-        for (size_t i = 0; i < nm; i++) {
-            double fu[2], fv[2], h[2];
-            factor_bound(md[i].u, fu);
-            factor_bound(md[i].v, fv);
-            h_bound(&md[i], h);
-            xc += h[0] * fu[0] * fv[0];
-            d[c][0] += h[0] * fu[1] * fv[0];
-            d[c][1] += h[0] * fu[0] * fv[1];
-            d[c][2] += h[1] * fu[0] * fv[0];
-        }
-        x = fmax(x, isnan(xc) ? INFINITY : xc);
+        x = fmax(x, isnan(mag[c][0]) ? INFINITY : mag[c][0]);
+        for (int a = 0; a < 3; a++)
+            d[c][a] = mag[c][a + 1];
     }
     if (!(x <= limit))
         return api_fail(err, API_ERR_DOCUMENT, "", "the solid is too large for %s: its coordinates could reach "

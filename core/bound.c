@@ -320,6 +320,16 @@ double obj_magnitude(const pde_solution *s, int what)
     return t[0];
 }
 
+void pde_solution_magnitudes(const pde_solution *s, double mag[3][4])
+{
+    const pbox cube = { { 0, 0, 0 }, { 1, 1, 1 } };
+    xjet mx;
+    xjet_fill(s, &cube, 1, 1, -1, NULL, &mx);
+    for (int c = 0; c < 3; c++)
+        for (int q = 0; q < 4; q++)   /* the jets' order: x, x_u, x_v, x_w */
+            mag[c][q] = mx.d[c][q];
+}
+
 /* The half-widths of the partial derivatives' ranges over a box of radii r around the centre. */
 static void grad_spread(const obj_model *m, const double r[3], double spread[3])
 {

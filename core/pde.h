@@ -342,4 +342,12 @@ int pde_properties_flat_axis(const pde_solution *sol);
  * are 1-D along w; else -1 (for api/cost.h). */
 int pde_properties_free_axis(const pde_solution *sol);
 
+/*
+ * Bounds over the unit cube of |x_c| (mag[c][0]) and of |dx_c/du|, |dx_c/dv|, |dx_c/dw| (mag[c][1..3]),
+ * each a sum over the modes of products of their factors' bounds (core/bound.c): never below the true
+ * maximum (up to rounding), above it where modes cancel, inf or nan where a bound overflows. For
+ * deciding, before sampling, whether a solid fits a narrower type (api/output.c: float32). Cannot fail.
+ */
+void pde_solution_magnitudes(const pde_solution *sol, double mag[3][4]);
+
 #endif
