@@ -241,7 +241,11 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
     /* Where det J is constant along the separable face's other parameter, its branch and bound is
      * along w alone and closes its gap: a tenth of that (fig. 4a: 82 M -> 4.6 M instructions). */
     const int free_axis = pde_properties_free_axis(sol);
-    w += 2.0 * (free_axis >= 0 ? 0.05 : 0.5) * PDE_PROPS_BOXES_J * 2.5 * (2.0 * K_BOX_MODE * modes + K_BOX_J);
+    /* Its budget grows with the solid's fastest rate (fig. 3: 32000 boxes a side, of which 3k to 23k taken;
+     * on the face of a separable solid, 2-D boxes, fig. 3a and 3b: 3.3k to 16k). */
+    const double jboxes = (double)pde_properties_detj_boxes(sol);
+    const double jused = free_axis >= 0 ? 0.05 : pde_properties_flat_axis(sol) >= 0 ? 0.2 : 0.5;
+    w += 2.0 * jused * jboxes * 2.5 * (2.0 * K_BOX_MODE * modes + K_BOX_J);
     /* The integrals: lines through the panels' nodes, each node a few points (sampling, roots and
      * the rule on each piece where det J may change sign), each a multiply-add per mode from the
      * panel's factor tables (core/quad.c); refined panels, about K_REFINE times their own work,
@@ -275,9 +279,9 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
         w += rres * rres * rres * (st[i].d4 + 2.0 * st[i].d0 + 3.0 * (st[i].fu + st[i].fv));
     c->work = w;
     /* core/quad.c's factor tables: each axis's values and derivatives at up to 26 points per mode;
-     * core/bound.c's memo of factors (3 axes x 256 slots x 5 doubles per mode, up to 64 modes). */
-    c->bytes = grid_bytes(st, res, res) + 64.0 * (PDE_PROPS_BOXES + PDE_PROPS_BOXES_J) + 64.0 * modes + 65536.0 +
-               8.0 * (6.0 * 26.0 + 5.0) * (modes + 1.0) + (modes <= 64.0 ? 3.0 * 256.0 * 5.0 * 8.0 * modes : 0.0);
+     * core/bound.c's memo of factors (3 axes x 256 slots x 6 doubles per mode, up to 64 modes). */
+    c->bytes = grid_bytes(st, res, res) + 64.0 * (PDE_PROPS_BOXES + jboxes) + 64.0 * modes + 65536.0 +
+               8.0 * (6.0 * 26.0 + 5.0) * (modes + 1.0) + (modes <= 64.0 ? 3.0 * 256.0 * 6.0 * 8.0 * modes : 0.0);
 }
 
 /* ---- outputs ---- */
@@ -296,18 +300,15 @@ static void mesh_cost(const comp_stats st[3], const unsigned res[3], api_cost *c
     double nraw = 2.0 * (nv * nw + nu * nw + nu * nv);
     double ntraw = 4.0 * ((nv - 1) * (nw - 1) + (nu - 1) * (nw - 1) + (nu - 1) * (nv - 1));
     w += K_WELD * nraw + K_TRI * ntraw;
-    double cells = 16.0;
-    while (cells < 2.0 * nraw)
-        cells *= 2.0;
-    double tris = 16.0;
-    while (tris < 2.0 * ntraw / 3.0)
-        tris *= 2.0;
-    /* raw, wid, wpos, chain; rtri, rface; the two maps; then tri, pos, nrm, weld, acc, vof. */
-    double scratch = nraw * (12.0 + 4.0 + 24.0 + 4.0) + ntraw * 13.0 + 12.0 * cells + 12.0 * tris + nraw;
-    double outb = ntraw * 12.0 + nraw * (12.0 + 12.0 + 4.0 + 24.0 + 4.0);
-    double g = grid_bytes(st, nu, nv);
-    c->work = w + K_TOUCH * (scratch + outb);
-    c->bytes = scratch + outb + g;
+    /* api/mesh.c's two blocks: the mesh (pos, nrm, detj, weld: 32 bytes a sample; tri: 12 a triangle) and
+     * the scratch (up, vof, pid, flag: 13 a sample), each with a 32-byte header and pad; and, while it
+     * samples, its four grids (u = 0, 1; v = 0, 1; w = 0; w = 1) and row buffers. */
+    double blocks = nraw * (32.0 + 13.0) + ntraw * 12.0 + 64.0;
+    double nmax = fmax(nu, nv);
+    double g = grid_bytes(st, 2.0, nv) + grid_bytes(st, nu, 2.0) + 2.0 * grid_bytes(st, nu, nv) + 8.0 * (nu + nv) +
+               96.0 * nmax;
+    c->work = w + K_TOUCH * blocks;
+    c->bytes = blocks + g;
 }
 
 void api_cost_output_ex(const pde_solution *sol, api_format f, const unsigned res[3], const api_output_opts *opts,

@@ -309,6 +309,20 @@ static int get_points(const cJSON *j, const char *ptr, int want, double (**out)[
     return 0;
 }
 
+/* A term's factor: as a model's, but a loft's powers are t^0 to t^3 (higher ones chain modes, which core/loft.c
+ * does not take), said at the factor's own pointer rather than the core's /loft/pde. */
+static int loft_factor(const cJSON *j, const char *ptr, pde_factor *f, api_error *err)
+{
+    const cJSON *pw = cJSON_IsObject(j) ? cJSON_GetObjectItemCaseSensitive(j, "pow") : NULL;
+    if (cJSON_IsNumber(pw) && !(pw->valuedouble >= 0 && pw->valuedouble <= 3 && pw->valuedouble == floor(pw->valuedouble))) {
+        char q[260];
+        api_json_child(q, sizeof q, ptr, "pow");
+        return api_fail(err, API_ERR_DOCUMENT, q, "lofts take powers t^0 to t^3 only (0, 1, 2 or 3), not %.17g",
+                        pw->valuedouble);
+    }
+    return api_json_factor(j, ptr, f, err);
+}
+
 /* A section of the terms form: {"x": [{"u": F, "v": F, "c": n, "dw": n}], ...}; *tangent: any "dw". */
 static int parse_terms(const cJSON *j, const char *ptr, records *rs, int k, int *tangent, api_error *err)
 {
@@ -334,10 +348,10 @@ static int parse_terms(const cJSON *j, const char *ptr, records *rs, int k, int 
             if (api_json_object(t, r, keys, f, err))
                 return -1;
             api_json_child(s, sizeof s, r, "u");
-            if (api_json_factor(f[0], s, &u, err))
+            if (loft_factor(f[0], s, &u, err))
                 return -1;
             api_json_child(s, sizeof s, r, "v");
-            if (api_json_factor(f[1], s, &v, err))
+            if (loft_factor(f[1], s, &v, err))
                 return -1;
             api_json_child(s, sizeof s, r, "c");
             if (api_json_number(f[2], s, &x, err))
@@ -457,7 +471,8 @@ static int new_term(const records *rs, size_t i)
 static int build_terms(api_loft *l, records *rs, api_error *err)
 {
     const size_t K = l->loft.nsections;
-    qsort(rs->r, rs->n, sizeof *rs->r, cmp_record);
+    if (rs->n)   /* sections that are all zero leave none: the zero solid (qsort takes no NULL) */
+        qsort(rs->r, rs->n, sizeof *rs->r, cmp_record);
     size_t nt[3] = { 0, 0, 0 }, total = 0;
     for (size_t i = 0; i < rs->n; i++)
         if (new_term(rs, i))

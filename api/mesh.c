@@ -8,10 +8,12 @@
  * 1. The two faces of each axis are sampled on one grid (pde_grid; u = 0, 1
  *    as a grid of nu = 2, which core fills column-wise), straight into the
  *    mesh's arrays, and triangulated, wound so that each face's normal points
- *    out of the parameter cube. Positions first; the closed form's first
- *    derivatives (normal, det J) only after step 3, on the faces that keep a
- *    triangle (fig4a drops three of six). A joined sample then takes its
- *    root's position, so every copy of a point has the same bits.
+ *    out of the parameter cube. Positions first, with the closed form's
+ *    first derivatives (normal, det J) for u = 0, 1 only (their narrow grid's
+ *    row coefficients serve both); the other faces' derivatives after step 3,
+ *    on the faces that keep a triangle (fig4a drops three of six). A joined
+ *    sample then takes its root's position, so every copy of a point has the
+ *    same bits.
  * 2. Samples are joined (union-find) where they are one point:
  *    - a face's edge row is its neighbour's (the cube's 12 edges): by the
  *      lattice alone;
@@ -35,12 +37,16 @@
  *    area-weighted mean of its triangles' instead. A sample joined with no
  *    other (almost all) skips every map: its vertex and position id are the
  *    next ones.
- * Every pass is linear in the samples, and the hot ones (neighbour and seam
- * tests, bounds, a cell's area test) take 2 to 4 samples a step in SSE2
- * (a run of near samples costs a join each, no further test)
- * where it is, with the scalar code's arithmetic, so the bits do not depend
- * on it. Memory: one block for the mesh (32 bytes a sample, 12 a triangle)
- * and one of scratch (13 bytes a sample), both kept for the next build
+ * Every pass is linear in the samples, and the hot ones take 2 to 16 samples
+ * a step in SSE2 where it is, with the scalar code's arithmetic, so the bits
+ * do not depend on it: neighbour and seam tests (a run of near samples costs
+ * a join each, no further test), bounds, x_a x x_b and det J, the roots (a
+ * sample that is its own root stores nothing), the live test (4 cells whose
+ * triangles all have three points), the vertices (4 samples used and joined
+ * with no other) and the triangles (4 cells whose 8 triangles live). The
+ * scalar code handles the rest: collapsed rows, seams, opposite faces, edges.
+ * Memory: one block for the mesh (32 bytes a sample, 12 a triangle) and one
+ * of scratch (13 bytes a sample), both kept for the next build
  * (api_mesh_free): on a server, builds after the first touch no fresh page.
  */
 #include <math.h>
@@ -94,6 +100,16 @@ typedef struct {
     float lo[3], hi[3];
     int bad;
 } samples;
+
+#if defined(__SSE2__)
+/* Two points' x, y, z (lanes 0 and 1 of c[0..2]) rounded to float, to o[0..5] as x0 y0 z0 x1 y1 z1. */
+static inline void store2_xyz(float *o, const __m128d c[3])
+{
+    const __m128 fz = _mm_cvtpd_ps(c[2]), xy = _mm_unpacklo_ps(_mm_cvtpd_ps(c[0]), _mm_cvtpd_ps(c[1]));   /* x0 y0 x1 y1 */
+    _mm_storel_pi((__m64 *)o, xy), _mm_store_ss(o + 2, fz);
+    _mm_storeh_pi((__m64 *)(o + 3), xy), _mm_store_ss(o + 5, _mm_shuffle_ps(fz, fz, 1));
+}
+#endif
 
 /* Bounds of n floats of interleaved x, y, z: lanes l of lo12, hi12 hold axis l % 3 (4 points, 12
  * floats, a step); sum12 turns NaN on any NaN or infinity. */
@@ -196,7 +212,24 @@ static void emit_row(const face *f, size_t b, size_t first, size_t step, int der
     }
     const float *restrict ta0 = sp->xd[o[0]], *restrict tb0 = sp->xd[o[1]], *restrict tc0 = sp->xd[axis];
     const float sg = axis == 1 ? -1.0f : 1.0f;
-    for (size_t a = 0; a < na; a++) {
+    size_t a = 0;
+#if defined(__SSE2__)
+    for (; a + 2 <= na; a += 2) {   /* two samples in double lanes, the loop's products and sums below */
+        const size_t e = 3 * (first + a * step), e1 = e + 3 * step;
+        __m128d A[3], B[3], C[3], n[3];
+        for (int k = 0; k < 3; k++)
+            A[k] = _mm_set_pd(ta0[e1 + k], ta0[e + k]), B[k] = _mm_set_pd(tb0[e1 + k], tb0[e + k]),
+            C[k] = _mm_set_pd(tc0[e1 + k], tc0[e + k]);
+        for (int k = 0; k < 3; k++) {
+            const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+            n[k] = _mm_sub_pd(_mm_mul_pd(A[k1], B[k2]), _mm_mul_pd(A[k2], B[k1]));
+        }
+        const __m128d det = _mm_add_pd(_mm_add_pd(_mm_mul_pd(n[0], C[0]), _mm_mul_pd(n[1], C[1])), _mm_mul_pd(n[2], C[2]));
+        store2_xyz(nrm + 3 * a, n);
+        _mm_storel_pi((__m64 *)(dj + a), _mm_mul_ps(_mm_set1_ps(sg), _mm_cvtpd_ps(det)));
+    }
+#endif
+    for (; a < na; a++) {
         const size_t e = 3 * (first + a * step);
         const float *ta = ta0 + e, *tb = tb0 + e, *tc = tc0 + e;
         double n[3] = { (double)ta[1] * tb[2] - (double)ta[2] * tb[1], (double)ta[2] * tb[0] - (double)ta[0] * tb[2],
@@ -210,9 +243,9 @@ static void emit_row(const face *f, size_t b, size_t first, size_t step, int der
 
 /*
  * The six faces, na x nb samples each, fast index first, from the closed form. The positions pass (keep NULL)
- * samples x on every face; the derivatives pass x_u, x_v, x_w, only on the faces with keep[face] != 0 (those
- * that kept a triangle: a face dropped whole costs no derivative). Polled before each face row. 1 when
- * cancelled.
+ * samples x on every face, and x_u, x_v, x_w on u = 0, 1; the derivatives pass x_u, x_v, x_w on the other
+ * faces with keep[face] != 0 (those that kept a triangle: such a face dropped whole costs no derivative).
+ * Polled before each face row. 1 when cancelled.
  */
 static int sample_faces(sampler *sp, const face f[6], const unsigned res[3], const size_t *keep,
                         const pde_cancel *cancel, samples *out)
@@ -226,20 +259,28 @@ static int sample_faces(sampler *sp, const face f[6], const unsigned res[3], con
     for (size_t b = 0; b < res[2] && !rc; b++) {
         const double w = sample(b, res[2]);
         for (int axis = 0; axis < 2 && !rc; axis++) {
-            if (derivs && !keep[2 * axis] && !keep[2 * axis + 1])
+            /* u = 0, 1 take their derivatives with their positions: a narrow grid's cost is its row
+             * coefficients, and x's serve x_u too, so one pass of all four costs less than two passes,
+             * even with a dead face's x_a x x_b (fig4a's u = 0) */
+            const int with_d = axis == 0;
+            if (derivs && (with_d || (!keep[2 * axis] && !keep[2 * axis + 1])))
                 continue;
             if ((rc = stopped(cancel)))
                 break;
-            pde_grid_plane_d(sp->g[axis], w, x, xu, xv, xw);
+            if (with_d)
+                pde_grid_plane_d(sp->g[axis], w, x, sp->xd[0], sp->xd[1], sp->xd[2]);
+            else
+                pde_grid_plane_d(sp->g[axis], w, x, xu, xv, xw);
             for (int side = 0; side < 2; side++) {
                 if (derivs && !keep[2 * axis + side])
                     continue;
                 if (side && (rc = stopped(cancel)))
                     break;
                 /* u = 0, 1: (v, u) interleaved; v = 0, 1: by rows */
-                if (axis == 0)
-                    emit_row(&f[side], b, (size_t)side, 2, derivs, sp, out);
-                else
+                if (axis == 0) {
+                    emit_row(&f[side], b, (size_t)side, 2, 0, sp, out);
+                    emit_row(&f[side], b, (size_t)side, 2, 1, sp, out);
+                } else
                     emit_row(&f[2 + side], b, (size_t)side * nu, 1, derivs, sp, out);
             }
         }
@@ -251,8 +292,13 @@ static int sample_faces(sampler *sp, const face f[6], const unsigned res[3], con
                 continue;
             if ((rc = stopped(cancel)))
                 break;
-            pde_grid_rows(sp->g[2 + side], side ? 1.0 : 0.0, b, b + 1, x, xu, xv, xw);
-            emit_row(&f[4 + side], b, 0, 1, derivs, sp, out);
+            /* a row of w = 0, 1 is a face row in the mesh's layout: positions straight to the mesh */
+            float *row = derivs ? NULL : out->pos + 3 * (f[4 + side].base + b * f[4 + side].na);
+            pde_grid_rows(sp->g[2 + side], side ? 1.0 : 0.0, b, b + 1, row, xu, xv, xw);
+            if (derivs)
+                emit_row(&f[4 + side], b, 0, 1, derivs, sp, out);
+            else
+                row_bounds(row, 3 * f[4 + side].na, sp->lo12, sp->hi12, sp->sum12);
         }
     if (!derivs)
         for (int l = 0; l < 12; l++) {
@@ -365,6 +411,52 @@ static size_t join_near(uint32_t *up, const float *p, const float *q, uint32_t i
     return joined;
 }
 
+/* The first k' >= k below end with fl[k'] & bits, or end; 16 flags a step where SSE2 is. */
+static size_t next_flag(const uint8_t *fl, size_t k, size_t end, uint8_t bits)
+{
+#if defined(__SSE2__)
+    const __m128i b = _mm_set1_epi8((char)bits), zero = _mm_setzero_si128();
+    for (; k + 16 <= end; k += 16) {
+        const __m128i x = _mm_and_si128(_mm_loadu_si128((const __m128i *)(fl + k)), b);
+        const unsigned m = (unsigned)_mm_movemask_epi8(_mm_cmpeq_epi8(x, zero)) ^ 0xffffu;
+        if (m)
+            return k + (size_t)__builtin_ctz(m);
+    }
+#endif
+    for (; k < end && !(fl[k] & bits); k++)
+        ;
+    return k;
+}
+
+#if defined(__SSE2__)
+/*
+ * Samples k..k+3 to vertices v..v+3 (v <= k) as api_mesh_build's vertex loop moves them: position and
+ * det J copied, x_a x x_b times sgn / |x_a x x_b|, in double two lanes at a time with its arithmetic.
+ * Returns 0 and writes nothing where some |x_a x x_b| <= tiny (the loop's fallback).
+ */
+static inline int plain4(float *P, float *N, float *J, size_t k, size_t v, double sgn, double tiny)
+{
+    const float *n = N + 3 * k;
+    __m128d x[2], y[2], z[2], len[2];
+    for (int h = 0; h < 2; h++, n += 6) {
+        x[h] = _mm_set_pd(n[3], n[0]), y[h] = _mm_set_pd(n[4], n[1]), z[h] = _mm_set_pd(n[5], n[2]);
+        len[h] = _mm_sqrt_pd(_mm_add_pd(_mm_add_pd(_mm_mul_pd(x[h], x[h]), _mm_mul_pd(y[h], y[h])), _mm_mul_pd(z[h], z[h])));
+    }
+    const __m128d t = _mm_set1_pd(tiny);
+    if ((_mm_movemask_pd(_mm_cmpgt_pd(len[0], t)) & _mm_movemask_pd(_mm_cmpgt_pd(len[1], t))) != 3)
+        return 0;
+    const __m128 p0 = _mm_loadu_ps(P + 3 * k), p1 = _mm_loadu_ps(P + 3 * k + 4), p2 = _mm_loadu_ps(P + 3 * k + 8);
+    _mm_storeu_ps(P + 3 * v, p0), _mm_storeu_ps(P + 3 * v + 4, p1), _mm_storeu_ps(P + 3 * v + 8, p2);
+    _mm_storeu_ps(J + v, _mm_loadu_ps(J + k));
+    for (int h = 0; h < 2; h++) {
+        const __m128d s = _mm_div_pd(_mm_set1_pd(sgn), len[h]);
+        const __m128d sn[3] = { _mm_mul_pd(s, x[h]), _mm_mul_pd(s, y[h]), _mm_mul_pd(s, z[h]) };
+        store2_xyz(N + 3 * (v + 2 * (size_t)h), sn);
+    }
+    return 1;
+}
+#endif
+
 /* The triple in increasing order; returns the parity of the sorting permutation. */
 static int sorted(const uint32_t t[3], uint32_t s[3])
 {
@@ -446,6 +538,48 @@ static inline unsigned cell_live(const float *restrict pos, size_t v00, size_t n
 #endif
 }
 
+#if defined(__SSE2__)
+/*
+ * cell_live for the 4 cells v00..v00+3 of a row, both triangles wanted: live[i] and the volumes v[i][q]
+ * (added to the total by the caller, in cell order). Lanes are cells, two at a time; the products and
+ * sums are cell_normals' (d x e2 = -e2 x d: cell_live's lane 1), so the bits are the same.
+ */
+static inline void cells4_live(const float *restrict pos, size_t v00, size_t na, double sgn, double tiny2, unsigned live[4],
+                               double v[4][2])
+{
+    const __m128d t2 = _mm_set1_pd(tiny2), sg = _mm_set1_pd(sgn);
+    for (int h = 0; h < 2; h++) {
+        const float *p = pos + 3 * (v00 + 2 * (size_t)h), *q = p + 3 * na;
+        __m128d p0[3], e1[3], d[3], e2[3];
+        for (int k = 0; k < 3; k++) {
+            p0[k] = _mm_set_pd(p[3 + k], p[k]);
+            e1[k] = _mm_sub_pd(_mm_set_pd(p[6 + k], p[3 + k]), p0[k]);
+            d[k] = _mm_sub_pd(_mm_set_pd(q[6 + k], q[3 + k]), p0[k]);
+            e2[k] = _mm_sub_pd(_mm_set_pd(q[3 + k], q[k]), p0[k]);
+        }
+        __m128d n[2][3];
+        for (int k = 0; k < 3; k++) {
+            const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+            n[0][k] = _mm_sub_pd(_mm_mul_pd(e1[k1], d[k2]), _mm_mul_pd(e1[k2], d[k1]));
+            n[1][k] = _mm_sub_pd(_mm_mul_pd(d[k1], e2[k2]), _mm_mul_pd(d[k2], e2[k1]));
+        }
+        unsigned m[2];
+        double vq[2][2];
+        for (int t = 0; t < 2; t++) {
+            const __m128d *x = n[t];
+            const __m128d nn = _mm_add_pd(_mm_add_pd(_mm_mul_pd(x[0], x[0]), _mm_mul_pd(x[1], x[1])), _mm_mul_pd(x[2], x[2]));
+            m[t] = (unsigned)_mm_movemask_pd(_mm_cmpgt_pd(nn, t2));
+            const __m128d dot = _mm_add_pd(_mm_add_pd(_mm_mul_pd(p0[0], x[0]), _mm_mul_pd(p0[1], x[1])), _mm_mul_pd(p0[2], x[2]));
+            _mm_storeu_pd(vq[t], _mm_mul_pd(sg, dot));
+        }
+        for (int c = 0; c < 2; c++) {
+            live[2 * h + c] = (m[0] >> c & 1) | (m[1] >> c & 1) << 1;
+            v[2 * h + c][0] = vq[0][c], v[2 * h + c][1] = vq[1][c];
+        }
+    }
+}
+#endif
+
 /* The samples of triangle q (0, 1) of cell (a, b) of face f, wound outward of the cube. */
 static void cell_tri(const face *f, size_t a, size_t b, int q, uint32_t t[3])
 {
@@ -455,6 +589,31 @@ static void cell_tri(const face *f, size_t a, size_t b, int q, uint32_t t[3])
     t[1] = q ? (f->reverse ? v01 : v11) : (f->reverse ? v11 : v10);
     t[2] = q ? (f->reverse ? v11 : v01) : (f->reverse ? v10 : v11);
 }
+
+#if defined(__SSE2__)
+/*
+ * Both triangles of the 4 cells whose v00 are samples u[0..3] (u holding vertex ids, na to a row), in
+ * the order and windings of the scalar loop in api_mesh_build: per cell (v00, v10, v11), (v00, v11, v01),
+ * or with swap (v00, v11, v10), (v00, v01, v11). 24 ids to T.
+ */
+static inline void tri4(uint32_t *T, const uint32_t *u, size_t na, int swap)
+{
+    const __m128i A = _mm_loadu_si128((const __m128i *)u), B = _mm_loadu_si128((const __m128i *)(u + 1));
+    const __m128i C = _mm_loadu_si128((const __m128i *)(u + na)), D = _mm_loadu_si128((const __m128i *)(u + na + 1));
+    /* triangles (A, s, t) and (A, p, q) */
+    const __m128i s = swap ? D : B, t = swap ? B : D, p = swap ? C : D, q = swap ? D : C;
+    const __m128i lo[3] = { _mm_unpacklo_epi32(A, s), _mm_unpacklo_epi32(t, A), _mm_unpacklo_epi32(p, q) };
+    const __m128i hi[3] = { _mm_unpackhi_epi32(A, s), _mm_unpackhi_epi32(t, A), _mm_unpackhi_epi32(p, q) };
+    const __m128i *h[2] = { lo, hi };
+    for (int i = 0; i < 2; i++, T += 12) {   /* cells 0, 1 from the low halves, 2, 3 from the high */
+        const __m128i *x = h[i];   /* x[0] = A0 s0 A1 s1, x[1] = t0 A0 t1 A1, x[2] = p0 q0 p1 q1 */
+        _mm_storeu_si128((__m128i *)T, _mm_unpacklo_epi64(x[0], x[1]));
+        _mm_storeu_si128((__m128i *)(T + 4),
+                         _mm_castpd_si128(_mm_shuffle_pd(_mm_castsi128_pd(x[2]), _mm_castsi128_pd(x[0]), 2)));
+        _mm_storeu_si128((__m128i *)(T + 8), _mm_unpackhi_epi64(x[1], x[2]));
+    }
+}
+#endif
 
 void api_mesh_free(api_mesh *m)
 {
@@ -468,15 +627,23 @@ void api_mesh_free(api_mesh *m)
  * which of the cell's two triangles live; its vertex's normal marked for its triangles' mean. */
 enum { SHARED = 1, USED = 2, LIVE0 = 4, LIVE1 = 8, NANV = 16 };
 
+/* Cell v00's live triangles (bits 0, 1) to its flags: LIVE0, LIVE1 on v00; USED on the corners they use. */
+static inline void mark_live(uint8_t *fl, size_t na, unsigned live)
+{
+    fl[0] |= (uint8_t)(live * LIVE0 | USED), fl[na + 1] |= USED;
+    fl[1] |= (uint8_t)(live & 1 ? USED : 0), fl[na] |= (uint8_t)(live & 2 ? USED : 0);
+}
+
 /* vof[r] while face f's vertices are made: the face has one (TAG1) or several (TAG2) samples at root r
  * and no vertex there yet; vertex ids of earlier faces are below the face's first, tags above any id. */
 #define TAG1(f) (UINT32_MAX - 2u * (uint32_t)(f) - 1u)
 #define TAG2(f) (UINT32_MAX - 2u * (uint32_t)(f) - 2u)
 #define TAGMIN (UINT32_MAX - 13u)
 
-/* Growable accumulators of the area-weighted normals of the vertices marked NaN. */
+/* Growable accumulators of the area-weighted normals of the vertices marked NaN, and those vertices. */
 typedef struct {
     double *acc;
+    uint32_t *v;
     size_t n, cap;
 } nan_acc;
 
@@ -489,12 +656,16 @@ static int mark_nan(float *nrm, uint32_t v, nan_acc *a)
     if (a->n == a->cap) {
         size_t cap = a->cap ? 2 * a->cap : 256;
         double *p = realloc(a->acc, 3 * cap * sizeof *p);
-        if (!p)
+        if (p)
+            a->acc = p;
+        uint32_t *q = p ? realloc(a->v, cap * sizeof *q) : NULL;
+        if (!q)
             return -1;
-        a->acc = p, a->cap = cap;
+        a->v = q, a->cap = cap;
     }
     const uint32_t i = (uint32_t)a->n++;
     a->acc[3 * i] = a->acc[3 * i + 1] = a->acc[3 * i + 2] = 0.0;
+    a->v[i] = v;
     nrm[3 * v] = NAN;
     memcpy(&nrm[3 * v + 1], &i, 4);
     return 0;
@@ -531,7 +702,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     uint32_t *vof = up ? up + nraw : NULL;     /* step 5: a root's vertex in the face, or a tag */
     uint32_t *pid = up ? vof + nraw : NULL;    /* step 5: a shared root's position id, or UINT32_MAX */
     uint8_t *flag = up ? (uint8_t *)(pid + nraw) : NULL;
-    nan_acc nacc = { NULL, 0, 0 };
+    nan_acc nacc = { NULL, NULL, 0, 0 };
     sampler sp;
     int rc = -1, cancelled = 0, have_sp = 0;
     const char *why = "out of memory building the mesh";
@@ -549,7 +720,8 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     samples raw = { out->pos, out->nrm, out->detj,
                     { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY }, 0 };
 
-    /* 1. Faces: positions now, derivatives after step 3 where a face keeps a triangle. */
+    /* 1. Faces: positions now (and u = 0, 1's derivatives), the others' derivatives after step 3 where a face
+     * keeps a triangle. */
     if (sampler_init(&sp, sol, res))
         goto done;
     have_sp = 1;
@@ -571,8 +743,8 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     float *restrict P = out->pos;
 
     /* 2. Join: the cube's edges by the lattice; collapsed rows and seams where the map joins them. */
-    for (size_t i = 0; i < nraw; i++)
-        up[i] = (uint32_t)i;
+    for (uint32_t i = 0; i < (uint32_t)nraw; i++)
+        up[i] = i;
     for (int fi = 0; fi < 6; fi++) {
         const face *f = &faces[fi];
         const size_t na = f->na, nb = f->nb;
@@ -605,17 +777,26 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         seams[a] = join_near(up, p0, p1, (uint32_t)f0->base, (uint32_t)f1->base, n, epsf);
     }
     /* Roots; a joined sample takes its root's position, so that every copy of a point is the same
-     * bits (the root, the least sample, is settled before any other of its set). */
+     * bits (the root, the least sample, is settled before any other of its set). Almost every sample
+     * is its own root and needs no store: 4 a step in SSE2 find the others. */
+    memset(flag, 0, nraw);
     for (size_t i = 0; i < nraw; i++) {
+#if defined(__SSE2__)
+        const __m128i step4 = _mm_set1_epi32(4);
+        for (__m128i ids = _mm_add_epi32(_mm_set1_epi32((int)i), _mm_setr_epi32(0, 1, 2, 3));
+             i + 4 <= nraw && _mm_movemask_epi8(_mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)(up + i)), ids)) == 0xffff;
+             i += 4)
+            ids = _mm_add_epi32(ids, step4);
+        if (i == nraw)
+            break;
+#endif
         const uint32_t r = up[up[i]];   /* up[i] < i is a root already, or points at one */
-        up[i] = r;
-        if (r == i) {
-            flag[i] = 0;
+        if (r == i)
             continue;
-        }
+        up[i] = r;
         flag[i] = SHARED;
-        flag[r] |= SHARED;
-        vof[r] = pid[r] = UINT32_MAX;
+        if (!flag[r])   /* the root's first joined sample (a collapsed row's first sample has na - 1 more) */
+            flag[r] = SHARED, vof[r] = pid[r] = UINT32_MAX;
         memcpy(P + 3 * i, P + 3 * (size_t)r, 3 * sizeof *P);
     }
     if (stopped(cancel)) {
@@ -642,6 +823,29 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             const uint32_t *o0 = u0 + opp, *o1 = u1 + opp;
             uint8_t *restrict fl = flag + row;
             for (size_t a = 0; a + 1 < f->na; a++) {
+#if defined(__SSE2__)
+                /* 4 cells a step where no face coincides here and every triangle has three points */
+                for (; !opp && a + 5 <= f->na; a += 4) {
+                    const __m128i r00 = _mm_loadu_si128((const __m128i *)(u0 + a)), r11 = _mm_loadu_si128((const __m128i *)(u1 + a + 1));
+                    const __m128i r10 = _mm_loadu_si128((const __m128i *)(u0 + a + 1)), r01 = _mm_loadu_si128((const __m128i *)(u1 + a));
+                    const __m128i same = _mm_or_si128(
+                        _mm_or_si128(_mm_cmpeq_epi32(r00, r11), _mm_or_si128(_mm_cmpeq_epi32(r10, r00), _mm_cmpeq_epi32(r10, r11))),
+                        _mm_or_si128(_mm_cmpeq_epi32(r01, r00), _mm_cmpeq_epi32(r01, r11)));
+                    if (_mm_movemask_epi8(same))
+                        break;
+                    unsigned live[4];
+                    double v[4][2];
+                    cells4_live(P, row + a, f->na, sgn, tiny2, live, v);
+                    for (size_t i = 0; i < 4; i++)
+                        if (live[i]) {
+                            vol += (live[i] & 1 ? v[i][0] : 0.0) + (live[i] & 2 ? v[i][1] : 0.0);
+                            mark_live(fl + a + i, f->na, live[i]);
+                            ftri[fi] += (live[i] & 1) + (live[i] >> 1);
+                        }
+                }
+                if (a + 1 >= f->na)
+                    break;
+#endif
                 const uint32_t r00 = u0[a], r10 = u0[a + 1], r01 = u1[a], r11 = u1[a + 1];
                 /* both triangles hold v00 and v11: (v00, v10, v11) and (v00, v11, v01), either winding */
                 const int diag = r00 != r11;
@@ -653,9 +857,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                 const unsigned live = cell_live(P, row + a, f->na, sgn, tiny2, (unsigned)c0 | (unsigned)c1 << 1, &vol);
                 if (!live)
                     continue;
-                /* bits 0, 1 -> LIVE0, LIVE1; the corners the live triangles use */
-                fl[a] |= (uint8_t)(live * LIVE0 | USED), fl[a + f->na + 1] |= USED;
-                fl[a + 1] |= (uint8_t)(live & 1 ? USED : 0), fl[a + f->na] |= (uint8_t)(live & 2 ? USED : 0);
+                mark_live(fl + a, f->na, live);
                 ftri[fi] += (live & 1) + (live >> 1);
             }
         }
@@ -739,13 +941,25 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             }
         }
         /* how many samples of the face each shared root has */
-        for (size_t k = f->base; k < end; k++)
-            if (flag[k] & SHARED) {
-                const uint32_t r = up[k];
-                vof[r] = vof[r] == TAG1(fi) || vof[r] == TAG2(fi) ? TAG2(fi) : TAG1(fi);
-            }
+        for (size_t k = next_flag(flag, f->base, end, SHARED); k < end; k = next_flag(flag, k + 1, end, SHARED)) {
+            const uint32_t r = up[k];
+            vof[r] = vof[r] == TAG1(fi) || vof[r] == TAG2(fi) ? TAG2(fi) : TAG1(fi);
+        }
         const size_t nacc0 = nacc.n;
         for (size_t k = f->base; k < end; k++) {
+#if defined(__SSE2__)
+            /* 4 samples a step where each is used and joined with no other (almost all) and its x_a x x_b
+             * does not vanish: vertices nv.., position ids npos.. */
+            for (uint32_t c4; k + 4 <= end; k += 4, nv += 4, npos += 4) {
+                memcpy(&c4, flag + k, 4);
+                if ((c4 & 0x03030303u) != 0x02020202u || !plain4(P, N, J, k, nv, sgn, tiny))
+                    break;
+                for (uint32_t i = 0; i < 4; i++)
+                    W[nv + i] = (uint32_t)npos + i, up[k + i] = (uint32_t)nv + i;
+            }
+            if (k == end)
+                break;
+#endif
             const uint8_t c = flag[k];
             uint32_t v;
             int twice = 0;
@@ -795,36 +1009,37 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             }
         }
         row_bounds(P + 3 * (size_t)first, 3 * (nv - first), lo12, hi12, sum12);
-        /* the face's triangles, as wound in the mesh: corners 0-3 of a cell are v00, v10, v01, v11 */
-        unsigned char ci[2][3];
-        for (int q = 0; q < 2; q++) {
-            uint32_t t[3];
-            cell_tri(f, 0, 0, q, t);
-            for (int i = 0; i < 3; i++) {
-                const uint32_t o = t[i] - (uint32_t)f->base;   /* 0, 1, na or na + 1 */
-                ci[q][i] = (unsigned char)((o >= na ? 2 : 0) + (o == 1 || o == na + 1));
-            }
-            if (flip) {
-                const unsigned char x = ci[q][1];
-                ci[q][1] = ci[q][2], ci[q][2] = x;
-            }
-        }
+        /* the face's triangles as cell_tri winds them, (v00, v10, v11) and (v00, v11, v01), their second and
+         * third corners swapped where the face reverses, and again where the solid flips; the choice made
+         * once a face, so the corners stay in registers */
+        const int swap = f->reverse != flip;
         /* a corner's vertex may have a NaN normal where its sample is joined (SHARED) or was marked (NANV) */
         const uint8_t maybe_nan = nacc.n > nacc0 ? SHARED | NANV : 0;
+        const uint64_t nan5 = maybe_nan * 0x0101010101u;   /* the flags of a 4-cell step's 5 corners a row */
         for (size_t b = 0; b + 1 < f->nb; b++) {
             const size_t row = f->base + b * na;
             const uint8_t *restrict fl = flag + row;
             const uint32_t *restrict u = up + row;
             for (size_t a = 0; a + 1 < na; a++) {
+#if defined(__SSE2__)
+                uint32_t live4;
+                uint64_t c0, c1;
+                for (; a + 8 <= na; a += 4, k3 += 24) {   /* 4 cells a step where all 8 triangles live */
+                    memcpy(&live4, fl + a, 4), memcpy(&c0, fl + a, 8), memcpy(&c1, fl + a + na, 8);
+                    if ((live4 & 0x0c0c0c0cu) != 0x0c0c0c0cu || ((c0 | c1) & nan5))
+                        break;
+                    tri4(T + k3, u + a, na, swap);
+                }
+#endif
                 const uint8_t c = fl[a];
                 if (!(c & (LIVE0 | LIVE1)))
                     continue;
-                const uint32_t w[4] = { u[a], u[a + 1], u[a + na], u[a + na + 1] };
+                const uint32_t w00 = u[a], w10 = u[a + 1], w01 = u[a + na], w11 = u[a + na + 1];
                 const uint32_t *t = T + k3;
                 if (c & LIVE0)
-                    T[k3] = w[ci[0][0]], T[k3 + 1] = w[ci[0][1]], T[k3 + 2] = w[ci[0][2]], k3 += 3;
+                    T[k3] = w00, T[k3 + 1] = swap ? w11 : w10, T[k3 + 2] = swap ? w10 : w11, k3 += 3;
                 if (c & LIVE1)
-                    T[k3] = w[ci[1][0]], T[k3 + 1] = w[ci[1][1]], T[k3 + 2] = w[ci[1][2]], k3 += 3;
+                    T[k3] = w00, T[k3 + 1] = swap ? w01 : w11, T[k3 + 2] = swap ? w11 : w01, k3 += 3;
                 if (!((c | fl[a + 1] | fl[a + na] | fl[a + na + 1]) & maybe_nan))
                     continue;
                 for (; t < T + k3; t += 3) {
@@ -846,17 +1061,13 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                 }
             }
         }
-        const int any_nan = nacc.n > nacc0;
-        /* the area-weighted normals of the face's marked vertices */
-        if (any_nan)
-            for (uint32_t v = first; v < nv; v++)
-                if (isnan(N[3 * v])) {
-                    uint32_t j;
-                    memcpy(&j, &N[3 * v + 1], 4);
-                    const double *n = nacc.acc + 3 * j, len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-                    for (int c2 = 0; c2 < 3; c2++)
-                        N[3 * v + c2] = len > 0 ? (float)(n[c2] / len) : (c2 == 2 ? 1.0f : 0.0f);
-                }
+        /* the area-weighted normals of the face's marked vertices (a vertex is marked once) */
+        for (size_t j = nacc0; j < nacc.n; j++) {
+            const uint32_t v = nacc.v[j];
+            const double *n = nacc.acc + 3 * j, len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            for (int c2 = 0; c2 < 3; c2++)
+                N[3 * v + c2] = len > 0 ? (float)(n[c2] / len) : (c2 == 2 ? 1.0f : 0.0f);
+        }
     }
     for (int c = 0; c < 3; c++)
         out->min[c] = INFINITY, out->max[c] = -INFINITY;
@@ -877,6 +1088,7 @@ done:
     }
     block_put(up);
     free(nacc.acc);
+    free(nacc.v);
     if (have_sp)
         sampler_free(&sp);
     return rc;

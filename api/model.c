@@ -418,7 +418,12 @@ static api_model *parse_request(const cJSON *root, api_error *err)
                         return NULL;
                 }
             } else {
-                api_fail(err, API_ERR_DOCUMENT, q, "must be a number, or an array of three for a, b and c; not %s", api_json_type(c));
+                if (cJSON_IsArray(c))
+                    api_fail(err, API_ERR_DOCUMENT, q, "must be a number, or an array of three for a, b and c; not an "
+                             "array of %d", cJSON_GetArraySize(c));
+                else
+                    api_fail(err, API_ERR_DOCUMENT, q, "must be a number, or an array of three for a, b and c; not %s",
+                             api_json_type(c));
                 return NULL;
             }
             if (n == 1 && api_json_number(c, q, &v[0], err))

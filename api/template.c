@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "model.h"
 #include "template.h"
 
 typedef void (*expand_fn)(const api_template *t, const api_params *p, pde_model *m, pde_bterm bt[3][4],
@@ -282,6 +283,59 @@ void api_template_defaults(const api_template *t, api_params *p)
     apply_values(t, p, t->defaults);
 }
 
+/* The value in the field a failed check names: a factor's k or power, or a term's value; 0 if none. */
+static int failed_value(const pde_model *m, const pde_diag *d, double *out)
+{
+    if (d->component < 0 || d->component > 2 || d->term < 0)
+        return 0;
+    const pde_component *c = &m->comp[d->component];
+    if (d->in_force ? (size_t)d->term >= c->nfterms : (size_t)d->term >= c->nbterms)
+        return 0;
+    const pde_fterm *f = d->in_force ? &c->fterms[d->term] : NULL;
+    const pde_bterm *b = d->in_force ? NULL : &c->bterms[d->term];
+    const struct {
+        const char *field;
+        double v;
+    } fields[] = {
+        { "u", f ? f->u.p : b->u.p }, { "v", f ? f->v.p : b->v.p }, { "w", f ? f->w.p : 0 },
+        { "coef", f ? f->coef : 0 },  { "w0", b ? b->w0 : 0 },      { "dw0", b ? b->dw0 : 0 },
+        { "w1", b ? b->w1 : 0 },      { "dw1", b ? b->dw1 : 0 },
+    };
+    for (size_t i = 0; i < sizeof fields / sizeof *fields; i++)
+        if (!strcmp(d->field, fields[i].field)) {
+            *out = fields[i].v;
+            return 1;
+        }
+    return 0;
+}
+
+/*
+ * A model the core refuses, pointed at the parameter that made it: the one parameter whose value (or its
+ * negative: sin(-k) is -sin k) is the refused field's, else /params. So n_xy = 2e6 is /params/n_xy, for a
+ * front-end to place the message under its field; a failure of several values together stays /params.
+ */
+static int refused(const api_template *t, const api_params *p, const pde_model *m, const pde_diag *d,
+                   pde_status st, api_error *err)
+{
+    char ptr[128] = "/params";
+    double v;
+    int found = 0;
+    if (d->component >= 0 && d->term < 0 && strchr("abc", d->field[0]) && d->field[0] && !d->field[1])
+        snprintf(ptr, sizeof ptr, "/params/%s/%d", d->field, d->component), found = 1;
+    else if (failed_value(m, d, &v) && v != 0)
+        for (size_t i = 0; i < t->nparams; i++) {
+            double pv[API_MAX_SLOTS];
+            int n = api_params_get(t, p, t->params[i].name, pv);
+            for (int k = 0; k < n; k++)
+                if (fabs(pv[k]) == fabs(v)) {
+                    if (found++ == 0)
+                        snprintf(ptr, sizeof ptr, n > 1 ? "/params/%s/%d" : "/params/%s", t->params[i].name, k);
+                }
+        }
+    return api_fail(err, api_status_of(st), found == 1 ? ptr : "/params", "%s",
+                    d->message[0] ? d->message : pde_strerror(st));
+}
+
 api_model *api_template_expand(const api_template *t, const api_params *p, api_error *err)
 {
     pde_model m;
@@ -296,6 +350,15 @@ api_model *api_template_expand(const api_template *t, const api_params *p, api_e
         m.comp[c].bterms = bt[c];
         m.comp[c].fterms = ft[c];
     }
+    /* The model's own checks now, while the parameters are at hand to name. */
+    pde_model canon;
+    pde_diag d;
+    pde_status st = pde_model_canonical(&m, &canon, &d);
+    if (st != PDE_OK) {
+        refused(t, p, &m, &d, st, err);
+        return NULL;
+    }
+    pde_model_canonical_free(&canon);
     return api_model_build(&m, 1, err);
 }
 

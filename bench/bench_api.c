@@ -194,8 +194,14 @@ glb:;
     printf("## glb of fig4a at 256 x 256 per face (properties given; read through a reused 64 KiB buffer)\n\n");
     printf("| what | bytes | median time | bytes/s | minor page faults (median) | relative to memcpy (median of "
            "per-run ratios) |\n|---|---|---|---|---|---|\n");
-    printf("| glb, api_output_open + read | %.1f MB | %.1f ms | %.0f MB/s | %.0f | %.3f (fresh pages), %.3f (mapped) |\n",
-           bytes / 1e6, mm * 1e3, bytes / mm / 1e6, median(fm, RUNS), median(ratio, RUNS), median(ratio_warm, RUNS));
+    /* also the fastest memcpy over the fastest glb: on a shared machine the median carries the neighbours' load */
+    double tmin = tm[0], twmin = twarm[0];
+    for (int r = 1; r < RUNS; r++)
+        tmin = tm[r] < tmin ? tm[r] : tmin, twmin = twarm[r] < twmin ? twarm[r] : twmin;
+    printf("| glb, api_output_open + read | %.1f MB | %.1f ms | %.0f MB/s | %.0f | %.3f (fresh pages), %.3f (mapped; "
+           "fastest runs %.3f) |\n",
+           bytes / 1e6, mm * 1e3, bytes / mm / 1e6, median(fm, RUNS), median(ratio, RUNS), median(ratio_warm, RUNS),
+           twmin / tmin);
     printf("| api_mesh_build + api_mesh_free alone | | %.1f ms | | %.0f | |\n", mb * 1e3, median(fb, RUNS));
     const double mw = median(twarm, RUNS);
     printf("| memcpy of the glb into fresh pages | %.1f MB | %.2f ms | %.0f MB/s | %.0f | 1 |\n", bytes / 1e6, mcp * 1e3,

@@ -10,6 +10,10 @@
  *
  *     |f(c + d) - f(c) - g.d - d'Hd/2| <= 1/6 sum_klm T_klm |d_k d_l d_m|   for c + d in the box.
  *
+ * For det J of a solid that is not a polynomial, the model's rest is tighter: the exact cubic terms
+ * at c plus bounds of the fourth-order ones (bounds of products lose det J's cancellation; one
+ * order up, they lose it on a smaller term).
+ *
  * Bounds of derivatives come from bounds of each factor's derivatives over
  * the box's intervals (factor_bounds, mode_h_bounds), combined as majorants:
  * no rounding-error analysis, so "certified" holds up to the rounding of the
@@ -29,6 +33,7 @@ enum { OBJ_DETJ = 3 };
 typedef struct {
     double v, g[3], H[3][3];   /* value, gradient and Hessian at the centre */
     double T[3][3][3];         /* bounds of the third derivatives' magnitudes over the box */
+    double rest;               /* a bound of |f(c + d) - f(c) - g.d - d'Hd/2| over the box: at most the sum above */
 } obj_model;
 
 /* The model of objective what (0..2: x_what, 3: det J) over b, unsigned. */
@@ -55,7 +60,8 @@ typedef struct {
 /*
  * Minimises sign * f over the box within (NULL: the unit cube; it may be flat, a face) by branch and
  * bound, from a known point start in it, until the gap best - lower is at most tol or `budget` boxes
- * have been bounded. stop() is polled every 16 boxes; returns PDE_ERR_CANCELLED then.
+ * have been bounded. A box whose model is convex shrinks to where the model allows values below
+ * best - tol/2 (so a gap is at most tol, and often near tol/2). stop() is polled every 16 boxes; returns PDE_ERR_CANCELLED then.
  */
 pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], const pbox *within,
                        double tol, size_t budget, const pde_cancel *cancel, bb_result *out);

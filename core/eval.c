@@ -87,9 +87,9 @@ void pde_grid_free(pde_grid *g)
         free(g->group[c]);
         free(g->phi[c]);
         free(g->psi[c]);
-        free(g->h[c]);
         free(g->k[c]);
     }
+    free(g->hs);
     free(g->row);
     free(g->col);
     free(g);
@@ -107,18 +107,22 @@ pde_status pde_grid_create(const pde_solution *sol, const double *us, size_t nu,
     g->nu = nu;
     g->nv = nv;
     g->w = NAN;
+    const size_t mt = sol->comp[0].nmodes + sol->comp[1].nmodes + sol->comp[2].nmodes;
     g->row = malloc(12 * nu * sizeof *g->row);
-    if (!g->row)
+    g->hs = malloc(2 * (mt ? mt : 1) * sizeof *g->hs);
+    if (!g->row || !g->hs)
         goto nomem;
-    for (int c = 0; c < 3; c++) {
+    size_t off = 0;
+    for (int c = 0; c < 3; off += sol->comp[c].nmodes, c++) {
         const pde_mode *modes = sol->comp[c].modes;
         size_t nm = sol->comp[c].nmodes, k = nm ? nm : 1, nd = 0;
         g->nm[c] = nm;
         g->group[c] = malloc(k * sizeof *g->group[c]);
         g->psi[c] = malloc(2 * k * nv * sizeof(double));
-        g->h[c] = malloc(2 * k * sizeof(double));
+        g->h[c] = g->hs + off;
+        g->dh[c] = g->hs + (mt ? mt : 1) + off;
         g->k[c] = malloc(3 * k * sizeof(double));
-        if (!g->group[c] || !g->psi[c] || !g->h[c] || !g->k[c])
+        if (!g->group[c] || !g->psi[c] || !g->k[c])
             goto nomem;
         for (size_t m = 0; m < nm; m++) {
             size_t d = 0;
@@ -132,7 +136,6 @@ pde_status pde_grid_create(const pde_solution *sol, const double *us, size_t nu,
             goto nomem;
         g->dphi[c] = g->phi[c] + (nd ? nd : 1) * nu;
         g->dpsi[c] = g->psi[c] + k * nv;
-        g->dh[c] = g->h[c] + k;
         for (size_t m = 0; m < nm; m++) {
             size_t d = g->group[c][m];
             for (size_t i = 0; i < nu; i++)
@@ -145,7 +148,8 @@ pde_status pde_grid_create(const pde_solution *sol, const double *us, size_t nu,
         size_t ndmax = 1;
         for (int c = 0; c < 3; c++)
             ndmax = g->nd[c] > ndmax ? g->nd[c] : ndmax;
-        if (!(g->col = malloc(3 * ndmax * nv * sizeof *g->col)))
+        /* 3 nv more when nd = 1, 1, 1: grid_cols then keeps the three components' coefficients */
+        if (!(g->col = malloc((3 * ndmax > 9 ? 3 * ndmax : 9) * nv * sizeof *g->col)))
             goto nomem;
     }
     *out = g;
@@ -155,13 +159,19 @@ nomem:
     return PDE_ERR_NOMEM;
 }
 
-/* row[i] = sum_d k_d tab[d][i]. */
+/* row[i] = sum_d k_d tab[d][i], the first product stored rather than added to 0 (but for its zero's sign, the
+ * same sums). */
 static void combine(double *restrict row, const double *restrict tab, const double *restrict k,
                     size_t nd, size_t n)
 {
+    if (nd == 0) {
+        for (size_t i = 0; i < n; i++)
+            row[i] = 0.0;
+        return;
+    }
     for (size_t i = 0; i < n; i++)
-        row[i] = 0.0;
-    for (size_t d = 0; d < nd; d++) {
+        row[i] = k[0] * tab[i];
+    for (size_t d = 1; d < nd; d++) {
         const double kd = k[d];
         const double *restrict t = tab + d * n;
         for (size_t i = 0; i < n; i++)
@@ -174,9 +184,7 @@ void grid_set_w(pde_grid *g, double w)
     if (w == g->w)
         return;
     g->w = w;
-    for (int c = 0; c < 3; c++)
-        for (size_t m = 0; m < g->nm[c]; m++)
-            mode_h(&g->sol->comp[c].modes[m], w, &g->h[c][m], &g->dh[c][m]);
+    solution_factors(g->sol, 2, w, g->h[0], g->dh[0]);
 }
 
 /* Each distinct u-factor's coefficient in row j: sums of h f_v over its modes. */
@@ -301,51 +309,105 @@ static inline float dot_k(const double *k, size_t ks, const double *t, size_t ts
 }
 
 /*
- * Rows j0 <= j < j1 of a narrow grid (nu <= COL_NU): grid_coefs for every row at once, mode by mode
- * over contiguous v (the same sums in the same order), then each point's few dot products.
+ * Component c's coefficients of rows j0 .. j0 + n - 1 of a narrow grid, grid_coefs' sums in the same order: u-factor d's
+ * of row j at kx[s (d n + j)] (kv, kw likewise; not written when xonly), BLK rows at a time in registers, summed over
+ * its modes in order, mode by mode over contiguous v.
+ */
+static void col_coefs(const pde_grid *g, int c, size_t j0, size_t n, int xonly, size_t s, double *restrict kx,
+                      double *restrict kv, double *restrict kw)
+{
+    const size_t nd = g->nd[c], nm = g->nm[c], nv = g->nv;
+    enum { BLK = 8 };
+    for (size_t d = 0; d < nd; d++)
+        for (size_t jb = 0; jb < n; jb += BLK) {
+            const size_t nb = n - jb < BLK ? n - jb : BLK;
+            double ax[BLK] = { 0 }, av[BLK] = { 0 }, aw[BLK] = { 0 };
+            for (size_t m = 0; m < nm; m++) {
+                if (g->group[c][m] != d)
+                    continue;
+                const double h = g->h[c][m], dh = g->dh[c][m];
+                const double *restrict p = g->psi[c] + m * nv + j0 + jb, *restrict dp = g->dpsi[c] + m * nv + j0 + jb;
+                if (nb == BLK && !xonly) {
+                    for (size_t j = 0; j < BLK; j++) {
+                        ax[j] += h * p[j];
+                        av[j] += h * dp[j];
+                        aw[j] += dh * p[j];
+                    }
+                } else if (nb == BLK) {   /* positions only: x's coefficients alone */
+                    for (size_t j = 0; j < BLK; j++)
+                        ax[j] += h * p[j];
+                } else {
+                    for (size_t j = 0; j < nb; j++) {
+                        ax[j] += h * p[j];
+                        av[j] += h * dp[j];
+                        aw[j] += dh * p[j];
+                    }
+                }
+            }
+            for (size_t j = 0; j < nb; j++)
+                kx[s * (d * n + jb + j)] = ax[j];
+            for (size_t j = 0; j < nb && !xonly; j++) {
+                kv[s * (d * n + jb + j)] = av[j];
+                kw[s * (d * n + jb + j)] = aw[j];
+            }
+        }
+}
+
+/*
+ * Faces u = 0, 1 of one u-factor a component (nd = 1, 1, 1), each output's 6 floats a row: k[3j + c] t[c] for
+ * u = 0, then k[3j + c] t[3 + c] for u = 1, k a row's three coefficients side by side. The products and their
+ * rounding to float of grid_cols' case 1, two rows (12 floats) a step.
+ */
+static void emit_ends(float *restrict o, size_t n, const double *restrict k, const double t[6])
+{
+    size_t j = 0;
+#if defined(__SSE2__)
+    const __m128d T0 = _mm_loadu_pd(t), T1 = _mm_loadu_pd(t + 2), T2 = _mm_loadu_pd(t + 4);   /* x0 y0, z0 x1, y1 z1 */
+    for (; j + 2 <= n; j += 2) {
+        const __m128d A = _mm_loadu_pd(k + 3 * j), B = _mm_loadu_pd(k + 3 * j + 2), C = _mm_loadu_pd(k + 3 * j + 4);
+        /* A = kx ky, B = kz kx', C = ky' kz' (' the next row) */
+        const __m128 p0 = _mm_cvtpd_ps(_mm_mul_pd(A, T0));
+        const __m128 p1 = _mm_cvtpd_ps(_mm_mul_pd(_mm_shuffle_pd(B, A, 0), T1));
+        const __m128 p2 = _mm_cvtpd_ps(_mm_mul_pd(_mm_shuffle_pd(A, B, 1), T2));
+        const __m128 p3 = _mm_cvtpd_ps(_mm_mul_pd(_mm_shuffle_pd(B, C, 1), T0));
+        const __m128 p4 = _mm_cvtpd_ps(_mm_mul_pd(_mm_shuffle_pd(C, B, 3), T1));
+        const __m128 p5 = _mm_cvtpd_ps(_mm_mul_pd(C, T2));
+        _mm_storeu_ps(o + 6 * j, _mm_movelh_ps(p0, p1));
+        _mm_storeu_ps(o + 6 * j + 4, _mm_movelh_ps(p2, p3));
+        _mm_storeu_ps(o + 6 * j + 8, _mm_movelh_ps(p4, p5));
+    }
+#endif
+    for (; j < n; j++)
+        for (int c = 0; c < 3; c++)
+            o[6 * j + c] = (float)(k[3 * j + c] * t[c]), o[6 * j + 3 + c] = (float)(k[3 * j + c] * t[3 + c]);
+}
+
+/*
+ * Rows j0 <= j < j1 of a narrow grid (nu <= COL_NU): grid_coefs for every row at once (col_coefs), then each point's
+ * few dot products.
  */
 static void grid_cols(pde_grid *g, size_t j0, size_t j1, float *const outs[4])
 {
-    const size_t nu = g->nu, nv = g->nv, n = j1 - j0;
+    const size_t nu = g->nu, n = j1 - j0;
     const int xonly = !outs[1] && !outs[2] && !outs[3];   /* kv, kw unused */
+    if (nu == 2 && g->nd[0] == 1 && g->nd[1] == 1 && g->nd[2] == 1) {   /* the three components' rows at once */
+        double *kx = g->col, *kv = kx + 3 * n, *kw = kv + 3 * n;
+        for (int c = 0; c < 3; c++)
+            col_coefs(g, c, j0, n, xonly, 3, kx + c, kv + c, kw + c);
+        const double *ks[4] = { kx, kx, kv, kw };
+        for (int q = 0; q < 4; q++) {
+            if (!outs[q])
+                continue;
+            double *const *tab = q == 1 ? g->dphi : g->phi;   /* x_u: the factors' derivatives */
+            const double t[6] = { tab[0][0], tab[1][0], tab[2][0], tab[0][1], tab[1][1], tab[2][1] };
+            emit_ends(outs[q], n, ks[q], t);
+        }
+        return;
+    }
     for (int c = 0; c < 3; c++) {
-        const size_t nd = g->nd[c], nm = g->nm[c];
+        const size_t nd = g->nd[c];
         double *restrict kx = g->col, *restrict kv = kx + nd * n, *restrict kw = kv + nd * n;
-        /* a u-factor's coefficients, BLK rows at a time in registers, summed over its modes in order */
-        enum { BLK = 8 };
-        for (size_t d = 0; d < nd; d++)
-            for (size_t jb = 0; jb < n; jb += BLK) {
-                const size_t nb = n - jb < BLK ? n - jb : BLK;
-                double ax[BLK] = { 0 }, av[BLK] = { 0 }, aw[BLK] = { 0 };
-                for (size_t m = 0; m < nm; m++) {
-                    if (g->group[c][m] != d)
-                        continue;
-                    const double h = g->h[c][m], dh = g->dh[c][m];
-                    const double *restrict p = g->psi[c] + m * nv + j0 + jb, *restrict dp = g->dpsi[c] + m * nv + j0 + jb;
-                    if (nb == BLK && !xonly) {
-                        for (size_t j = 0; j < BLK; j++) {
-                            ax[j] += h * p[j];
-                            av[j] += h * dp[j];
-                            aw[j] += dh * p[j];
-                        }
-                    } else if (nb == BLK) {   /* positions only: x's coefficients alone */
-                        for (size_t j = 0; j < BLK; j++)
-                            ax[j] += h * p[j];
-                    } else {
-                        for (size_t j = 0; j < nb; j++) {
-                            ax[j] += h * p[j];
-                            av[j] += h * dp[j];
-                            aw[j] += dh * p[j];
-                        }
-                    }
-                }
-                for (size_t j = 0; j < nb; j++)
-                    kx[d * n + jb + j] = ax[j];
-                for (size_t j = 0; j < nb && !xonly; j++) {
-                    kv[d * n + jb + j] = av[j];
-                    kw[d * n + jb + j] = aw[j];
-                }
-            }
+        col_coefs(g, c, j0, n, xonly, 1, kx, kv, kw);
         const double *tab[4] = { g->phi[c], g->dphi[c], g->phi[c], g->phi[c] };
         const double *ks[4] = { kx, kx, kv, kw };
         for (int q = 0; q < 4; q++) {

@@ -125,23 +125,70 @@ static void horner2(const double *c, int deg, double w, double *p, double *dp)
     *dp = d;
 }
 
-void mode_h(const pde_mode *m, double w, double *h, double *dh)
+/*
+ * The exps and sincos already taken at one w, by (alpha, shift) and by beta: w-terms of other modes
+ * often share them (the sin and cos modes of one frequency have the same terms' exponents). The
+ * last MEMO_N of each are kept.
+ */
+enum { MEMO_N = 8 };
+
+typedef struct {
+    unsigned ne, nt;
+    double ea[MEMO_N], es[MEMO_N], ev[MEMO_N];   /* alpha, shift: exp(alpha (w - shift)) */
+    double tb[MEMO_N], tc[MEMO_N], ts[MEMO_N];   /* beta: cos(beta w), sin(beta w) */
+} wmemo;
+
+static inline double memo_exp(wmemo *mc, const pde_wterm *t, double w)
+{
+    if (t->alpha == 0.0)
+        return 1.0;
+    if (!mc)
+        return exp(t->alpha * (w - t->shift));
+    for (unsigned i = 0; i < mc->ne && i < MEMO_N; i++)
+        if (mc->ea[i] == t->alpha && mc->es[i] == t->shift)
+            return mc->ev[i];
+    const double e = exp(t->alpha * (w - t->shift));
+    const unsigned i = mc->ne++ % MEMO_N;
+    mc->ea[i] = t->alpha, mc->es[i] = t->shift, mc->ev[i] = e;
+    return e;
+}
+
+static inline void memo_sincos(wmemo *mc, double beta, double w, double *c, double *s)
+{
+    if (!mc) {
+        *c = cos(beta * w), *s = sin(beta * w);
+        return;
+    }
+    for (unsigned i = 0; i < mc->nt && i < MEMO_N; i++)
+        if (mc->tb[i] == beta) {
+            *c = mc->tc[i], *s = mc->ts[i];
+            return;
+        }
+    *c = cos(beta * w), *s = sin(beta * w);
+    const unsigned i = mc->nt++ % MEMO_N;
+    mc->tb[i] = beta, mc->tc[i] = *c, mc->ts[i] = *s;
+}
+
+/* mode_h, with the exps and sincos of mc (NULL: none kept). The library calls come first in a term,
+ * so that fewer values live across them (and are spilled to memory). */
+static inline void mode_h_memo(const pde_mode *m, double w, wmemo *mc, double *h, double *dh)
 {
     double hv = 0.0, hd = 0.0;
     size_t k0, k1;
     mode_slab(m, w, &k0, &k1);
     for (size_t k = k0; k < k1; k++) {
         const pde_wterm *t = &m->terms[k];
+        const double E = memo_exp(mc, t, w);
         double a, da;
-        horner2(t->A, t->deg, w, &a, &da);
-        double E = t->alpha != 0.0 ? exp(t->alpha * (w - t->shift)) : 1.0;
         if (t->beta == 0.0) {
+            horner2(t->A, t->deg, w, &a, &da);
             hv += E * a;
             hd += E * (t->alpha * a + da);
         } else {
-            double b, db;
+            double b, db, c, s;
+            memo_sincos(mc, t->beta, w, &c, &s);
+            horner2(t->A, t->deg, w, &a, &da);
             horner2(t->B, t->deg, w, &b, &db);
-            double c = cos(t->beta * w), s = sin(t->beta * w);
             double v = a * c + b * s;
             hv += E * v;
             hd += E * (t->alpha * v + da * c + db * s + t->beta * (b * c - a * s));
@@ -151,15 +198,79 @@ void mode_h(const pde_mode *m, double w, double *h, double *dh)
     *dh = hd;
 }
 
+void mode_h(const pde_mode *m, double w, double *h, double *dh)
+{
+    mode_h_memo(m, w, NULL, h, dh);
+}
+
+void solution_factors(const pde_solution *s, int axis, double t, double *val, double *der)
+{
+    size_t o = 0;
+    if (axis == 2) {
+        wmemo mc;
+        mc.ne = mc.nt = 0;
+        for (int c = 0; c < 3; c++)
+            for (size_t m = 0; m < s->comp[c].nmodes; m++, o++)
+                mode_h_memo(&s->comp[c].modes[m], t, &mc, &val[o], &der[o]);
+        return;
+    }
+    /* the last MEMO_N distinct factors and their places in val, der: a factor recurs across modes;
+     * and sin(k pi t), cos(k pi t) by k, which sin and cos factors of one k share */
+    pde_factor key[MEMO_N];
+    size_t at[MEMO_N];
+    double tk[MEMO_N], ts[MEMO_N], tc[MEMO_N];
+    unsigned nk = 0, nt = 0;
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes; m++, o++) {
+            const pde_factor f = axis ? s->comp[c].modes[m].v : s->comp[c].modes[m].u;
+            unsigned i = 0;
+            while (i < nk && i < MEMO_N && !(key[i].kind == f.kind && key[i].p == f.p))
+                i++;
+            if (i < nk && i < MEMO_N) {
+                val[o] = val[at[i]], der[o] = der[at[i]];
+                continue;
+            }
+            if (f.kind == PDE_SIN || f.kind == PDE_COS) {   /* factor_eval's values */
+                const double w = f.p * M_PI;
+                unsigned j = 0;
+                while (j < nt && j < MEMO_N && tk[j] != f.p)
+                    j++;
+                if (!(j < nt && j < MEMO_N)) {
+                    j = nt++ % MEMO_N;
+                    tk[j] = f.p, ts[j] = sin(w * t), tc[j] = cos(w * t);
+                }
+                val[o] = f.kind == PDE_SIN ? ts[j] : tc[j];
+                der[o] = f.kind == PDE_SIN ? w * tc[j] : -w * ts[j];
+            } else
+                factor_eval(f, t, &val[o], &der[o]);
+            i = nk++ % MEMO_N;
+            key[i] = f, at[i] = o;
+        }
+}
+
 /*
  * The term is Re[(A - iB)(w) exp(alpha (w - shift)) exp(i beta w)], and
- * d^n/dw^n [P(w) e^{zw}] = e^{zw} sum_j C(n,j) z^(n-j) P^(j)(w), z = alpha + i beta.
+ * d^n/dw^n [P(w) e^{zw}] = e^{zw} sum_j C(n,j) z^(n-j) P^(j)(w), z = alpha + i beta; with beta = 0
+ * the term is A(w) E, the real parts of the same sums.
  */
 double wterm_deriv(const pde_wterm *t, double w, int n)
 {
+    const double E = t->alpha != 0.0 ? exp(t->alpha * (w - t->shift)) : 1.0;
+    double binom = 1.0;
+    if (t->beta == 0.0) {
+        double sum = 0.0, zp = 1.0;
+        for (int j = n; j >= 0; j--) {
+            double pj = 0.0;
+            for (int k = t->deg; k >= j; k--)
+                pj = pj * w + falling(k, j) * t->A[k];
+            sum += binom * zp * pj;
+            zp *= t->alpha;
+            binom = binom * j / (n - j + 1);
+        }
+        return E * sum;
+    }
     double complex z = t->alpha + I * t->beta;
     double complex sum = 0.0, zp = 1.0;
-    double binom = 1.0;
     for (int j = n; j >= 0; j--) {
         /* P^(j)(w): Horner over the j-th derivative's coefficients. */
         double complex pj = 0.0;
@@ -169,8 +280,7 @@ double wterm_deriv(const pde_wterm *t, double w, int n)
         zp *= z;
         binom = binom * j / (n - j + 1);
     }
-    double E = exp(t->alpha * (w - t->shift));
-    return E * creal(sum * cexp(I * t->beta * w));
+    return E * (creal(sum) * cos(t->beta * w) - cimag(sum) * sin(t->beta * w));
 }
 
 void factor_derivs(pde_factor f, double t, int n, double *d)
@@ -212,6 +322,35 @@ void factor_derivs(pde_factor f, double t, int n, double *d)
         d[k] = 0.0;
 }
 
+/* C(k, j) for k, j <= 7, exact: the binomial sums of the derivatives of P(w) e^{zw}. */
+static const double binom7[8][8] = {
+    { 1 }, { 1, 1 }, { 1, 2, 1 }, { 1, 3, 3, 1 }, { 1, 4, 6, 4, 1 }, { 1, 5, 10, 10, 5, 1 },
+    { 1, 6, 15, 20, 15, 6, 1 }, { 1, 7, 21, 35, 35, 21, 7, 1 },
+};
+
+/*
+ * P^(j)(w), j = 0..n, of the coefficients c[0..deg] (stride 1) by one Horner pass per j, all passes
+ * sharing each coefficient: q[j] = q[j] w + k!/(k-j)! c[k], k from deg down to j.
+ */
+static void poly_derivs(const double *c, int deg, double w, int n, double *q)
+{
+    for (int j = 0; j <= n; j++)
+        q[j] = 0.0;
+    for (int k = deg; k >= 0; k--) {
+        double f = 1.0;
+        for (int j = 0; j <= n && j <= k; j++) {
+            q[j] = q[j] * w + f * c[k];
+            f *= k - j;
+        }
+    }
+}
+
+/*
+ * The term is Re[(A - iB)(w) e^{alpha (w - shift)} e^{i beta w}] and, with z = alpha + i beta,
+ * d^k [P e^{zw}] = e^{zw} sum_(j <= k) C(k,j) z^(k-j) P^(j)(w). With beta = 0 the term is A(w) E
+ * and takes real arithmetic (the real parts of the complex sums, the same roundings); with alpha = 0
+ * as well its k-th derivative is A^(k).
+ */
 void mode_h_derivs(const pde_mode *m, double w, int n, double *d)
 {
     for (int k = 0; k <= n; k++)
@@ -220,36 +359,56 @@ void mode_h_derivs(const pde_mode *m, double w, int n, double *d)
     mode_slab(m, w, &i0, &i1);
     for (size_t i = i0; i < i1; i++) {
         const pde_wterm *t = &m->terms[i];
-        const double complex z = t->alpha + I * t->beta;
-        double complex q[8];   /* (A - iB)^(j)(w), j <= n */
-        for (int j = 0; j <= n; j++) {
-            q[j] = 0.0;
-            for (int k = t->deg; k >= j; k--)
-                q[j] = q[j] * w + falling(k, j) * (t->A[k] - I * t->B[k]);
+        double a[8], b[8];   /* A^(j)(w), B^(j)(w), j <= n */
+        poly_derivs(t->A, t->deg, w, n, a);
+        if (t->alpha == 0.0 && t->beta == 0.0) {
+            for (int k = 0; k <= n; k++)
+                d[k] += a[k];
+            continue;
         }
-        const double complex e = exp(t->alpha * (w - t->shift)) * cexp(I * t->beta * w);
-        for (int k = 0; k <= n; k++) {
-            double complex sum = 0.0, zp = 1.0;
-            double binom = 1.0;
-            for (int j = k; j >= 0; j--) {
-                sum += binom * zp * q[j];
-                zp *= z;
-                binom = binom * j / (k - j + 1);
+        const double E = t->alpha != 0.0 ? exp(t->alpha * (w - t->shift)) : 1.0;
+        if (t->beta == 0.0) {
+            double zp[8] = { 1.0 };
+            for (int k = 1; k <= n; k++)
+                zp[k] = zp[k - 1] * t->alpha;
+            for (int k = 0; k <= n; k++) {
+                double sum = 0.0;
+                for (int j = k < t->deg ? k : t->deg; j >= 0; j--)   /* a[j > deg] = 0 */
+                    sum += binom7[k][j] * zp[k - j] * a[j];
+                d[k] += E * sum;
             }
-            d[k] += creal(e * sum);
+            continue;
+        }
+        poly_derivs(t->B, t->deg, w, n, b);
+        const double complex z = t->alpha + I * t->beta;
+        double complex zp[8] = { 1.0 };
+        for (int k = 1; k <= n; k++)
+            zp[k] = zp[k - 1] * z;
+        const double c = cos(t->beta * w), s = sin(t->beta * w);
+        for (int k = 0; k <= n; k++) {
+            double complex sum = 0.0;
+            for (int j = k < t->deg ? k : t->deg; j >= 0; j--)
+                sum += binom7[k][j] * zp[k - j] * (a[j] - I * b[j]);
+            d[k] += (E * c) * creal(sum) - (E * s) * cimag(sum);
         }
     }
 }
 
-/* max |sin| over [a, b] */
-static double maxabs_sin(double a, double b)
+/* max |sin| and max |cos| over [a, b]: 1 where the interval holds a peak, else the larger end */
+static void maxabs_sincos(double a, double b, double *ms, double *mc)
 {
-    if (b - a >= M_PI)
-        return 1.0;
-    double m = ceil((a - M_PI_2) / M_PI);
-    if (M_PI_2 + m * M_PI <= b)
-        return 1.0;
-    return fmax(fabs(sin(a)), fabs(sin(b)));
+    if (b - a >= M_PI) {
+        *ms = *mc = 1.0;
+        return;
+    }
+    const int speak = M_PI_2 + ceil((a - M_PI_2) / M_PI) * M_PI <= b, cpeak = ceil(a / M_PI) * M_PI <= b;
+    if (speak && cpeak) {
+        *ms = *mc = 1.0;
+        return;
+    }
+    const double sa = sin(a), ca = cos(a), sb = sin(b), cb = cos(b);
+    *ms = speak ? 1.0 : fmax(fabs(sa), fabs(sb));
+    *mc = cpeak ? 1.0 : fmax(fabs(ca), fabs(cb));
 }
 
 void factor_bounds(pde_factor f, double t0, double t1, int n, double *d)
@@ -264,11 +423,11 @@ void factor_bounds(pde_factor f, double t0, double t1, int n, double *d)
     }
     case PDE_SIN:
     case PDE_COS: {
-        double w = fabs(f.p) * M_PI, wk = 1.0;
-        for (int k = 0; k <= n; k++, wk *= w) {
-            double ph = (k + (f.kind == PDE_COS)) * M_PI_2;
-            d[k] = wk * maxabs_sin(w * t0 + ph, w * t1 + ph);
-        }
+        /* |sin| at even phases (k + cos), |cos| at odd ones: two maxima for all orders */
+        double w = fabs(f.p) * M_PI, wk = 1.0, mx[2];
+        maxabs_sincos(w * t0, w * t1, &mx[0], &mx[1]);
+        for (int k = 0; k <= n; k++, wk *= w)
+            d[k] = wk * mx[(k + (f.kind == PDE_COS)) & 1];
         return;
     }
     case PDE_EXP: {
@@ -289,7 +448,17 @@ void factor_bounds(pde_factor f, double t0, double t1, int n, double *d)
         d[k] = 0.0;
 }
 
-/* Bounds over [w0, w1] of the terms i0 .. i1 - 1. */
+/* |x + iy|, without hypot where one part is 0 (the same value). */
+static double cabs2(double x, double y)
+{
+    return y == 0.0 ? fabs(x) : x == 0.0 ? fabs(y) : hypot(x, y);
+}
+
+/*
+ * Bounds over [w0, w1] of the terms i0 .. i1 - 1: |(A - iB)^(j)| <= the same polynomial's derivative
+ * with coefficients |A_k - iB_k| at W = max |w| (|A_k| alone where beta = 0, which makes the term
+ * A(w) E), and |z| for z, in mode_h_derivs' sums.
+ */
 static void terms_bounds(const pde_mode *m, size_t i0, size_t i1, double w0, double w1, int n, double *d)
 {
     const double W = fmax(fabs(w0), fabs(w1));
@@ -297,21 +466,31 @@ static void terms_bounds(const pde_mode *m, size_t i0, size_t i1, double w0, dou
         d[k] = 0.0;
     for (size_t i = i0; i < i1; i++) {
         const pde_wterm *t = &m->terms[i];
-        const double az = hypot(t->alpha, t->beta);
-        double q[8];   /* bounds of |(A - iB)^(j)| over the interval */
-        for (int j = 0; j <= n; j++) {
+        double q[8];   /* bounds of |(A - iB)^(j)| over the interval, Horner passes as in poly_derivs */
+        for (int j = 0; j <= n; j++)
             q[j] = 0.0;
-            for (int k = t->deg; k >= j; k--)
-                q[j] = q[j] * W + falling(k, j) * hypot(t->A[k], t->B[k]);
-        }
-        const double E = exp(t->alpha * ((t->alpha >= 0 ? w1 : w0) - t->shift));
-        for (int k = 0; k <= n; k++) {
-            double sum = 0.0, zp = 1.0, binom = 1.0;
-            for (int j = k; j >= 0; j--) {
-                sum += binom * zp * q[j];
-                zp *= az;
-                binom = binom * j / (k - j + 1);
+        for (int k = t->deg; k >= 0; k--) {
+            const double c = t->beta == 0.0 ? fabs(t->A[k]) : cabs2(t->A[k], t->B[k]);
+            double f = 1.0;
+            for (int j = 0; j <= n && j <= k; j++) {
+                q[j] = q[j] * W + f * c;
+                f *= k - j;
             }
+        }
+        if (t->alpha == 0.0 && t->beta == 0.0) {
+            for (int k = 0; k <= n; k++)
+                d[k] += q[k];
+            continue;
+        }
+        const double az = cabs2(t->alpha, t->beta);
+        const double E = exp(t->alpha * ((t->alpha >= 0 ? w1 : w0) - t->shift));
+        double zp[8] = { 1.0 };
+        for (int k = 1; k <= n; k++)
+            zp[k] = zp[k - 1] * az;
+        for (int k = 0; k <= n; k++) {
+            double sum = 0.0;
+            for (int j = k < t->deg ? k : t->deg; j >= 0; j--)   /* q[j > deg] = 0 */
+                sum += binom7[k][j] * zp[k - j] * q[j];
             d[k] += E * sum;
         }
     }

@@ -152,6 +152,11 @@ void mode_h_bounds(const pde_mode *m, double w0, double w1, int n, double *d);
 /* h(w) and h'(w) of a mode. */
 void mode_h(const pde_mode *m, double w, double *h, double *dh);
 
+/* Every mode's factor along axis (0: f_u, 1: f_v, 2: h) and its derivative at t, the modes of x,
+ * y, z in order, into val[] and der[]: the values of factor_eval and mode_h, each factor and each
+ * w-term's exp and sincos computed once where modes share them. */
+void solution_factors(const pde_solution *s, int axis, double t, double *val, double *der);
+
 /* A sampling grid (pde.h). Modes that share their u-factor share a row of the
  * u table, so a point costs one multiply-add per distinct u-factor, not per
  * mode. row holds, for row j of the current plane, x then xu, xv, xw, each as
@@ -164,11 +169,12 @@ struct pde_grid {
     size_t *group[3];           /* nm: each mode's u-factor */
     double *phi[3], *dphi[3];   /* nd x nu: f_u and f_u' at each u */
     double *psi[3], *dpsi[3];   /* nm x nv */
-    double *h[3], *dh[3];       /* nm: h and h' at the current plane */
+    double *hs;                 /* h of every mode, x's modes then y's and z's, then h' likewise */
+    double *h[3], *dh[3];       /* nm: h and h' at the current plane, in hs */
     double w;                   /* the current plane, NaN before the first */
     double *k[3];               /* 3 nd: a row's coefficients for x, xv and xw */
     double *row;                /* 12 nu */
-    double *col;                /* nu <= COL_NU: 3 max(nd) nv, the coefficients of a plane's rows side by side */
+    double *col;                /* nu <= COL_NU: max(3 max(nd), 9) nv, the coefficients of a plane's rows side by side */
 };
 
 /* Grids this narrow (faces u = const) fill a plane column-wise: the coefficients of all its rows at

@@ -318,9 +318,12 @@ typedef struct {
  * change sign, and for the skin's. */
 #define PDE_PROPS_WORK (6.0 * (1u << 21))
 
-/* Boxes of one branch and bound, at most: of a coordinate's extreme, and of det J's (pde_properties). */
-#define PDE_PROPS_BOXES   2000
-#define PDE_PROPS_BOXES_J 1000
+/* Boxes of one branch and bound, at most: of a coordinate's extreme, and of det J's (pde_properties),
+ * whose budget grows with the solid's frequencies from PDE_PROPS_BOXES_J up to PDE_PROPS_BOXES_J_MAX. */
+#define PDE_PROPS_BOXES       2000
+#define PDE_PROPS_BOXES_J     1000
+#define PDE_PROPS_BOXES_J_MAX 32000
+#define PDE_PROPS_J_WORK      3e6    /* det J's grown budget stops at this / (modes + 3)^2 (fig. 3: 32000, tower: 1000) */
 
 /* A zeroed options struct gives the defaults. */
 typedef struct {
@@ -336,6 +339,10 @@ void pde_properties_nodes(const pde_solution *sol, size_t nodes[3]);
 /* The axis (0: u, 1: v) along which det J separates, so that pde_properties() integrates the solid
  * over the face of that axis at 1 alone (docs/MATH.md, "Separable solids"), or -1 (for api/cost.h). */
 int pde_properties_flat_axis(const pde_solution *sol);
+
+/* det J's branch-and-bound budget of boxes per extreme: PDE_PROPS_BOXES_J, grown with the solid's fastest
+ * rate up to PDE_PROPS_BOXES_J_MAX (for api/cost.h). */
+size_t pde_properties_detj_boxes(const pde_solution *sol);
 
 /* Where det J also does not depend on that face's other parameter (docs/MATH.md, "det J constant
  * along the face"): that parameter (0: u, 1: v), so that det J's bounds and the integrals' roots

@@ -551,6 +551,39 @@ static void scales(const double best[8], double *size, double *jscale)
     *jscale = js > 0.0 ? js : 1.0;
 }
 
+/*
+ * det J's box budget: PDE_PROPS_BOXES_J times (w / pi)^2 / 2, at most PDE_PROPS_BOXES_J_MAX boxes,
+ * w the solid's fastest rate (of a sin, cos, sinh, cosh or exp factor, or of a w-term). A branch
+ * and bound first covers the region where det J is near its extreme with boxes whose remainder
+ * bounds, (w r)^4 times the looseness of bounds of products, are below det J's variation, so r ~
+ * 1/w along each axis: fig. 3's sin(8..30 pi v) took 3.3k to 23k boxes a side (2-D fig. 3a, 3b: 3.3k
+ * to 16k; 3-D fig. 3c, 3d: 3.6k to 23k) where fig. 1, 2 and 4 take at most 1000. The budget only
+ * caps a search that has not closed its gap. Its growth stops at PDE_PROPS_J_WORK / (modes + 3)^2.
+ */
+size_t pde_properties_detj_boxes(const pde_solution *s)
+{
+    double w = 0.0;
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
+            const pde_mode *md = &s->comp[c].modes[m];
+            const pde_factor f[2] = { md->u, md->v };
+            for (int a = 0; a < 2; a++)
+                if (f[a].kind != PDE_POW)
+                    w = fmax(w, fabs(f[a].p) * (f[a].kind == PDE_SIN || f[a].kind == PDE_COS ? M_PI : 1.0));
+            for (size_t k = 0; k < md->nterms; k++)
+                w = fmax(w, hypot(md->terms[k].alpha, md->terms[k].beta));
+        }
+    const double grow = fmin(fmax(0.5 * (w / M_PI) * (w / M_PI), 1.0), (double)PDE_PROPS_BOXES_J_MAX / PDE_PROPS_BOXES_J);
+    /* The growth is for solids of few fast modes (fig. 3: 5 or 6). A box costs jets of every mode, and a
+     * solid of many (a loft of 64-point sections: tower, 99 modes) did not close its gap in 3000 boxes
+     * either: the budget falls back to PDE_PROPS_BOXES_J as (modes + 3)^2 reaches PDE_PROPS_J_WORK / 1000. */
+    size_t modes = 0;
+    for (int c = 0; c < 3; c++)
+        modes += s->comp[c].nmodes;
+    const double cap = fmax((double)PDE_PROPS_BOXES_J, PDE_PROPS_J_WORK / ((double)(modes + 3) * (double)(modes + 3)));
+    return (size_t)fmin(grow * PDE_PROPS_BOXES_J, cap);
+}
+
 /* The extreme of sign * det J by branch and bound, over the face where det J separates. */
 static pde_status what_detj(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
                             double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
@@ -613,6 +646,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     quad_separate(s, &sp);
     double jlow[2], jat[2][3];   /* det J's certified lower bounds of +det J, -det J, without the pad */
     int single[3] = { 0, 0, 0 };   /* components of one mode: both extremes from single_mode_extremes */
+    const size_t jbudget = pde_properties_detj_boxes(s);
     bb_result sb[3][2];
     for (int o = 0; o < 8; o++) {
         const int what = o < 6 ? o / 2 : 3;
@@ -632,7 +666,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         }
         if (what < 3 && single[what])
             b = sb[what][o & 1];
-        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, PDE_PROPS_BOXES_J, cancel, &b)
+        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, jbudget, cancel, &b)
                        : sp.axis >= 0 ? separable_extreme(s, &sp, what, sign, at[o], tol, PDE_PROPS_BOXES, cancel, &b)
                                       : bb_minimise(s, what, sign, at[o], NULL, tol, PDE_PROPS_BOXES, cancel, &b)) != PDE_OK)
             return st;

@@ -48,9 +48,14 @@
 #define MAX_WORK PDE_PROPS_WORK   /* nodes of the rules times (modes + 1), at most: bounded work */
 #define MAX_EDGES (MAX_PANELS + PDE_MAX_SECTIONS)   /* panels along w: MAX_PANELS, plus one per slab */
 #define FACE_DEPTH 4          /* halvings of a face's panel in its refinement, at most */
+#define FACE_DEPTH_MAX 8      /* ... and 8 where a panel still differs from its quarters by FACE_DEEP tolerances */
+#define FACE_DEEP 30.0        /* (fig. 4a: two panels at a cusp of the fold, 8.7e-7 apart at depth 4) */
 #define FACE_EST 1e4          /* a face panel whose estimate is below this times the tolerance is not split */
 #define FACE_EST_MIN 0.3      /* ... unless its element falls below this of its largest at the nodes */
-#define FACE_REFINE 256       /* face panels refined, at most: fig. 4's, not all of fig. 3's */
+/* Face panels refined, at most: every panel of the six faces. At 256 (fig. 4's, not all of fig. 3's),
+ * fig. 3d's area was 6.6e-8 off the reference, now 2.4e-10 (fig. 3c: 7.3e-10 -> 8e-13) for 6% and 8%
+ * more instructions; REFINE_WORK bounds the work. */
+#define FACE_REFINE (6 * MAX_PANELS * MAX_PANELS)
 #define POLL_WORK 65536       /* factor evaluations between polls of the caller's stop() */
 #define OUTER_DEPTH 2         /* halvings of a panel in its refinement, at most */
 #define OFF_WORK MAX_WORK   /* points off the tables times (modes + 1), at most */
@@ -61,6 +66,10 @@
  * at four halvings (7e-7 at two, within 96 panels). */
 #define FLAT_DEPTH 4
 #define FLAT_PANELS ((size_t)-1)
+/* The same where every line runs along a polynomial axis (qctx's along): its boxes are halved in the
+ * two other axes only, each line exact (poly_line). */
+#define ALONG_DEPTH 5
+#define ALONG_PANELS ((size_t)-1)
 #define SEG_MEMO 128          /* segments of w remembered by free_panel */
 #define FREE_DEPTH 2          /* halvings along w where det J does not depend on the face's other parameter */
 
@@ -90,6 +99,9 @@ typedef struct {
     double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];   /* n-point rules on [0, 1] */
     int n[3];                    /* the current panel's points per axis (0: the flat axis) */
     int flat;                    /* the axis fixed at 1 (quad_separate), or -1 */
+    int along;                   /* a polynomial axis every line runs along, never split (quad_solid), or -1 */
+    int line_sig, line_mixed;    /* poly_line: the first line's signs and roots in panel_lines, and whether
+                                  * another line's differ */
     int jsign;                   /* det J's sign where certified over the whole solid (quad_solid), or 0 */
     int free;                    /* the face's parameter det J does not depend on (quad_sep), or -1 */
     /* free_panel's segments of w whose sign was certified or not, the same for every panel of the
@@ -171,27 +183,13 @@ static void rules_init(void)
     }
 }
 
-static void factor_on(const pde_mode *md, int axis, double t, double *val, double *der)
-{
-    if (axis == 0)
-        factor_eval(md->u, t, val, der);
-    else if (axis == 1)
-        factor_eval(md->v, t, val, der);
-    else
-        mode_h(md, t, val, der);
-}
-
-/* Every factor of axis a at the tables' points tb->t[0 .. np - 1]. */
+/* Every factor of axis a at the tables' points tb->t[0 .. np - 1] (the modes of x, y, z in order, as
+ * q->off lays them out; factors and w-terms that modes share computed once). */
 static void tab_eval(qctx *q, int a, int np)
 {
     axis_tab *tb = &q->tab[a];
     for (int i = 0; i < np; i++)
-        for (int c = 0; c < 3; c++) {
-            const comp_solution *cs = &q->s->comp[c];
-            size_t o = (size_t)i * q->mt + q->off[c];
-            for (size_t m = 0; m < cs->nmodes; m++)
-                factor_on(&cs->modes[m], a, tb->t[i], &tb->val[o + m], &tb->der[o + m]);
-        }
+        solution_factors(q->s, a, tb->t[i], tb->val + (size_t)i * q->mt, tb->der + (size_t)i * q->mt);
 }
 
 /* Fills q->tab[a] for [lo, hi] with an n-point rule (n = 0: the point lo alone). */
@@ -286,11 +284,7 @@ static double line_eval_at(qctx *q, int it, double x[3], double d[3][3])
 static double line_eval_d(qctx *q, double t, double x[3], double d[3][3])
 {
     q->off_evals++;
-    for (int c = 0; c < 3; c++) {
-        const comp_solution *cs = &q->s->comp[c];
-        for (size_t m = 0; m < cs->nmodes; m++)
-            factor_on(&cs->modes[m], q->k, t, &q->g[q->off[c] + m], &q->dg[q->off[c] + m]);
-    }
+    solution_factors(q->s, q->k, t, q->g, q->dg);
     return line_point(q, q->g, q->dg, x, d);
 }
 
@@ -424,6 +418,139 @@ static int line_dip(qctx *q, double t0, double t2, double sign, double *at, doub
     return fmin(fc, fd) < -q->jtol;
 }
 
+/* det J's degree on a line, at most, whose roots poly_line finds from the polynomial itself. */
+#define POLY_LINE_DEG 5
+
+/* The coefficients c[0 .. m - 1] in powers of s of the polynomial through (s[i], y[i]), i < m: Newton's
+ * divided differences, then expanded. */
+static void poly_through(const double *s, const double *y, int m, double *c)
+{
+    double dd[POLY_LINE_DEG + 1];
+    memcpy(dd, y, (size_t)m * sizeof *dd);
+    for (int k = 1; k < m; k++)
+        for (int i = m - 1; i >= k; i--)
+            dd[i] = (dd[i] - dd[i - 1]) / (s[i] - s[i - k]);
+    memset(c, 0, (size_t)m * sizeof *c);
+    c[0] = dd[m - 1];
+    for (int k = m - 2; k >= 0; k--) {   /* c = c (s - s_k) + dd_k */
+        for (int i = m - 1 - k; i >= 1; i--)
+            c[i] = c[i - 1] - s[k] * c[i];
+        c[0] = dd[k] - s[k] * c[0];
+    }
+}
+
+typedef struct {
+    const double *c;
+    int deg;
+} qpoly;
+
+static double poly_at(void *arg, double s)
+{
+    const qpoly *p = arg;
+    double v = p->c[p->deg];
+    for (int i = p->deg - 1; i >= 0; i--)
+        v = v * s + p->c[i];
+    return v;
+}
+
+/* The points of (0, 1), ascending, where the polynomial c of degree deg changes sign: between its
+ * derivative's sign changes (found the same way) it is monotone, so each such piece holds one root at
+ * most, bracketed by its ends (Illinois). Returns their number. */
+static int poly_roots(const double *c, int deg, double *root)
+{
+    double e[POLY_LINE_DEG + 2], dc[POLY_LINE_DEG];
+    int ne = 1, nr = 0;
+    if (deg == 2 && c[2] != 0.0) {   /* in closed form, without cancellation (fig. 3c, 3d: x linear in u) */
+        const double disc = c[1] * c[1] - 4.0 * c[2] * c[0];
+        if (!(disc > 0.0))
+            return 0;   /* no sign change: a double root at most */
+        const double h = -0.5 * (c[1] + copysign(sqrt(disc), c[1]));
+        double r0 = h / c[2], r1 = h != 0.0 ? c[0] / h : r0;
+        if (r0 > r1) {
+            const double tmp = r0;
+            r0 = r1, r1 = tmp;
+        }
+        if (r0 > 0.0 && r0 < 1.0)
+            root[nr++] = r0;
+        if (r1 > 0.0 && r1 < 1.0 && r1 > r0)
+            root[nr++] = r1;
+        return nr;
+    }
+    e[0] = 0.0;
+    if (deg >= 2) {
+        for (int i = 0; i < deg; i++)
+            dc[i] = (i + 1) * c[i + 1];
+        ne += poly_roots(dc, deg - 1, e + 1);
+    }
+    e[ne++] = 1.0;
+    qpoly p = { c, deg };
+    double pa = poly_at(&p, 0.0);
+    for (int i = 0; i + 1 < ne; i++) {
+        const double pb = poly_at(&p, e[i + 1]);
+        if ((pa < 0 && pb > 0) || (pa > 0 && pb < 0))
+            root[nr++] = illinois(poly_at, &p, e[i], e[i + 1], pa, pb);
+        else if (pb == 0.0 && i + 2 < ne)
+            root[nr++] = e[i + 1];   /* on an extreme: a cut there costs nothing */
+        pa = pb;
+    }
+    return nr;
+}
+
+/*
+ * Along an axis where the solution is a polynomial of degree d (within a slab: poly_degrees), x on a
+ * line is a polynomial of degree d and det J one of degree at most 3d - 1 (x_t has degree d - 1, the
+ * two other partials d): both are known exactly from their values at the table's points, f and x
+ * at t[0 .. n + 1]. So det J's sign changes are found on the polynomial itself (poly_roots, not
+ * between samples, where a lobe can hide), and each piece between them is integrated with the rule
+ * exact on the integrands (poly_points), from the two polynomials: no factor is evaluated afresh.
+ * The line integral is exact to rounding. Returns 0, with nothing added, where this does not apply
+ * (not a polynomial axis, or too few points for the degree).
+ */
+static int poly_line(qctx *q, double a, double b, const double *f, double x[][3], double wt)
+{
+    const int d = q->poly[q->k], n = q->n[q->k], deg = 3 * d - 1;
+    if (d < 1 || deg > POLY_LINE_DEG || deg + 1 > n + 2)
+        return 0;
+    const double *t = q->tab[q->k].t;
+    double s[POLY_LINE_DEG + 1], y[POLY_LINE_DEG + 1], cj[POLY_LINE_DEG + 1], cx[3][POLY_LINE_DEG + 1];
+    for (int i = 0; i <= deg; i++) {   /* deg + 1 of the n + 2 points, spread from a to b */
+        const int at = (i * (n + 1) + deg / 2) / deg;
+        s[i] = (t[at] - a) / (b - a), y[i] = f[at];
+    }
+    poly_through(s, y, deg + 1, cj);
+    double root[POLY_LINE_DEG];
+    const int nr = poly_roots(cj, deg, root);
+    const int sig = (f[0] > 0) | (f[n + 1] > 0) << 1 | nr << 2;
+    if (q->line_sig < 0)
+        q->line_sig = sig;
+    q->line_mixed |= sig != q->line_sig;
+    if (!nr) {
+        for (int i = 0; i < n; i++)
+            add_value(q, x[i + 1], f[i + 1], wt * (b - a) * q->gw[n][i]);
+        return 1;
+    }
+    for (int c = 0; c < 3; c++) {
+        for (int i = 0; i <= d; i++) {
+            const int at = (i * (n + 1) + d / 2) / d;
+            s[i] = (t[at] - a) / (b - a), y[i] = x[at][c];
+        }
+        poly_through(s, y, d + 1, cx[c]);
+    }
+    const int m = poly_points(d);
+    qpoly pj = { cj, deg };
+    for (int r = 0; r <= nr; r++) {
+        const double s0 = r ? root[r - 1] : 0.0, s1 = r < nr ? root[r] : 1.0;
+        for (int i = 0; i < m; i++) {
+            const double si = s0 + (s1 - s0) * q->gx[m][i];
+            double xi[3];
+            for (int c = 0; c < 3; c++)
+                xi[c] = poly_at(&(qpoly){ cx[c], d }, si);
+            add_value(q, xi, poly_at(&pj, si), wt * (b - a) * (s1 - s0) * q->gw[m][i]);
+        }
+    }
+    return 1;
+}
+
 /*
  * The current line over the panel [a, b]: det J at the ends and the rule's n nodes (the table). Each sign change
  * between neighbours (bracketed from the last value clear of zero) is located, and so is each dip
@@ -437,6 +564,9 @@ static void line_integrate(qctx *q, double a, double b, double wt)
     double f[GMAX + 2], x[GMAX + 2][3], d[3][3];
     for (int i = 0; i <= m; i++)
         f[i] = line_eval_at(q, i, x[i], d);
+    if (poly_line(q, a, b, f, x, wt))
+        return;
+    q->line_mixed = 1;   /* no signature: box_refine refines it */
     double cut[2 * GMAX + 4];
     int ncut = 0, last = 0;
     for (int i = 1; i <= m && off_budget(q); i++) {
@@ -497,6 +627,8 @@ static int line_axis(qctx *q, const pbox *b)
 {
     enum { S = 4 };
     double j[S][S][S];
+    if (q->along >= 0)
+        return q->along;
     tabs_for(q, b);
     int at[3][S];   /* the table's points nearest (i + 1/2) / S of each axis */
     for (int a = 0; a < 3; a++)
@@ -541,6 +673,7 @@ static void panel_lines(qctx *q, const pbox *b, int k, int definite, double acc[
     const double *wi = q->n[i] ? q->gw[ni] : (const double[1]){ 1.0 };
     const double *wj = q->n[j] ? q->gw[nj] : (const double[1]){ 1.0 };
     tabs_for(q, b);
+    q->line_sig = -1, q->line_mixed = 0;
     int idx[3] = { 0, 0, 0 };
     for (int a = 0; a < ni && !poll(q); a++)
         for (int c = 0; c < nj; c++) {
@@ -564,7 +697,9 @@ static void panel_lines(qctx *q, const pbox *b, int k, int definite, double acc[
  * the two differ by more than 1e-12 of the solid's volume, down to OUTER_DEPTH halvings (FLAT_DEPTH). Lines
  * that all cross the zero set the same number of times do not show that nothing was missed: a
  * narrow lobe of det J near tangency can lie between samples (fig. 4b), so every such panel is
- * refined, within REFINE_PANELS (FLAT_PANELS).
+ * refined, within REFINE_PANELS (FLAT_PANELS). Lines along a polynomial axis (q->along) miss no lobe
+ * (poly_line): their boxes are quarters, not octants, down to ALONG_DEPTH halvings, and a box whose
+ * lines all agree in det J's signs at their ends and number of roots is not refined further.
  */
 static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int depth, double out[Q_N])
 {
@@ -576,11 +711,12 @@ static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int dep
         sub[s] = *b;
         smooth[s] = 1;   /* an octant across the flat axis: none, nothing to add */
         memset(part[s], 0, sizeof part[s]);
-        if (q->flat >= 0 && (s >> q->flat & 1))
+        const int keep = q->flat >= 0 ? q->flat : q->along;   /* an axis not split */
+        if (keep >= 0 && (s >> keep & 1))
             continue;
         for (int a = 0; a < 3; a++) {
-            if (a == q->flat) {
-                nsub[s][a] = q->n[a] = 0;
+            if (a == keep) {
+                nsub[s][a] = q->n[a] = saved_n[a];
                 continue;
             }
             double mid = 0.5 * (b->lo[a] + b->hi[a]);
@@ -590,10 +726,12 @@ static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int dep
                 sub[s].hi[a] = mid;
             nsub[s][a] = q->n[a] = rule_points(q->f[a] * (sub[s].hi[a] - sub[s].lo[a]));
         }
-        definite[s] = sign_definite(q, &sub[s]);
+        /* Along a polynomial axis, the lines themselves tell (poly_line): no branch and bound (on
+         * fig. 3c and 3d it certified no box of a refinement). */
+        definite[s] = q->along >= 0 ? 0 : sign_definite(q, &sub[s]);
         axis[s] = definite[s] ? (q->flat == 0 ? 1 : 0) : line_axis(q, &sub[s]);
         panel_lines(q, &sub[s], axis[s], definite[s], part[s]);
-        smooth[s] = definite[s];
+        smooth[s] = definite[s] || (q->along >= 0 && !q->line_mixed);
         for (int e = 0; e < Q_N; e++)
             fine[e] += part[s][e];
     }
@@ -676,7 +814,7 @@ static void panel(qctx *q, const pbox *b)
             q->r.acc[e] += acc[e];
         return;
     }
-    const int definite = q->jsign ? 1 : sign_definite(q, b);
+    const int definite = q->jsign ? 1 : q->along >= 0 ? 0 : sign_definite(q, b);
     int k = 0;
     if (definite) {   /* lines along the axis with the fewest points, the cheapest */
         k = q->flat == 0 ? 1 : 0;
@@ -690,13 +828,14 @@ static void panel(qctx *q, const pbox *b)
     double acc[Q_N];
     panel_lines(q, b, k, definite, acc);
     /* Refined within a budget: the first REFINE_PANELS panels where det J may change sign. */
-    if (!definite && q->r.lined <= q->max_panels && q->r.evals * q->modes < REFINE_WORK) {
+    const int smooth = definite || (q->along >= 0 && !q->line_mixed);
+    if (!smooth && q->r.lined <= q->max_panels && q->r.evals * q->modes < REFINE_WORK) {
         double refined[Q_N];
         box_refine(q, b, acc, 0, refined);
         q->r.refined++;
         q->r.refine_change += fabs(refined[Q_VOL] - acc[Q_VOL]);
         memcpy(acc, refined, sizeof acc);
-    } else if (!definite)
+    } else if (!smooth)
         q->r.unrefined++;
     for (int e = 0; e < Q_N; e++)
         q->r.acc[e] += acc[e];
@@ -758,9 +897,9 @@ static int rule_points(double phi)
 }
 
 /*
- * Panels and points for an integrand that multiplies `factors` of the solution's factors; exact:
- * along an axis where the solution is a polynomial, one panel and the rule exact on the solid's
- * integrands (poly_points). Along w,
+ * Panels and points for an integrand that multiplies `factors` of the solution's factors; exact (a
+ * mask of axes): along such an axis where the solution is a polynomial, one panel and the rule exact
+ * on the solid's integrands (poly_points). Along w,
  * panels never straddle a slab's break, where h's higher derivatives jump: each slab gets panels of
  * its own, as many as its share of the axis calls for.
  */
@@ -777,7 +916,7 @@ static void plan_for(const pde_solution *s, double factors, int exact, qplan *p)
     for (int a = 0; a < 3; a++) {
         double v = ceil(f[a] / PANEL_PHASE);   /* then 12 points per panel */
         want[a] = v < 1 ? 1 : v > MAX_PANELS ? MAX_PANELS : (int)v;
-        if (exact && deg[a] >= 0)
+        if ((exact >> a & 1) && deg[a] >= 0)
             want[a] = 1;   /* one panel (a slab's, along w), with a rule exact on it */
     }
     /* Bounded work: past MAX_WORK in all, the busiest axis gets fewer, wider panels, and its rule
@@ -812,8 +951,9 @@ static void plan_for(const pde_solution *s, double factors, int exact, qplan *p)
             }
             for (int i = 0; i < p->np[a]; i++)
                 widest = fmax(widest, p->edge[a][i + 1] - p->edge[a][i]);
-            p->n[a] = exact && deg[a] >= 0 ? poly_points(deg[a]) : rule_points(f[a] * widest);
-            p->phase[a] = exact && deg[a] >= 0 ? 0.0 : f[a] * widest;
+            const int ex = (exact >> a & 1) && deg[a] >= 0;
+            p->n[a] = ex ? poly_points(deg[a]) : rule_points(f[a] * widest);
+            p->phase[a] = ex ? 0.0 : f[a] * widest;
         }
         if ((double)p->np[0] * p->n[0] * p->np[1] * p->n[1] * p->np[2] * p->n[2] * (double)mt <= MAX_WORK)
             break;
@@ -864,6 +1004,7 @@ static qctx *qctx_new(const pde_solution *s, const pde_cancel *cancel)
     q->s = s;
     q->cancel = cancel;
     q->flat = -1;
+    q->along = -1;
     q->free = -1;
     q->nseg = 0;
     q->max_depth = OUTER_DEPTH;
@@ -1066,6 +1207,17 @@ static void period_moments(const int d[3], const int m[3], int k, int half, doub
     }
 }
 
+/* The polynomial axis of lowest degree (the fewest pieces per line) along which poly_line applies with
+ * its exact rule, or -1. */
+static int along_axis(const qctx *q)
+{
+    int best = -1;
+    for (int a = 0; a < 3; a++)
+        if (q->poly[a] >= 1 && 3 * q->poly[a] - 1 <= POLY_LINE_DEG && (best < 0 || q->poly[a] < q->poly[best]))
+            best = a;
+    return best;
+}
+
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
                       int jsign, const pde_cancel *cancel, quad_result *out)
 {
@@ -1079,12 +1231,20 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     q->jtol = 1e-13 * jscale;
     q->vscale = vscale;
     q->jsign = jsign;
-    /* One exact panel along a polynomial axis, except in 3-D where det J may change sign: there lines
-     * along one axis are integrated across the others, where they are not polynomials (lines that
-     * touch det J's zero set), and the refinement's budget (REFINE_PANELS) covers the same panels as
-     * before (fig. 3c's volume was 6e-8 off with them, 5e-6 with one panel along u); so are octants. */
+    /* One exact panel along a polynomial axis. In 3-D where det J may change sign, lines along such
+     * an axis are exact (poly_line), but across lines their integrals are not polynomials (where
+     * roots enter or leave the line): so only the axis the lines run along (along_axis) is exact,
+     * the others stay sized to the frequencies. Not over the cube (separate 0, the tests' general
+     * path): where det J = t G (fig. 2c, 4), whole lines along t flip sign where G does, a kink |G|
+     * of the line integrals, to which the 2-D refinement converges slowly (fig. 2c: 2e-5 off). */
+    const int along = separate && sp.axis < 0 && !jsign ? along_axis(q) : -1;
     qplan p;
-    plan_for(s, 5.0, jsign != 0 || sp.axis >= 0, &p);
+    plan_for(s, 5.0, jsign != 0 || sp.axis >= 0 ? 7 : along >= 0 ? 1 << along : 0, &p);
+    if (along >= 0) {   /* every panel where det J may change sign refined in 2-D, deeper */
+        q->along = along;
+        q->max_depth = ALONG_DEPTH;
+        q->max_panels = ALONG_PANELS;
+    }
     if (sp.axis >= 0) {   /* the face t = 1 alone: one panel along the flat axis, no rule */
         q->flat = sp.axis;
         q->max_depth = FLAT_DEPTH;
@@ -1384,8 +1544,9 @@ static double face_refine(face_ctx *c, const double lo[2], const double h[2], do
         double fl;
         fine += q[k] = face_panel(c, ql[k], hh, &fl, &qe[k]);
     }
-    if (c->stopped || depth + 1 >= FACE_DEPTH || c->line.q->r.evals * c->line.q->modes >= REFINE_WORK ||
-        fabs(fine - coarse) <= c->tol)
+    const double diff = fabs(fine - coarse);
+    if (c->stopped || c->line.q->r.evals * c->line.q->modes >= REFINE_WORK || diff <= c->tol ||
+        depth + 1 >= FACE_DEPTH_MAX || (depth + 1 >= FACE_DEPTH && diff <= FACE_DEEP * c->tol))
         return fine;
     double sum = 0.0;
     for (int k = 0; k < 4; k++)

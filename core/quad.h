@@ -54,8 +54,9 @@ void quad_separate(const pde_solution *s, quad_sep *sep);
  * bound), so that every panel takes its tensor rule, else 0; vscale: the size of the
  * volume (jscale will do), for the refinement's tolerance. separate: where det J separates
  * (quad_separate), integrate over the face t = 1 only, and along w alone where det J does not
- * depend on the face's other parameter (pde_properties); 2: the face without that (tests); 0: over
- * the cube (tests). */
+ * depend on the face's other parameter (pde_properties), and where it does not separate, along a
+ * polynomial axis (quad.c's poly_line); 2: the face without the former (tests); 0: over the cube,
+ * lines along the axis that crosses det J's zero set most often, in 3-D (tests). */
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
                       int jsign, const pde_cancel *cancel, quad_result *out);
 

@@ -22,6 +22,9 @@
 #include "ep.h"
 
 #define COND_LIMIT 1e12   /* boundary systems worse than this are singular */
+/* |e| beyond this (t = |e|^(1/4) > 1e8): h(w)'s layers at w = 0, 1 are 1/t wide, and x_w there is t times
+ * sums that cancel, so t eps of it is rounding (1e-8 at the limit, which the certificate shows). */
+#define E_LIMIT 1e32
 /* h'''' = e h with clamped ends is singular only at e = t^4 with cos t cosh t = 1; the
  * first such t is 4.7300407, e = 500.5639. Below it no condition estimate is needed. */
 #define FIRST_EIGENVALUE 500.0
@@ -434,6 +437,13 @@ static pde_status solve_mode(arena *s, plan_cache *plans, const pde_component *c
         return pde_fail(diag, PDE_ERR_RANGE, ci, m->src_force, m->src_term, "",
                     "component %s: the separation constant e = -(a lu + b lv)/c overflows",
                     pde_comp_name[ci]);
+    if (fabs(e) > E_LIMIT)
+        return pde_fail(diag, PDE_ERR_RANGE, ci, 0, -1, "c",
+                    "component %s: e = -(a lu + b lv)/c = %.3g for the mode %s(%g)*%s(%g) is beyond %g: h(w) "
+                    "would have boundary layers of width |e|^(-1/4) = %.2g, thinner than a double resolves, "
+                    "and x_w at w = 0 and 1 would lose every digit; make |c| larger against a and b",
+                    pde_comp_name[ci], e, factor_name(m->u.kind), m->u.p, factor_name(m->v.kind), m->v.p,
+                    E_LIMIT, pow(fabs(e), -0.25));
     ep q = { 0 };
     pde_status st;
     unsigned polls = 0;

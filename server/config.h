@@ -46,6 +46,8 @@ typedef struct {
     double job_timeout;     /* --job-timeout: wall-clock seconds one job may run before it is cancelled */
     double max_work;        /* --max-work: largest estimated cost of a request, in units of about 1 ns of a core */
     size_t max_mem;         /* --max-mem-mb, in bytes: scratch memory of one request beyond the caches */
+    double heavy_work;      /* --heavy-work: an estimate from which a request's solid output waits apart (pool.h) */
+    size_t heavy_queue;     /* --heavy-queue: heavy requests that may wait before 503 */
     int http_threads;       /* --http-threads: libmicrohttpd's polling threads, one per core by default */
     srv_log_format log_format; /* --log-format text|json */
     char store[1024];       /* --store: DIR, lmdb:DIR, redis://HOST:PORT[/DB] or none (store.h) */

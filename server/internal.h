@@ -92,6 +92,7 @@ typedef struct srv_req {
     pde_cancel cancel;           /* polls srv_job_stop(r) */
     double queued_at, run_start;
     double work;                 /* seconds the solver threads spent on it before this run */
+    srv_entry *heavy;            /* the solid whose output waits apart (--heavy-work), or NULL */
     struct {
         double queue, parse, solve, props, output;
         int cached;

@@ -17,29 +17,49 @@ struct srv_pool {
     pthread_cond_t work;
     job *ring;
     size_t cap, limit, head, count, reserved, running;   /* limit: places for reserve; cap adds extra */
+    job *heavy;                                          /* deferred heavy parts, a ring of cap places */
+    size_t hhead, hcount, hrunning;
     int stopping, nthreads, alive;   /* alive: workers not yet past their last job */
     pthread_t *threads;
 };
+
+/* A heavy part runs while fewer than threads - 1 do (one thread is kept for the rest), or when no other
+ * job waits (no thread idles while work waits). */
+static int heavy_next(const srv_pool *p)
+{
+    const size_t lanes = p->nthreads > 1 ? (size_t)p->nthreads - 1 : 1;
+    return p->hcount && (p->hrunning < lanes || p->count == 0);
+}
 
 static void *worker(void *arg)
 {
     srv_pool *p = arg;
     pthread_mutex_lock(&p->lock);
     for (;;) {
-        while (p->count == 0 && (!p->stopping || p->reserved))
+        while (p->count == 0 && p->hcount == 0 && (!p->stopping || p->reserved))
             pthread_cond_wait(&p->work, &p->lock);
-        if (p->count == 0) {
+        if (p->count == 0 && p->hcount == 0) {
             p->alive--;   /* stopping and drained: a push from now on is refused, not lost */
             break;
         }
-        job j = p->ring[p->head];
-        p->head = (p->head + 1) % p->cap;
-        p->count--;
+        const int heavy = heavy_next(p);
+        job j;
+        if (heavy) {
+            j = p->heavy[p->hhead];
+            p->hhead = (p->hhead + 1) % p->cap;
+            p->hcount--;
+            p->hrunning++;
+        } else {
+            j = p->ring[p->head];
+            p->head = (p->head + 1) % p->cap;
+            p->count--;
+        }
         p->running++;
         pthread_mutex_unlock(&p->lock);
         j.fn(j.arg);
         pthread_mutex_lock(&p->lock);
         p->running--;
+        p->hrunning -= heavy;
     }
     pthread_mutex_unlock(&p->lock);
     return NULL;
@@ -53,9 +73,11 @@ srv_pool *srv_pool_create(int threads, size_t queue, size_t extra)
     p->limit = queue ? queue : 1;
     p->cap = p->limit + extra;
     p->ring = malloc(p->cap * sizeof *p->ring);
+    p->heavy = malloc(p->cap * sizeof *p->heavy);
     p->threads = malloc((size_t)threads * sizeof *p->threads);
-    if (!p->ring || !p->threads || pthread_mutex_init(&p->lock, NULL) || pthread_cond_init(&p->work, NULL)) {
+    if (!p->ring || !p->heavy || !p->threads || pthread_mutex_init(&p->lock, NULL) || pthread_cond_init(&p->work, NULL)) {
         free(p->ring);
+        free(p->heavy);
         free(p->threads);
         free(p);
         return NULL;
@@ -103,10 +125,23 @@ int srv_pool_push(srv_pool *p, srv_job_fn fn, void *arg)
     return ok ? 0 : -1;
 }
 
+int srv_pool_defer_heavy(srv_pool *p, srv_job_fn fn, void *arg, size_t limit)
+{
+    pthread_mutex_lock(&p->lock);
+    int ok = p->alive > 0 && p->hcount < limit && p->hcount < p->cap;
+    if (ok) {
+        p->heavy[(p->hhead + p->hcount) % p->cap] = (job){ fn, arg };
+        p->hcount++;
+        pthread_cond_signal(&p->work);
+    }
+    pthread_mutex_unlock(&p->lock);
+    return ok ? 0 : -1;
+}
+
 size_t srv_pool_depth(srv_pool *p)
 {
     pthread_mutex_lock(&p->lock);
-    size_t d = p->count + p->running;
+    size_t d = p->count + p->hcount + p->running;
     pthread_mutex_unlock(&p->lock);
     return d;
 }
@@ -136,6 +171,7 @@ void srv_pool_destroy(srv_pool *p)
     pthread_cond_destroy(&p->work);
     pthread_mutex_destroy(&p->lock);
     free(p->ring);
+    free(p->heavy);
     free(p->threads);
     free(p);
 }

@@ -3,6 +3,12 @@
  * variable, as Redis's bio.c) feeds N threads. A job's slot is reserved
  * before the job exists, so that the HTTP layer can answer 503 while it still
  * can, and only then suspend the connection and hand the job over.
+ *
+ * Heavy parts wait apart: a job that finds its remaining work heavy (its
+ * estimate, known only once it has parsed its request) defers it
+ * (srv_pool_defer_heavy), and threads take deferred parts only while fewer
+ * than threads - 1 run, or when nothing else waits. So a light request never
+ * queues behind a row of heavy ones: with 2 threads, one serves the rest.
  */
 #ifndef SRV_POOL_H
 #define SRV_POOL_H
@@ -25,6 +31,10 @@ void srv_pool_submit(srv_pool *p, srv_job_fn fn, void *arg);
 /* Queues a continuation of work already admitted (the next piece of a stream), outside the
  * reserved places; 0, or -1 when all extra places are taken. */
 int srv_pool_push(srv_pool *p, srv_job_fn fn, void *arg);
+/* Queues fn(arg), the heavy remainder of a job that has ended, apart from the queue (above); at most
+ * limit wait. 0, or -1 when limit wait already or the pool is stopping. Call it as the job's last act:
+ * fn may run at once on another thread. */
+int srv_pool_defer_heavy(srv_pool *p, srv_job_fn fn, void *arg, size_t limit);
 /* Jobs waiting or running now. */
 size_t srv_pool_depth(srv_pool *p);
 /* Refuses new jobs, runs every queued and reserved one to the end (a job sees the server

@@ -157,9 +157,11 @@ enum MHD_Result srv_queue(srv_req *r, struct MHD_Response *resp)
         return MHD_NO;
     srv_server *s = r->s;
     const char *origin = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, "Origin");
+    /* A list of origins makes every answer depend on Origin (granted or not, or none): say so to caches. */
+    if (s->cfg.cors[0] && strcmp(s->cfg.cors, "*"))
+        MHD_add_response_header(resp, "Vary", "Origin");
     if (cors_granted(s, origin)) {
         MHD_add_response_header(resp, "Access-Control-Allow-Origin", !strcmp(s->cfg.cors, "*") ? "*" : origin);
-        MHD_add_response_header(resp, "Vary", "Origin");
         MHD_add_response_header(resp, "Access-Control-Expose-Headers",
                                 "X-Solid-Id, X-Request-Id, ETag, Content-Length, Retry-After, Server-Timing");
     }

@@ -133,14 +133,15 @@ static int over_budget(srv_req *r, const api_cost *part)
     if (r->cost.work > c->max_work) {
         srv_problem(r, 422, NULL,
                     "this request is estimated at %.3g units of work (about %.2g CPU-seconds), over the limit of %.3g "
-                    "(--max-work); ask for a lower res, fewer points, or a model with fewer terms",
+                    "(--max-work); ask for a lower res, fewer points, or a smaller model (fewer terms, or a loft with "
+                    "fewer sections or grid points)",
                     r->cost.work, r->cost.work * 1e-9, c->max_work);
         return 1;
     }
     if (r->cost.bytes > (double)c->max_mem) {
         srv_problem(r, 422, NULL,
                     "this request would use about %.0f MiB of memory, over the limit of %zu MiB (--max-mem-mb); "
-                    "ask for a lower res or a model with fewer terms",
+                    "ask for a lower res, or a smaller model (fewer terms, or a loft with fewer sections or grid points)",
                     r->cost.bytes / 1048576, c->max_mem >> 20);
         return 1;
     }
@@ -167,7 +168,10 @@ static int solve_model(void *arg, pde_solution **out, api_error *err)
     return api_solve_ex(a->model, a->cancel, out, err);
 }
 
-/* The response of a solved entry: 304, a whole body, or a stream. Takes over the reference. */
+static void answer_heavy(srv_req *r, srv_entry *e);
+
+/* The response of a solved entry: its ETag and the budget's checks, then answer_heavy() now or, when the
+ * estimate is --heavy-work or more, apart from lighter requests (pool.h). Takes over the reference. */
 static void answer_entry(srv_req *r, srv_entry *e)
 {
     srv_server *s = r->s;
@@ -177,13 +181,6 @@ static void answer_entry(srv_req *r, srv_entry *e)
     api_output_opts opts = { .compress = r->q.comp };
     snprintf(r->etag, sizeof r->etag, "\"%s.%s%s%s.%ux%ux%u\"", r->id, api_format_info_of(f)->name,
              opts.compress ? "." : "", opts.compress ? api_compress_name(opts.compress) : "", res[0], res[1], res[2]);
-    const char *inm = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
-    if (inm && (strstr(inm, r->etag) || !strcmp(inm, "*"))) {
-        r->status = 304;
-        r->ctype = NULL;
-        srv_cache_release(s->cache, e);
-        return;
-    }
     const pde_solution *sol = srv_entry_solution(e);
     int with_props = api_format_info_of(f)->props;
     api_cost part;
@@ -197,6 +194,22 @@ static void answer_entry(srv_req *r, srv_entry *e)
         srv_cache_release(s->cache, e);
         return;
     }
+    if (r->cost.work >= s->cfg.heavy_work) {
+        r->heavy = e;   /* srv_run_job defers the rest (answer_heavy) as its last act */
+        return;
+    }
+    answer_heavy(r, e);
+}
+
+/* The properties and the output of an entry the budget admitted: 304, a whole body, or a stream. */
+static void answer_heavy(srv_req *r, srv_entry *e)
+{
+    srv_server *s = r->s;
+    api_format f = r->q.fmt;
+    const unsigned *res = r->q.res3;
+    api_output_opts opts = { .compress = r->q.comp };
+    const pde_solution *sol = srv_entry_solution(e);
+    const int with_props = api_format_info_of(f)->props;
     const pde_props *props = NULL;
     double t0 = srv_now();
     int cancelled = 0;
@@ -215,6 +228,16 @@ static void answer_entry(srv_req *r, srv_entry *e)
     if (!o) {
         srv_cache_release(s->cache, e);
         failed(r, &err);
+        return;
+    }
+    /* Not modified only once the output is known to exist: an ETag (or *) of an output this request is
+     * refused (a limit, float32, no skin) names no representation, and the refusal is the answer. */
+    const char *inm = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
+    if (inm && (strstr(inm, r->etag) || !strcmp(inm, "*"))) {
+        api_output_free(o);
+        srv_cache_release(s->cache, e);
+        r->status = 304;
+        r->ctype = NULL;
         return;
     }
     r->status = 200;
@@ -466,6 +489,24 @@ static void post_eval(srv_req *r)
     srv_set_text(r, 200, "application/json", json);
 }
 
+static void job_end(srv_req *r);
+
+/* The heavy remainder of a request (--heavy-work), on the thread that took it from the pool. */
+static void run_heavy(void *arg)
+{
+    srv_req *r = arg;
+    srv_entry *e = r->heavy;
+    r->heavy = NULL;
+    r->run_start = srv_now();
+    r->tm.queue += r->run_start - r->queued_at;
+    if (atomic_load(&r->s->aborting)) {
+        srv_cache_release(r->s->cache, e);
+        stopped(r);
+    } else
+        answer_heavy(r, e);
+    job_end(r);
+}
+
 void srv_run_job(void *arg)
 {
     srv_req *r = arg;
@@ -476,7 +517,26 @@ void srv_run_job(void *arg)
         stopped(r);
     else
         srv_routes[r->route].handler(r);
+    job_end(r);
+}
+
+/* A job's end: its heavy part deferred (the last act: it may run at once elsewhere), or the answer. */
+static void job_end(srv_req *r)
+{
+    srv_server *s = r->s;
     r->work += srv_now() - r->run_start;
+    if (r->heavy) {
+        r->queued_at = srv_now();
+        if (srv_pool_defer_heavy(s->pool, run_heavy, r, s->cfg.heavy_queue) == 0)
+            return;
+        srv_cache_release(s->cache, r->heavy);
+        r->heavy = NULL;
+        r->retry_after = 1;
+        srv_problem(r, 503, NULL,
+                    "the server is busy: %zu requests estimated at over %.3g units of work (--heavy-work) wait "
+                    "already (--heavy-queue); try again shortly, or ask for a lower res",
+                    s->cfg.heavy_queue, s->cfg.heavy_work);
+    }
     /* A job that took much memory gives it back to the system, rather than keeping the peak. */
     if (r->cost.bytes > 16e6)
         malloc_trim(0);

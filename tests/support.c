@@ -1,6 +1,7 @@
 /*
  * support.c: the tests' independent solver and helpers (support.h).
  */
+#include <errno.h>
 #include <math.h>
 #include <setjmp.h>
 #include <signal.h>
@@ -10,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -579,6 +581,15 @@ char *read_file(const char *path, size_t *len)
     return buf;
 }
 
+/* A failed assertion jumps past a test's daemon_stop (or a server's stop): what it started must not outlive
+ * the test binary, holding a port and CPU. The signal survives the exec (sh -c "exec ..." keeps the pid). */
+void child_dies_with_parent(void)
+{
+    prctl(PR_SET_PDEATHSIG, SIGTERM);   /* nginx's master stops its workers on it */
+    if (getppid() == 1)   /* the parent died before the call */
+        _exit(127);
+}
+
 void daemon_start(daemon_t *d, const char *dir, const char *args)
 {
     const char *bin = getenv("PDESOLIDD_SAN") ? getenv("PDESOLIDD_SAN") : "build/san/pdesolidd";
@@ -590,6 +601,7 @@ void daemon_start(daemon_t *d, const char *dir, const char *args)
     snprintf(cmd, sizeof cmd, "exec %s --port 0 --threads 2 --job-timeout 30 --store none %s 2>%s", bin, args, d->log);
     pid_t pid = fork();
     if (pid == 0) {
+        child_dies_with_parent();
         execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);
         _exit(127);
     }
@@ -613,21 +625,39 @@ void daemon_start(daemon_t *d, const char *dir, const char *args)
     fail_msg("pdesolidd did not start");
 }
 
+/* The end of a daemon's log, where a failure shows: its head is the flags and the first requests. */
+static const char *log_tail(const char *log, int lines)
+{
+    const char *p = log + strlen(log);
+    while (p > log && lines >= 0)
+        if (*--p == '\n')
+            lines--;
+    return p == log ? p : p + 1;
+}
+
 void daemon_stop(daemon_t *d)
 {
     kill(d->pid, SIGTERM);
-    int st;
-    waitpid(d->pid, &st, 0);
-    if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-        char *log = read_file(d->log, NULL);
-        fail_msg("pdesolidd exited with status %d:\n%s", WIFEXITED(st) ? WEXITSTATUS(st) : -1, log ? log : "");
-    }
+    int st = 0;
+    pid_t got;
+    while ((got = waitpid(d->pid, &st, 0)) < 0 && errno == EINTR)
+        ;
+    if (got != d->pid)
+        fail_msg("waitpid for pdesolidd %d: %s", d->pid, strerror(errno));
+    if (WIFEXITED(st) && WEXITSTATUS(st) == 0)
+        return;
+    char *log = read_file(d->log, NULL);
+    char how[96];
+    if (WIFSIGNALED(st))
+        snprintf(how, sizeof how, "was killed by signal %d (%s)", WTERMSIG(st), strsignal(WTERMSIG(st)));
+    else
+        snprintf(how, sizeof how, "exited with status %d", WEXITSTATUS(st));
+    fail_msg("pdesolidd %s; the end of its log:\n%s", how, log ? log_tail(log, 40) : "(none)");
 }
 
 /* ---- raw HTTP over loopback sockets, and a strict JSON check ---- */
 
 #include <arpa/inet.h>
-#include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
 #include <strings.h>

@@ -109,6 +109,8 @@ typedef struct {
     char log[160];
 } daemon_t;
 
+/* In a forked child before exec: killed when the test binary ends, as a failed assertion may skip its stop. */
+void child_dies_with_parent(void);
 void daemon_start(daemon_t *d, const char *dir, const char *args);
 void daemon_stop(daemon_t *d);
 

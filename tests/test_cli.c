@@ -432,6 +432,268 @@ static void presets_and_formats_should_work_from_the_command_line(void **state)
     }
 }
 
+/* Runs the tool and expects status st with words in stderr (or in stdout when on_out), then frees both. */
+static void expect(int sanitised, const char *args, int st, const char *words)
+{
+    char *out, *err;
+    int got = run(sanitised, args, &out, &err);
+    if (got != st || (words && !strstr(err, words)))
+        fail_msg("pdesolid %s: status %d (want %d), stderr: %s", args, got, st, err);
+    free(out);
+    free(err);
+}
+
+/* --res is checked offline as the server checks it, with --format or without: --res 0 exited 0 offline and 2
+ * (a 422) with --server. */
+static void res_should_be_checked_offline_as_the_server_does(void **state)
+{
+    (void)state;
+    daemon_t d;
+    daemon_start(&d, dir, "--quiet");
+    const char *bad[] = { "0", "abc", "1,2", "99999" };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        char args[256];
+        snprintf(args, sizeof args, "solve --preset fig4a --res %s", bad[i]);
+        expect(1, args, 2, "--res");
+        snprintf(args, sizeof args, "solve --preset fig4a --res %s --server %s", bad[i], d.base);
+        expect(1, args, 2, "res");
+    }
+    expect(1, "solve --preset fig4a --res 5", 0, NULL);
+    /* a request the server refuses makes no file, as offline */
+    char args[256], path[256];
+    snprintf(args, sizeof args, "solve --preset fig4a --param c=-1,-1,0 -o refused.glb --server %s", d.base);
+    expect(1, args, 2, "/params/c/2");
+    snprintf(path, sizeof path, "%s/refused.glb", dir);
+    assert_int_not_equal(access(path, F_OK), 0);
+    daemon_stop(&d);
+}
+
+/* --server takes the base URL of a pdesolidd: trailing slashes are dropped (it gave a 404 on //solve); a query,
+ * a fragment or a scheme other than http and https is refused (exit 2) before anything is sent, and every
+ * command that takes --server uses it (presets --server file:///etc/passwd printed the presets, exit 0). */
+static void server_urls_should_be_joined_cleanly_or_refused(void **state)
+{
+    (void)state;
+    daemon_t d;
+    daemon_start(&d, dir, "--quiet");
+    char args[512], *want, *got, *err;
+    assert_int_equal(run(1, "solve --preset fig3d", &want, &err), 0);
+    free(err);
+    const char *good[] = { "%s/", "%s//", "%s" };
+    for (size_t i = 0; i < sizeof good / sizeof *good; i++) {
+        char url[128];
+        snprintf(url, sizeof url, good[i], d.base);
+        snprintf(args, sizeof args, "solve --preset fig3d --server %s", url);
+        if (run(1, args, &got, &err) != 0 || strcmp(got, want))
+            fail_msg("pdesolid %s: %s%s", args, err, got);
+        free(got);
+        free(err);
+    }
+    free(want);
+    const char *bad[] = { "%s/?x=1", "%s#frag", "%s/solve?format=glb", "ftp://127.0.0.1:%.0s1", "file:///etc/passwd%.0s",
+                          "127.0.0.1:8080%.0s", "http:///%.0s" };
+    const char *cmds[] = { "solve --preset fig3d", "eval --preset fig3d pts.json", "presets" };
+    write_text("pts.json", "[[0.5,0.5,0.5]]");
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++)
+        for (size_t c = 0; c < sizeof cmds / sizeof *cmds; c++) {
+            char url[128];
+            snprintf(url, sizeof url, bad[i], d.base);
+            snprintf(args, sizeof args, "%s --server '%s'", cmds[c], url);
+            expect(1, args, 2, "--server");
+        }
+    /* presets through the server: the same table as offline */
+    assert_int_equal(run(1, "presets", &want, &err), 0);
+    free(err);
+    snprintf(args, sizeof args, "presets --server %s/", d.base);
+    assert_int_equal(run(1, args, &got, &err), 0);
+    assert_string_equal(got, want);
+    free(got);
+    free(err);
+    free(want);
+    daemon_stop(&d);
+}
+
+/* Writes n points spread over the cube (and a little past it) with 17 digits to name; returns its size. */
+static size_t write_points(const char *name, size_t n)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    uint64_t x = 88172645463325252u;
+    fputc('[', f);
+    for (size_t i = 0; i < n; i++) {
+        double p[3];
+        for (int c = 0; c < 3; c++) {
+            x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+            p[c] = (double)(x >> 11) / 9007199254740992.0 * 1.2 - 0.1;
+        }
+        fprintf(f, "%s[%.17g, %.17g, %.17g]", i ? ",\n" : "", p[0], p[1], p[2]);
+    }
+    fputs("]\n", f);
+    long len = ftell(f);
+    fclose(f);
+    return (size_t)len;
+}
+
+/* eval --server sends the points in batches under the server's body limit: 30,000 points (1.9 MB) gave a 413
+ * through a default pdesolidd; now the answer is the offline one, byte for byte, and a server with a smaller
+ * --max-body gets smaller batches. A bad point is named by its index in the file, as offline. */
+static void eval_through_the_server_should_batch_large_point_files(void **state)
+{
+    (void)state;
+    assert_true(write_points("many.json", 30000) > (1u << 20));
+    char args[512], path[256], *out, *err;
+    snprintf(args, sizeof args, "eval --preset fig4b many.json -o off.json");
+    assert_int_equal(run(0, args, &out, &err), 0);
+    free(out);
+    free(err);
+    snprintf(path, sizeof path, "%s/off.json", dir);
+    size_t olen, slen;
+    char *off = read_file(path, &olen);
+    assert_non_null(off);
+    const char *flags[] = { "--quiet", "--quiet --max-body 100KiB" };
+    for (int k = 0; k < 2; k++) {
+        daemon_t d;
+        daemon_start(&d, dir, flags[k]);
+        snprintf(args, sizeof args, "eval --preset fig4b many.json -o srv.json --server %s", d.base);
+        if (run(0, args, &out, &err) != 0)
+            fail_msg("pdesolid %s (daemon %s): %s", args, flags[k], err);
+        free(out);
+        free(err);
+        snprintf(path, sizeof path, "%s/srv.json", dir);
+        char *srv = read_file(path, &slen);
+        assert_non_null(srv);
+        if (slen != olen || memcmp(srv, off, olen))
+            fail_msg("daemon %s: eval --server differs from offline (%zu and %zu bytes)", flags[k], slen, olen);
+        free(srv);
+        /* a point far outside the cube, past the first batch: named as offline, by its index in the file */
+        if (k == 0) {
+            char *big = read_file(path, NULL);
+            free(big);
+            write_points("far.json", 12000);
+            snprintf(path, sizeof path, "%s/far.json", dir);
+            FILE *f = fopen(path, "r+");
+            assert_non_null(f);
+            fseek(f, -2, SEEK_END);
+            fputs(",[1e300,1e300,1e300]]\n", f);
+            fclose(f);
+            char *want;
+            assert_int_equal(run(1, "eval --preset fig4a far.json", &out, &want), 2);
+            free(out);
+            assert_non_null(strstr(want, "far.json: /12000: x(u, v, w) is not a finite number"));
+            snprintf(args, sizeof args, "eval --preset fig4a far.json --server %s", d.base);
+            assert_int_equal(run(1, args, &out, &err), 2);
+            if (!strstr(err, "far.json: /12000: x(u, v, w) is not a finite number"))
+                fail_msg("stderr: %s", err);
+            assert_string_equal(out, "");
+            free(out);
+            free(err);
+            free(want);
+        }
+        daemon_stop(&d);
+    }
+    free(off);
+}
+
+/* Wrong arguments get one line naming what is wrong (they got "unknown command or wrong arguments" and the
+ * whole usage); a repeated option, two standard inputs and numbers JSON does not write are refused. */
+static void arguments_should_be_refused_with_a_specific_message(void **state)
+{
+    (void)state;
+    write_text("fig4a.json", "{\"preset\":\"fig4a\"}");
+    write_text("pts.json", "[[0.5,0.5,0.5]]");
+    const struct {
+        const char *args, *words;
+    } cases[] = {
+        { "solve fig4a.json --preset fig4a", "fig4a.json and --preset" },
+        { "solve fig4a.json --template example4", "fig4a.json and --template" },
+        { "eval --preset fig4a", "POINTS.json is missing" },
+        { "eval fig4a.json", "POINTS.json is missing" },
+        { "solve", "MODEL.json is missing" },
+        { "presets extra", "\"extra\"" },
+        { "eval fig4a.json pts.json more.json", "\"more.json\"" },
+        { "solve --preset fig4a --preset fig4b", "--preset is given twice" },
+        { "solve --preset fig4a -o a.json -o b.json", "-o is given twice" },
+        { "solve --preset fig4a --server http://a --server http://b", "--server is given twice" },
+        { "eval - - <pts.json", "both standard input" },
+        { "eval --preset fig4a pts.json --format glb", "eval takes no --format" },
+        { "presets --preset fig4a", "presets takes no --preset" },
+        { "solve --preset fig4a --param p0=0x10", "\"0x10\" is not a number" },
+        { "solve --preset fig4a --param 'p0= 5'", "\" 5\" is not a number" },
+        { "solve --preset fig4a --param 'p0=5 '", "\"5 \" is not a number" },
+        { "solve --preset fig4a --param p0=.5", "\".5\" is not a number" },
+        { "solve --preset fig4a --param p0=+5", "\"+5\" is not a number" },
+        { "solve --preset fig4a --param p0=inf", "\"inf\" is not a number" },
+        { "solve --preset fig4a --param p0=1e999", "/params/p0" },
+        { "solve --preset fig4a --param c=1,2", "/params/c" },
+        { "solve --preset fig4a --param 'c=1, 2, 3'", "\"1, 2, 3\" is not a number" },
+        { "solve --preset fig4a --param p0=", "\"\" is not a number" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        char *out, *err;
+        int st = run(1, cases[i].args, &out, &err);
+        if (st != 2 || !strstr(err, cases[i].words) || strstr(err, "usage:") || strchr(err, '\n') != err + strlen(err) - 1)
+            fail_msg("pdesolid %s: status %d, want 2 and one line with \"%s\"; stderr: %s", cases[i].args, st,
+                     cases[i].words, err);
+        free(out);
+        free(err);
+    }
+    /* JSON's numbers are taken, the same solid as in a request file */
+    char *a, *b, *err;
+    write_text("req.json", "{\"preset\":\"fig4a\",\"params\":{\"p0\":-2.5e4,\"c\":[-10,-10,-9.5]}}");
+    assert_int_equal(run(1, "solve --preset fig4a --param p0=-2.5e4 --param c=-10,-10,-9.5", &a, &err), 0);
+    free(err);
+    assert_int_equal(run(1, "solve req.json", &b, &err), 0);
+    free(err);
+    assert_string_equal(a, b);
+    free(a);
+    free(b);
+    /* -o - is standard output, and makes no file named - */
+    assert_int_equal(run(1, "solve --preset fig4a -o -", &a, &err), 0);
+    assert_non_null(strstr(a, "solid 99268af08d93209af6cac24a6617fc90"));
+    free(a);
+    free(err);
+    char args[9000];
+    snprintf(args, sizeof args, "solve --preset fig3d --res 4 --format stl -o - >o1.stl && %s solve --preset fig3d "
+             "--res 4 -o o2.stl && cmp o1.stl o2.stl", bins[1]);
+    assert_int_equal(run(1, args, &a, &err), 0);
+    free(a);
+    free(err);
+    assert_int_equal(run(1, "eval --preset fig4a pts.json -o -", &a, &err), 0);
+    assert_true(a[0] == '[');
+    free(a);
+    free(err);
+    assert_int_equal(run(1, "presets -o -", &a, &err), 0);
+    assert_non_null(strstr(a, "fig4a"));
+    free(a);
+    free(err);
+    char path[256];
+    snprintf(path, sizeof path, "%s/-", dir);
+    assert_int_not_equal(access(path, F_OK), 0);
+    /* a command's --help is its own usage and options; --help alone the whole */
+    const struct {
+        const char *cmd, *has, *lacks;
+    } helps[] = {
+        { "solve", "usage: pdesolid solve [MODEL.json]", "POINTS.json" },
+        { "eval", "usage: pdesolid eval MODEL.json POINTS.json", "--format" },
+        { "presets", "usage: pdesolid presets", "--preset" },
+    };
+    for (size_t i = 0; i < sizeof helps / sizeof *helps; i++) {
+        snprintf(args, sizeof args, "%s --help", helps[i].cmd);
+        assert_int_equal(run(1, args, &a, &err), 0);
+        if (!strstr(a, helps[i].has) || strstr(a, helps[i].lacks) || !strstr(a, "--server"))
+            fail_msg("pdesolid %s:\n%s", args, a);
+        free(a);
+        free(err);
+    }
+    assert_int_equal(run(1, "solve -h", &a, &err), 0);
+    assert_non_null(strstr(a, "--compress"));
+    assert_non_null(strstr(a, "  glb "));
+    free(a);
+    free(err);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -442,6 +704,10 @@ int main(void)
         cmocka_unit_test(eval_should_agree_with_the_independent_solution),
         cmocka_unit_test(solve_should_print_the_closed_form_and_properties),
         cmocka_unit_test(bad_input_should_exit_2_and_name_the_field),
+        cmocka_unit_test(res_should_be_checked_offline_as_the_server_does),
+        cmocka_unit_test(server_urls_should_be_joined_cleanly_or_refused),
+        cmocka_unit_test(eval_through_the_server_should_batch_large_point_files),
+        cmocka_unit_test(arguments_should_be_refused_with_a_specific_message),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

@@ -115,7 +115,7 @@ static const struct {
     { "--max-conns", "11" },       { "--grace", "4" },             { "--cors-origin", "http://a.example,http://b.example" },
     { "--web", "clients/web" },    { "--log-format", "json" },
     { "--store", "redis://127.0.0.1:6379/2" }, { "--store-mb", "3" }, { "--store-prefix", "pde:" },
-    { "--store-ttl", "86400" },
+    { "--store-ttl", "86400" },    { "--heavy-work", "2.5e8" },    { "--heavy-queue", "3" },
 };
 
 static void expect(srv_config *e, const char *flag)
@@ -142,6 +142,10 @@ static void expect(srv_config *e, const char *flag)
         e->max_mem = 16u << 20;
     else if (!strcmp(flag, "--job-timeout"))
         e->job_timeout = 0.5;
+    else if (!strcmp(flag, "--heavy-work"))
+        e->heavy_work = 2.5e8;
+    else if (!strcmp(flag, "--heavy-queue"))
+        e->heavy_queue = 3;
     else if (!strcmp(flag, "--request-timeout"))
         e->request_timeout = 12.5;
     else if (!strcmp(flag, "--timeout"))
@@ -217,7 +221,7 @@ static void every_flag_in_the_usage_should_be_tested(void **state)
         if (!found)
             fail_msg("%s is in the usage but not in every_flag", name);
     }
-    assert_int_equal(flags, 25);   /* 23 with values, --quiet, --version ("-h, --help" starts otherwise) */
+    assert_int_equal(flags, 27);   /* 25 with values, --quiet, --version ("-h, --help" starts otherwise) */
     assert_non_null(strstr(r.out, "-h, --help"));
 }
 

@@ -14,6 +14,11 @@
 #include <string.h>
 
 #include <cmocka.h>
+#if defined(__SANITIZE_ADDRESS__)
+size_t __sanitizer_get_current_allocated_bytes(void);   /* the ASan runtime's (sanitizer/allocator_interface.h) */
+#else
+#include <malloc.h>
+#endif
 
 #include "cost.h"
 #include "loft.h"
@@ -346,6 +351,46 @@ static void grid_memory_should_grow_with_the_modes(void **state)
     assert_true(c[1].bytes / c[0].bytes > 3.5 && c[1].bytes / c[0].bytes < 4.1);
 }
 
+/* Bytes the heap holds now: ASan's allocator under the sanitizers (the tests' build), else glibc's. */
+static double heap_in_use(void)
+{
+#if defined(__SANITIZE_ADDRESS__)
+    return (double)__sanitizer_get_current_allocated_bytes();
+#else
+    struct mallinfo2 mi = mallinfo2();
+    return (double)mi.uordblks + (double)mi.hblkhd;
+#endif
+}
+
+/* The mesh's two blocks stay allocated (kept for the next build) after api_mesh_free, so the heap's growth
+ * over a build is what it allocated; the estimate adds the sampling grids, a few percent here. */
+static void mesh_memory_estimate_should_match_the_blocks_a_build_allocates(void **state)
+{
+    (void)state;
+    const char *presets[] = { "fig4a", "fig1a" };
+    const unsigned res[][3] = { { 256, 256, 256 }, { 64, 32, 16 } };
+    for (size_t i = 0; i < 2; i++)
+        for (size_t r = 0; r < 2; r++) {
+            pde_solution *sol = preset_solution(presets[i]);
+            api_mesh_release_spares();
+            const double before = heap_in_use();
+            api_mesh m;
+            api_error err;
+            assert_int_equal(api_mesh_build(sol, res[r], NULL, &m, &err), 0);
+            api_mesh_free(&m);
+            const double blocks = heap_in_use() - before;
+            api_mesh_release_spares();
+            api_cost c;
+            api_cost_skin(sol, res[r], 0.0, 0.0, 0.0, 0.0, &c);
+            print_message("%s at %u x %u x %u: blocks %.0f bytes, estimate %.0f\n", presets[i], res[r][0], res[r][1],
+                          res[r][2], blocks, c.bytes);
+            assert_true(c.bytes >= blocks);
+            if (r == 0)   /* at 64 x 32 x 16 the skin's 2 MB read buffer is the estimate's larger term */
+                assert_true(c.bytes <= 1.1 * blocks);
+            pde_solution_free(sol);
+        }
+}
+
 static void eval_work_should_be_linear_in_the_points(void **state)
 {
     (void)state;
@@ -420,8 +465,10 @@ static void every_preset_in_every_format_should_stay_well_under_the_budget(void 
             api_cost c = total;
             api_cost_output(sol, (api_format)f, res, &part);
             api_cost_add(&c, &part);
-            /* fig. 3's properties (folds in 1024 panels) take about 0.6 s: under the budget, by 1.4x. */
-            if (!(c.work < 0.8e9 && c.bytes < MEMORY))
+            /* fig. 3b's properties (sin 30 pi v: its face u = 1 refined in full, det J's box budget grown to
+             * 32000) take about 1 s of an idle core: estimated at 0.7e9, with its msh 0.8e9, under the
+             * default budget by 1.25x. */
+            if (!(c.work < 0.85e9 && c.bytes < MEMORY))
                 fail_msg("%s %s: %.3g units, %.3g bytes", api_preset_at(i)->name,
                          api_format_info_of((api_format)f)->name, c.work, c.bytes);
             assert_true(c.work > 1e4);   /* and not nothing */
@@ -512,6 +559,7 @@ int main(void)
         cmocka_unit_test(f32_work_should_grow_eightfold_when_the_resolution_doubles),
         cmocka_unit_test(volume_mesh_estimates_should_not_be_below_their_measured_time),
         cmocka_unit_test(grid_memory_should_grow_with_the_modes),
+        cmocka_unit_test(mesh_memory_estimate_should_match_the_blocks_a_build_allocates),
         cmocka_unit_test(eval_work_should_be_linear_in_the_points),
         cmocka_unit_test(heavy_requests_of_the_issue_should_exceed_the_budget),
         cmocka_unit_test(every_preset_in_every_format_should_stay_well_under_the_budget),

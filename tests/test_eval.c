@@ -3,6 +3,7 @@
  * grids and faces against pointwise evaluation, and evaluation from many
  * threads at once.
  */
+#include <complex.h>
 #include <math.h>
 #include <pthread.h>
 #include <setjmp.h>
@@ -14,6 +15,7 @@
 
 #include <cmocka.h>
 
+#include "internal.h"   /* the factor and w-term evaluations the properties use */
 #include "support.h"
 
 static pde_solution *solve_figure(const char *name)
@@ -135,6 +137,46 @@ static void grid_should_give_faces_and_derivatives(void **state)
     pde_solution_free(sol);
 }
 
+/* Faces u = 0, 1 as one narrow grid (nu = 2, column-wise, the three components at once when each has one
+ * u-factor) give the bits of the same columns of a wide grid (row by row), for any rows asked. */
+static void narrow_grid_should_match_a_wide_grids_columns(void **state)
+{
+    (void)state;
+    const char *figs[] = { "fig4a", "fig1e", "fig2a", "fig4d" };
+    enum { NV = 23 };
+    double vs[NV], ends[2] = { 0.0, 1.0 }, wide[3] = { 0.0, 1.0, 0.5 };
+    for (int j = 0; j < NV; j++)
+        vs[j] = j / (double)(NV - 1);
+    int ones = 0, more = 0;   /* both of grid_cols' paths taken */
+    for (size_t f = 0; f < sizeof figs / sizeof *figs; f++) {
+        pde_solution *sol = solve_figure(figs[f]);
+        pde_grid *gn, *gw;
+        assert_int_equal(pde_grid_create(sol, ends, 2, vs, NV, &gn), PDE_OK);
+        assert_int_equal(pde_grid_create(sol, wide, 3, vs, NV, &gw), PDE_OK);
+        if (gn->nd[0] == 1 && gn->nd[1] == 1 && gn->nd[2] == 1)
+            ones++;
+        else
+            more++;
+        float n[4][6 * NV], wv[4][9 * NV], only[6 * NV];
+        for (int k = 0; k <= 3; k++) {
+            const double w = k / 3.0;
+            pde_grid_plane_d(gw, w, wv[0], wv[1], wv[2], wv[3]);
+            pde_grid_plane_d(gn, w, n[0], n[1], n[2], n[3]);
+            pde_grid_rows(gn, w, 5, 12, only, NULL, NULL, NULL);   /* positions alone, from row 5, an odd count */
+            assert_memory_equal(only, n[0] + 6 * 5, 6 * 7 * sizeof(float));
+            pde_grid_rows(gn, w, 2, 9, NULL, only, NULL, NULL);
+            assert_memory_equal(only, n[1] + 6 * 2, 6 * 7 * sizeof(float));
+            for (int q = 0; q < 4; q++)
+                for (int j = 0; j < NV; j++)
+                    assert_memory_equal(n[q] + 6 * j, wv[q] + 9 * j, 6 * sizeof(float));
+        }
+        pde_grid_free(gn);
+        pde_grid_free(gw);
+        pde_solution_free(sol);
+    }
+    assert_true(ones > 0 && more > 0);
+}
+
 /* Richardson-extrapolated central differences of order n (1..4) along one axis. */
 static double fd(const pde_solution *sol, int comp, const double p[3], int axis, int n, double h)
 {
@@ -199,14 +241,139 @@ static void force_should_be_the_models_force(void **state)
     pde_solution_free(sol);
 }
 
+/* w-terms of every kind mode_h_derivs and terms_bounds treat apart: polynomial, real exponential,
+ * pure rotation and both, of degrees 0 .. 3, one slab. */
+static const double T_A[4][4] = { { 0.5, -1.25, 3.0, -2.0 }, { 1.5, 0.25, -0.75, 0 }, { -0.8, 0.3, 0, 0 },
+                                  { 0.7, -0.4, 0.9, 0 } };
+static const double T_B[4][4] = { { 0, 0, 0, 0 }, { 0, 0, 0, 0 }, { 0.6, -1.1, 0, 0 }, { 0, 0.35, -0.2, 0 } };
+static const pde_wterm T_TERMS[4] = {
+    { 0.0, 0.0, 0.0, 3, T_A[0], T_B[0] },    /* polynomial */
+    { -2.5, 0.0, 0.0, 2, T_A[1], T_B[1] },   /* real exponential */
+    { 0.0, 7.0, 0.0, 1, T_A[2], T_B[2] },    /* rotation */
+    { 3.0, 4.5, 1.0, 2, T_A[3], T_B[3] },    /* both */
+};
+
+/* d^n/dw^n of a term from its definition Re[(A - iB)(w) e^{alpha (w - shift)} e^{i beta w}]: the
+ * Leibniz sum in complex arithmetic, each piece's derivatives taken apart. */
+static double term_deriv_ref(const pde_wterm *t, double w, int n)
+{
+    double complex z = t->alpha + I * t->beta, sum = 0.0;
+    for (int j = 0; j <= n; j++) {
+        double complex pj = 0.0;   /* (A - iB)^(j)(w) */
+        for (int k = t->deg; k >= j; k--) {
+            double f = 1.0;
+            for (int i = 0; i < j; i++)
+                f *= k - i;
+            pj = pj * w + f * (t->A[k] - I * t->B[k]);
+        }
+        double binom = 1.0;
+        double complex zp = 1.0;   /* z^(n - j); cpow(0, 0) is not 1 */
+        for (int i = 0; i < j; i++)
+            binom = binom * (n - i) / (i + 1);
+        for (int i = j; i < n; i++)
+            zp *= z;
+        sum += binom * zp * pj;
+    }
+    return creal(sum * cexp(t->alpha * (w - t->shift) + I * t->beta * w));
+}
+
+static void factor_paths_should_match_a_general_complex_evaluation(void **state)
+{
+    (void)state;
+    const size_t first[2] = { 0, 1 };
+    const double breaks[2] = { 0.0, 1.0 };
+    for (int i = 0; i < 4; i++) {
+        const pde_mode m = { F_pow(0), F_pow(0), 0.0, 1, &T_TERMS[i], 1, breaks, first };
+        for (int p = 0; p <= 8; p++) {
+            const double w = p / 8.0;
+            double d[5], h, dh;
+            mode_h_derivs(&m, w, 4, d);
+            mode_h(&m, w, &h, &dh);
+            for (int n = 0; n <= 4; n++) {
+                const double ref = term_deriv_ref(&T_TERMS[i], w, n), scale = pow(10.0, n);
+                assert_rel(d[n], ref, 1e-13, scale);
+                assert_rel(wterm_deriv(&T_TERMS[i], w, n), ref, 1e-13, scale);
+            }
+            assert_rel(h, d[0], 1e-14, 1.0);
+            assert_rel(dh, d[1], 1e-14, 10.0);
+            /* the bounds over [w - 1/16, w + 1/16] hold at its ends and centre */
+            double b[5];
+            mode_h_bounds(&m, w - 0.0625, w + 0.0625, 4, b);
+            for (int q = -1; q <= 1; q++) {
+                mode_h_derivs(&m, w + q * 0.0625, 4, d);
+                for (int n = 0; n <= 4; n++)
+                    assert_true(fabs(d[n]) <= b[n]);
+            }
+        }
+    }
+}
+
+static void sin_and_cos_bounds_should_hold_over_any_interval(void **state)
+{
+    (void)state;
+    const pde_factor fs[4] = { F_sin(1.0), F_cos(1.0), F_sin(3.5), F_cos(0.25) };
+    for (int f = 0; f < 4; f++)
+        for (int i = 0; i < 40; i++) {
+            /* intervals with and without a peak of |sin| or |cos|, short and long */
+            const double t0 = -0.3 + 0.037 * i, t1 = t0 + 0.011 * (1 + i % 7) * (1 + i % 3);
+            double b[5], d[5];
+            factor_bounds(fs[f], t0, t1, 4, b);
+            double top[5] = { 0 };
+            for (int q = 0; q <= 200; q++) {
+                factor_derivs(fs[f], t0 + (t1 - t0) * q / 200.0, 4, d);
+                for (int k = 0; k <= 4; k++) {
+                    assert_true(fabs(d[k]) <= b[k] * (1 + 1e-15));
+                    top[k] = fmax(top[k], fabs(d[k]));
+                }
+            }
+            for (int k = 0; k <= 4; k++)   /* and are the maxima, to the sampling's resolution */
+                assert_rel(b[k], top[k], 1e-3, 0.0);
+        }
+}
+
+static void solution_factors_should_be_factor_eval_and_mode_h(void **state)
+{
+    (void)state;
+    for (size_t f = 0; f < paper_figure_count(); f++) {
+        pde_solution *sol = solve_figure(paper_figure_name(f));
+        size_t mt = 0;
+        for (int c = 0; c < 3; c++)
+            mt += sol->comp[c].nmodes;
+        double *val = malloc(2 * (mt ? mt : 1) * sizeof *val), *der = val + (mt ? mt : 1);
+        assert_non_null(val);
+        for (int axis = 0; axis < 3; axis++)
+            for (int p = 0; p <= 6; p++) {
+                const double t = p / 6.0 - 0.05;
+                solution_factors(sol, axis, t, val, der);
+                size_t o = 0;
+                for (int c = 0; c < 3; c++)
+                    for (size_t m = 0; m < sol->comp[c].nmodes; m++, o++) {
+                        const pde_mode *md = &sol->comp[c].modes[m];
+                        double v, d;
+                        if (axis == 2)
+                            mode_h(md, t, &v, &d);
+                        else
+                            factor_eval(axis ? md->v : md->u, t, &v, &d);
+                        assert_true(v == val[o] && d == der[o]);   /* the same roundings */
+                    }
+            }
+        free(val);
+        pde_solution_free(sol);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(eval_should_give_identical_results_from_many_threads),
         cmocka_unit_test(sample_should_match_pointwise_evaluation),
         cmocka_unit_test(grid_should_give_faces_and_derivatives),
+        cmocka_unit_test(narrow_grid_should_match_a_wide_grids_columns),
         cmocka_unit_test(eval_partial_should_agree_with_differences_and_first_derivatives),
         cmocka_unit_test(force_should_be_the_models_force),
+        cmocka_unit_test(factor_paths_should_match_a_general_complex_evaluation),
+        cmocka_unit_test(sin_and_cos_bounds_should_hold_over_any_interval),
+        cmocka_unit_test(solution_factors_should_be_factor_eval_and_mode_h),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("eval", tests, NULL, NULL);

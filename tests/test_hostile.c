@@ -718,6 +718,7 @@ static int run_daemon(const char *args, char **err)
     snprintf(cmd, sizeof cmd, "exec %s %s 2>%s", bin, args, log);
     pid_t pid = fork();
     if (pid == 0) {
+        child_dies_with_parent();
         execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);
         _exit(127);
     }

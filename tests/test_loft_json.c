@@ -409,6 +409,29 @@ static void expect_bad(const char *doc, const char *pointer, api_status status)
 #define PDE3 "\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], \"c\": [1, 1, 1]}"
 #define TRI(z) "[[1, 0, " #z "], [0, 1, " #z "], [-1, -1, " #z "]]"
 
+/* Sections that are all zero leave no term: the loft is the zero solid, not undefined behaviour (a QA probe's
+ * all-zero profile aborted the sanitised daemon in build_terms' qsort of no records). */
+static void a_loft_of_zero_sections_should_be_the_zero_solid(void **state)
+{
+    (void)state;
+    const char *docs[] = {
+        "{\"loft\": {\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], \"c\": [2, 2, 2]}, \"sections\": ["
+        "{\"w\": 0, \"profile\": [[0, 0, 0], [0, 0, 0], [0, 0, 0]]}, {\"w\": 1, \"profile\": [[0, 0, 0], [0, 0, 0], [0, 0, 0]]}]}}",
+        "{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"grid\": [[[0, 0, 0], [0, 0, 0]], [[0, 0, 0], [0, 0, 0]]]},"
+        " {\"w\": 1, \"grid\": [[[0, 0, 0], [0, 0, 0]], [[0, 0, 0], [0, 0, 0]]]}]}}",
+    };
+    for (size_t i = 0; i < sizeof docs / sizeof *docs; i++) {
+        api_model *m = parse_ok(docs[i]);
+        assert_int_equal(loft_terms(m), 0);
+        pde_solution *s = solve_ok(m);
+        double x[3] = { 1, 1, 1 };
+        pde_eval_d(s, 0.3, 0.7, 0.4, x, NULL, NULL, NULL);
+        assert_true(x[0] == 0 && x[1] == 0 && x[2] == 0);
+        pde_solution_free(s);
+        api_model_free(m);
+    }
+}
+
 static void every_bad_loft_should_name_its_field(void **state)
 {
     (void)state;
@@ -440,6 +463,13 @@ static void every_bad_loft_should_name_its_field(void **state)
                "/loft/sections/0/grid/1", API_ERR_DOCUMENT);
     expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"periodic\": true, \"profile\": " TRI(0) "}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
                "/loft/sections/0", API_ERR_DOCUMENT);
+    /* A loft's powers are t^0 to t^3: the error names the term's own field (it named /loft/pde). */
+    expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"terms\": {\"x\": [{\"u\": {\"pow\": 4}, \"c\": 1}]}},"
+               " {\"w\": 1, \"profile\": " TRI(1) "}]}}",
+               "/loft/sections/0/terms/x/0/u/pow", API_ERR_DOCUMENT);
+    expect_bad("{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": " TRI(0) "},"
+               " {\"w\": 1, \"terms\": {\"y\": [{\"c\": 1}, {\"v\": {\"pow\": 7}, \"c\": 1}]}}]}}",
+               "/loft/sections/1/terms/y/1/v/pow", API_ERR_DOCUMENT);
     /* Limits: sections and points. */
     sbuf b = { 0 };
     put(&b, "{\"loft\": {" PDE3 ", \"sections\": [");
@@ -467,6 +497,7 @@ int main(void)
         cmocka_unit_test(the_tolerance_should_drop_the_harmonics_of_noise),
         cmocka_unit_test(equal_lofts_should_share_an_id_and_a_changed_one_should_not),
         cmocka_unit_test(every_bad_loft_should_name_its_field),
+        cmocka_unit_test(a_loft_of_zero_sections_should_be_the_zero_solid),
         cmocka_unit_test(every_loft_preset_should_solve_soundly_and_its_document_give_the_same_id),
         cmocka_unit_test(a_near_resonant_loft_should_report_its_harmonic_and_condition),
     };

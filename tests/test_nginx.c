@@ -245,6 +245,7 @@ static void front_start(front_t *f, int upstream_port)
                  dir, conf, f->log, dir, k, err);
         pid_t pid = fork();
         if (pid == 0) {
+            child_dies_with_parent();
             execl("/bin/sh", "sh", "-c", cmd, (char *)NULL);
             _exit(127);
         }

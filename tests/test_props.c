@@ -733,12 +733,11 @@ static void props_should_match_the_160_digit_volume_of_fig4a_which_folds(void **
 /* pde_properties against the reference: every integral to 1e-9, inertia relative to its largest entry. */
 static void expect_props_match_reference(const char *name, const pde_props *p, const ref_props_out *r)
 {
-    /* A known shortfall, which issue 9 leaves open (its notes): fig. 3c and 3d's sin(8 pi v) to
-     * sin(14 pi v) fold in up to 1024 panels, beyond core/quad.c's budget of refined panels (fig. 3b
-     * was 8.6e-7 off so). Fig. 3a and 3b separate (det J = u G(v, w)): every panel of the face u = 1
-     * is refined, and they come within 3e-11 (run under the sanitisers with PDESOLID_SLOW_TESTS=1). */
-    const int fig3_3d = strcmp(name, "fig3c") == 0 || strcmp(name, "fig3d") == 0;
-    const double tol = fig3_3d ? 2e-6 : 1e-9, area_tol = 1e-6;
+    /* Fig. 3a and 3b separate (det J = u G(v, w)): every panel of the face u = 1 is refined. Fig. 3c
+     * and 3d do not, but x is linear in u: lines along u are exact between the closed-form roots of
+     * det J, and the (v, w) panels are refined (core/quad.c). All come within 1e-9 (run under the
+     * sanitisers with PDESOLID_SLOW_TESTS=1). */
+    const double tol = 1e-9, area_tol = 3e-8;
     double imax = 0, size = cbrt(r->volume);
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
@@ -752,8 +751,9 @@ static void expect_props_match_reference(const char *name, const pde_props *p, c
     EXPECT("volume", p->volume, r->volume, 0);
     EXPECT("signed_volume", p->signed_volume, r->signed_volume, r->volume);
     /* The area element vanishes at points of a skin (cusps of a skin that folds, cone points)
-     * where core/quad.c's refinement of a face's panels converges slowly: within 1e-6 (fig. 2c:
-     * 3.6e-7). Issue 9 leaves this open. */
+     * where core/quad.c's refinement of a face's panels converges slowly: within 3e-8 (fig. 2c:
+     * 1.5e-8, where the fold is rounded: |x_v x x_w| dips to 1e-4 of its largest without
+     * vanishing). Issue 9 leaves 1e-9 open there; fig. 4a is within 2e-11. */
     EXPECT_TOL("surface_area", p->surface_area, r->surface_area, 0, area_tol);
     for (int i = 0; i < 3; i++) {
         EXPECT("centroid", p->centroid[i], r->centroid[i], size);
@@ -769,7 +769,7 @@ static void expect_props_match_reference(const char *name, const pde_props *p, c
     double verr = fabs(p->volume - r->volume) / r->volume;
     if (!(verr <= fmax(10 * p->integral_error, 1e-11)))
         fail_msg("%s: volume off by %.3g, reported integral_error %.3g", name, verr, p->integral_error);
-    if (!(p->integral_error <= (strncmp(name, "fig3", 4) == 0 ? 1e-5 : 1e-11)))
+    if (!(p->integral_error <= (strncmp(name, "fig3", 4) == 0 ? 1e-7 : 1e-11)))
         fail_msg("%s: integral_error %.3g", name, p->integral_error);
     /* Principal axes: orthonormal, right-handed, and eigenvectors of the reported inertia. */
     const double (*a)[3] = p->principal_axes;
@@ -830,6 +830,42 @@ static void props_should_match_the_reference_quadrature_on_every_preset(void **s
         pde_solution_free(sol);
     }
     print_message("reference quadrature of %zu presets: %.2f s\n", api_preset_count(), mono_now() - t0);
+}
+
+/*
+ * Fig. 3c at lower frequencies (n_xy = 3, n_z = 4): x is linear in u, det J a quadratic in u, and the
+ * solid folds without separating, so core/quad.c runs every line along u with det J's roots in closed
+ * form and refines the (v, w) panels; cheap enough for the reference under the sanitisers, which leave
+ * fig. 3c and 3d out unless PDESOLID_SLOW_TESTS=1.
+ */
+static void props_should_match_the_reference_on_a_folding_solid_linear_in_u(void **state)
+{
+    (void)state;
+    const api_preset *ps = api_preset_find("fig3c");
+    api_params prm;
+    api_error err;
+    api_preset_params(ps, &prm);
+    const double nxy = 3, nz = 4;
+    assert_int_equal(api_params_set(api_preset_template(ps), &prm, "n_xy", &nxy, 1, &err), 0);
+    assert_int_equal(api_params_set(api_preset_template(ps), &prm, "n_z", &nz, 1, &err), 0);
+    api_model *m = api_template_expand(api_preset_template(ps), &prm, &err);
+    assert_non_null(m);
+    pde_solution *sol = NULL;
+    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
+    quad_sep sp;
+    quad_separate(sol, &sp);
+    assert_int_equal(sp.axis, -1);   /* z's mode h(w) beside u sin(4 pi v) h(w) */
+    ref_props_out r;
+    assert_int_equal(ref_props(sol, &r), 0);
+    assert_true(r.converged);
+    assert_true(r.volume - fabs(r.signed_volume) > 1e-6 * r.volume);   /* it folds */
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    expect_props_match_reference("fig3c, n_xy = 3, n_z = 4", &p, &r);
+    print_message("volume %.3g, area %.3g off the reference\n", fabs(p.volume - r.volume) / r.volume,
+                  fabs(p.surface_area - r.surface_area) / r.surface_area);
+    pde_solution_free(sol);
+    api_model_free(m);
 }
 
 /*
@@ -1207,6 +1243,28 @@ static void bounds_should_stay_certified_when_a_factor_bound_overflows(void **st
     pde_solution_free(sol);
 }
 
+/* Issue 9 on det J: figure 3's det J has factors like sin(30 pi v), whose bounds of products (no
+ * cancellation) kept its gap at 5e2 to 4e3 of a range of 2e2 to 5e2 within 1000 boxes. Every paper
+ * figure's det J gap must be below 1e-9 of its scale, and its bounds must contain a dense sampling. */
+static void det_j_gap_should_close_to_1e_9_of_its_scale_on_every_paper_figure(void **state)
+{
+    (void)state;
+    static const char *const figs[] = { "fig1a", "fig1c", "fig1e", "fig1g", "fig2a", "fig2b", "fig2c", "fig3a",
+                                        "fig3b", "fig3c", "fig3d", "fig4a", "fig4b", "fig4c", "fig4d", "fig4e" };
+    for (size_t i = 0; i < sizeof figs / sizeof *figs; i++) {
+        pde_solution *sol = preset_solution(figs[i]);
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        const double scale = fmax(fabs(p.detj_min_found), fabs(p.detj_max_found));
+        if (!(p.detj_gap <= 1e-9 * scale))
+            fail_msg("%s: detj_gap %.3g for det J of scale %.3g (bounds [%.6g, %.6g], found [%.6g, %.6g])", figs[i],
+                     p.detj_gap, scale, p.detj_min, p.detj_max, p.detj_min_found, p.detj_max_found);
+        if (figs[i][3] == '3')   /* sin(8..30 pi v): finer along v */
+            expect_bounds_contain_samples(figs[i], sol, 30, 400, 100, PRESET_RANDOM);
+        pde_solution_free(sol);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1230,11 +1288,13 @@ int main(void)
         cmocka_unit_test(separable_integrals_should_equal_the_adaptive_integrals_over_the_cube),
         cmocka_unit_test(det_j_should_not_separate_without_the_product_structure),
         cmocka_unit_test(props_should_match_the_reference_quadrature_on_every_preset),
+        cmocka_unit_test(props_should_match_the_reference_on_a_folding_solid_linear_in_u),
         cmocka_unit_test(props_beyond_the_work_bound_should_report_an_error_that_covers_what_they_are_off_by),
         cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_every_preset),
         cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_stress_models),
         cmocka_unit_test(bounds_should_stay_certified_when_a_factor_bound_overflows),
         cmocka_unit_test(a_lofts_properties_should_match_the_reference_and_its_certificate_be_near_rounding),
+        cmocka_unit_test(det_j_gap_should_close_to_1e_9_of_its_scale_on_every_paper_figure),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);

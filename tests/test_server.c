@@ -8,6 +8,7 @@
 #include <math.h>
 #include <poll.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <setjmp.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -441,6 +442,40 @@ static void etag_with_if_none_match_should_give_304(void **state)
     r = http(&d, "POST", "/solve?format=glb&res=9", body, strlen(body), inm);
     assert_int_equal(r.status, 200);
     free(r.body);
+    /* Only a representation the request would get is "not modified": the checks come first (a QA probe got
+     * 304s for outputs that are 422s, with the ETag they would carry or with *). */
+    const struct {
+        const char *path, *body;
+    } refused[] = {
+        { "/solve?format=stl&res=2", "{\"preset\":\"fig4a\"}" },                           /* no triangle */
+        { "/solve?format=glb&res=512", "{\"preset\":\"fig4a\"}" },                         /* a limit */
+    };
+    for (size_t i = 0; i < sizeof refused / sizeof *refused; i++) {
+        r = post(&d, refused[i].path, refused[i].body);
+        long want = r.status;
+        assert_true(want >= 400);
+        free(r.body);
+        const char *path = refused[i].path;
+        const char *fmt = strstr(path, "format=") + 7;
+        const char *res = strstr(path, "res=") + 4;
+        char e[200];
+        /* the ETag it would carry: its id from a 200 of the same model in json */
+        r = post(&d, "/solve", refused[i].body);
+        assert_int_equal(r.status, 200);
+        char jt[128];
+        assert_true(header_value(&r, "ETag", jt, sizeof jt));
+        free(r.body);
+        int n = atoi(res);
+        snprintf(e, sizeof e, "If-None-Match: \"%.*s.%.*s.%dx%dx%d\"", API_ID_LEN, jt + 1, (int)(strchr(fmt, '&') - fmt), fmt,
+                 n, n, n);
+        const char *conds[] = { e, "If-None-Match: *" };
+        for (int k = 0; k < 2; k++) {
+            r = http(&d, "POST", path, refused[i].body, strlen(refused[i].body), conds[k]);
+            if (r.status != want)
+                fail_msg("%s with %s: %ld, want %ld", path, conds[k], r.status, want);
+            free(r.body);
+        }
+    }
     stop(&d);
 }
 
@@ -552,6 +587,74 @@ static void a_full_queue_should_give_503_with_retry_after(void **state)
     assert_int_equal(r.status, 200);
     free(r.body);
     stop(&d);
+}
+
+/* A row of heavy requests must not hold up a light one (a QA probe: 20 distinct heavy solves, and an f32 of
+ * res 2 waited 16.6 s behind them). The light request finishes before the third of four heavy ones, as no
+ * queue in front of all threads would let it; and past --heavy-queue, heavy ones get a prompt 503. */
+typedef struct {
+    const daemon_t *d;
+    int k;
+    long status;
+    atomic_int *done;
+    int order;
+    char retry[16];
+} lane_arg;
+
+static void *lane_client(void *arg)
+{
+    lane_arg *a = arg;
+    char body[128];
+    if (a->k < 0)
+        snprintf(body, sizeof body, "{\"preset\":\"fig1a\"}");
+    else
+        snprintf(body, sizeof body, "{\"preset\":\"fig3c\",\"params\":{\"h0\":%d}}", a->k + 3);
+    reply r = post(a->d, a->k < 0 ? "/solve?format=f32&res=2" : "/solve", body);
+    a->order = atomic_fetch_add(a->done, 1);
+    a->status = r.status;
+    header_value(&r, "Retry-After", a->retry, sizeof a->retry);
+    if (r.status == 503)
+        expect_problem(&r, 503, NULL, "--heavy-queue");
+    free(r.body);
+    return NULL;
+}
+
+static void a_light_request_should_not_wait_behind_heavy_ones(void **state)
+{
+    (void)state;
+    for (int round = 0; round < 2; round++) {
+        daemon_t d;
+        /* fig3c's json is some 1e8 units: heavy at 1e7; round 1 lets one heavy request wait */
+        start(&d, round ? "--threads 2 --heavy-work 1e7 --heavy-queue 1" : "--threads 2 --heavy-work 1e7");
+        enum { N = 6 };
+        const int heavies = round ? N : 4;
+        pthread_t t[N + 1];
+        lane_arg a[N + 1];
+        atomic_int done = 0;
+        for (int i = 0; i < heavies; i++)
+            a[i] = (lane_arg){ &d, i, 0, &done, -1, "" };
+        threads_start(t, heavies, lane_client, a, sizeof *a);
+        usleep(150000);   /* all of them in */
+        a[heavies] = (lane_arg){ &d, -1, 0, &done, -1, "" };
+        threads_start(t + heavies, 1, lane_client, a + heavies, sizeof *a);
+        threads_join(t, heavies + 1);
+        assert_int_equal(a[heavies].status, 200);
+        int busy = 0;
+        for (int i = 0; i < heavies; i++) {
+            if (a[i].status == 503) {
+                busy++;
+                assert_string_equal(a[i].retry, "1");
+            } else if (a[i].status != 200)
+                fail_msg("heavy %d: status %ld", i, a[i].status);
+        }
+        if (round == 0) {
+            assert_int_equal(busy, 0);
+            if (a[heavies].order > 2)
+                fail_msg("the light request finished after %d of %d heavy ones", a[heavies].order, heavies);
+        } else if (busy == 0 || busy > heavies - 2)
+            fail_msg("%d of %d heavy requests were refused (--heavy-queue 1, 2 threads)", busy, heavies);
+        stop(&d);
+    }
 }
 
 /* ---- bad input ---- */
@@ -871,6 +974,13 @@ static void presets_version_health_metrics_and_cors_should_answer(void **state)
     free(r.body);
     r = http(&d, "GET", "/livez", NULL, 0, "Origin: http://evil.example");
     assert_false(header_value(&r, "Access-Control-Allow-Origin", v, sizeof v));
+    assert_true(header_value(&r, "Vary", v, sizeof v));
+    free(r.body);
+    /* With a list of origins, every answer varies by Origin, one without it too: a shared cache must not
+     * give a.example's answer (with its Allow-Origin) to b.example, nor one without to a.example. */
+    r = http(&d, "GET", "/presets/fig4c", NULL, 0, NULL);
+    assert_true(header_value(&r, "Vary", v, sizeof v));
+    assert_string_equal(v, "Origin");
     free(r.body);
     stop(&d);
 }
@@ -1002,6 +1112,57 @@ static void the_cli_should_give_the_same_answers_through_the_server(void **state
     free(a);
 }
 
+/* ---- the harness itself ---- */
+
+/* Running, and not a zombie (where no init reaps orphans, as in some containers, one stays listed). */
+static int process_alive(int pid)
+{
+    char path[64], buf[256];
+    snprintf(path, sizeof path, "/proc/%d/stat", pid);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return 0;
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = 0;
+    const char *p = strrchr(buf, ')');   /* the state follows the command, which may hold spaces */
+    return p && p[1] == ' ' && p[2] != 'Z' && p[2] != 'X';
+}
+
+/* A failed assertion leaves a test without reaching daemon_stop: the daemon must still not outlive the test
+ * binary (it held a port and CPU after a failed CI run). A child starts one and exits without stopping it. */
+static void a_daemon_should_not_outlive_the_test_that_started_it(void **state)
+{
+    (void)state;
+    int fd[2];
+    assert_int_equal(pipe(fd), 0);
+    pid_t child = fork();
+    assert_true(child >= 0);
+    if (child == 0) {
+        daemon_t d;
+        daemon_start(&d, dir, "");
+        if (write(fd[1], &d.pid, sizeof d.pid) != (ssize_t)sizeof d.pid)
+            _exit(1);
+        _exit(0);   /* as a failed test's binary ends: no daemon_stop */
+    }
+    close(fd[1]);
+    int pid = 0, st;
+    assert_int_equal(read(fd[0], &pid, sizeof pid), (ssize_t)sizeof pid);
+    close(fd[0]);
+    waitpid(child, &st, 0);
+    assert_true(pid > 0);
+    int gone = 0;
+    for (int i = 0; i < 200 && !gone; i++) {
+        gone = !process_alive(pid);
+        if (!gone)
+            usleep(10000);
+    }
+    if (!gone) {
+        kill(pid, SIGKILL);
+        fail_msg("pdesolidd %d outlived the process that started it", pid);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1017,6 +1178,7 @@ int main(void)
         cmocka_unit_test(etag_with_if_none_match_should_give_304),
         cmocka_unit_test(sixty_four_concurrent_clients_should_all_get_correct_answers),
         cmocka_unit_test(a_full_queue_should_give_503_with_retry_after),
+        cmocka_unit_test(a_light_request_should_not_wait_behind_heavy_ones),
         cmocka_unit_test(bad_requests_should_get_problems_and_the_daemon_should_keep_serving),
         cmocka_unit_test(a_loft_should_solve_and_a_bad_one_get_its_pointer),
         cmocka_unit_test(two_content_lengths_and_stalled_clients_should_be_refused),
@@ -1024,6 +1186,7 @@ int main(void)
         cmocka_unit_test(presets_version_health_metrics_and_cors_should_answer),
         cmocka_unit_test(formats_should_list_the_table_and_each_row_should_hold),
         cmocka_unit_test(compress_should_be_checked_like_every_query_parameter),
+        cmocka_unit_test(a_daemon_should_not_outlive_the_test_that_started_it),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("server", tests, setup, teardown);

@@ -396,6 +396,7 @@ static pid_t redis_start(int port)
     snprintf(p, sizeof p, "%d", port);
     pid_t pid = fork();
     if (pid == 0) {
+        child_dies_with_parent();
         execl("/usr/bin/redis-server", "redis-server", "--port", p, "--bind", "127.0.0.1", "--save", "",
               "--appendonly", "no", "--dir", dir, "--logfile", "redis.log", "--loglevel", "warning", (char *)NULL);
         _exit(127);

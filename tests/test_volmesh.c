@@ -16,6 +16,7 @@
 
 #include "loft.h"
 #include "model.h"
+#include "output.h"
 #include "support.h"
 #include "volmesh.h"
 
@@ -403,6 +404,42 @@ static void large_files_should_stream_in_pieces_of_about_a_megabyte(void **state
     pde_solution_free(s);
 }
 
+/* A solid with no volume (a loft of zero sections: every point at the origin) gets no mesh of any kind: a
+ * document error that says so, rather than a volume mesh of flat cells (a QA probe got 9 nodes at the origin and
+ * one hexahedron of volume 0 at res 4, and at res 3 a message asking for the 3 samples it had). */
+static void a_solid_with_no_volume_should_get_no_mesh_and_say_why(void **state)
+{
+    (void)state;
+    static const char doc[] = "{\"loft\":{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[2,2,2]},\"sections\":["
+                              "{\"w\":0,\"profile\":[[0,0,0],[0,0,0],[0,0,0]]},{\"w\":1,\"profile\":[[0,0,0],[0,0,0],[0,0,0]]}]}}";
+    api_error err;
+    api_model *md = api_model_parse(doc, sizeof doc - 1, &err);
+    assert_non_null(md);
+    pde_solution *s = NULL;
+    assert_int_equal(api_solve(md, &s, &err), 0);
+    api_model_free(md);
+    const api_format fmts[] = { API_FMT_MSH, API_FMT_VTU, API_FMT_STL, API_FMT_GLB };
+    const unsigned res[][3] = { { 3, 3, 3 }, { 4, 4, 4 }, { 9, 17, 5 } };
+    for (size_t i = 0; i < sizeof fmts / sizeof *fmts; i++)
+        for (size_t k = 0; k < sizeof res / sizeof *res; k++) {
+            api_output *o = api_output_open_ex(s, NULL, NULL, fmts[i], res[k], NULL, NULL, &err);
+            if (o)
+                fail_msg("%s at %u: opened a mesh of a solid with no volume", api_format_info_of(fmts[i])->name,
+                         res[k][0]);
+            assert_int_equal(err.status, API_ERR_DOCUMENT);
+            if (!strstr(err.message, "no volume"))
+                fail_msg("%s at %u: %s", api_format_info_of(fmts[i])->name, res[k][0], err.message);
+        }
+    pde_solution_free(s);
+    /* A solid with volume at too few samples: the message names res, as the volume meshes' does. */
+    pde_solution *f = preset_solution("fig4a");
+    assert_null(api_output_open_ex(f, NULL, NULL, API_FMT_STL, (const unsigned[3]){ 2, 2, 2 }, NULL, NULL, &err));
+    assert_int_equal(err.status, API_ERR_DOCUMENT);
+    if (!strstr(err.message, "res") || !strstr(err.message, "at least 3"))
+        fail_msg("stl at 2: %s", err.message);
+    pde_solution_free(f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -412,6 +449,7 @@ int main(void)
         cmocka_unit_test(fig4a_should_have_no_two_points_in_one_place),
         cmocka_unit_test(res_should_be_bounded),
         cmocka_unit_test(a_cancelled_build_should_say_so),
+        cmocka_unit_test(a_solid_with_no_volume_should_get_no_mesh_and_say_why),
         cmocka_unit_test(files_should_read_back_in_meshio),
         cmocka_unit_test(large_files_should_stream_in_pieces_of_about_a_megabyte),
     };

@@ -3,11 +3,14 @@
  * closed form, properties, values at points, sampled grids and meshes.
  */
 #include <errno.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
 #include <unistd.h>
+
+#include <cJSON.h>
 
 #include "describe.h"
 #include "id.h"
@@ -21,52 +24,87 @@
 
 #define MAX_INPUT (64u << 20)
 
-static const char usage[] =
-    "usage: pdesolid COMMAND [ARGS] [OPTIONS]\n"
-    "\n"
-    "Solves a solid of the fourth-order PDE a x_uuuu + b x_vvvv + c x_wwww = p\n"
-    "in closed form (You, Comninos and Zhang), offline.\n"
-    "\n"
-    "commands:\n"
-    "  solve MODEL.json          the closed form and the solid's properties, or with\n"
-    "                            --format the solid in that format\n"
-    "  eval MODEL.json POINTS.json\n"
-    "                            [[x,y,z], ...] at each [u,v,w] of POINTS.json, with\n"
-    "                            17 significant digits\n"
-    "  presets                   the paper's solids: name, template and caption\n"
-    "\n"
-    "MODEL.json is a model, a loft ({\"loft\": {\"pde\": ..., \"sections\": [...]}}: a solid through\n"
-    "sections of your own) or a request ({\"preset\": \"fig4a\", \"params\": {...}});\n"
-    "either file may be - for standard input. docs/API.md describes the format.\n"
-    "\n"
-    "options:\n"
-    "  --preset NAME        instead of MODEL.json: a preset (see `pdesolid presets`)\n"
-    "  --template NAME      instead of MODEL.json: a template (example1 to example4,\n"
-    "                       docs/API.md), its defaults changed by --param\n"
-    "  --param NAME=VALUE   with --preset or --template, a parameter; VALUE is a number, or x,y,z for\n"
-    "                       a, b and c; repeatable\n"
-    "  --format F           solve: one of the formats below\n"
-    "  --res N|NU,NV,NW     samples per axis, or per face edge for the formats that\n"
-    "                       mesh the skin (the defaults below)\n"
-    "  --compress meshopt   gltf, glb: EXT_meshopt_compression with KHR_mesh_quantization\n"
-    "  -o FILE              write to FILE instead of standard output; solve without\n"
-    "                       --format takes the format from FILE's extension, and\n"
-    "                       with it refuses an extension of another format\n"
-    "  --server URL         solve and eval on a pdesolidd (e.g. http://127.0.0.1:8080)\n"
-    "                       instead of here; the output is the same\n"
-    "  -h, --help           this text\n"
-    "  --version            the version\n"
-    "\n"
-    "exit status: 0 success, 2 bad input (the message names the field as a JSON\n"
-    "pointer), 1 anything else.\n";
+/* The commands as bits, for the commands each option goes with. */
+enum { CMD_SOLVE = 1, CMD_EVAL = 2, CMD_PRESETS = 4 };
 
 typedef struct {
     const char *preset, *template, *format, *res, *compress, *out, *server;
     const char *params[64];
     int nparams;
-    const char *args[3];
-    int nargs;
+    const char *args[4];   /* the command's files, the first four */
+    int nargs;             /* all of them */
+    char base[2048];       /* --server as remote_base() cleaned it */
 } options;
+
+/* One row an option that takes a value: the commands that take it, where its value goes (--param, repeatable,
+ * has its own list), and its help (lines after the first indented by print_rows). */
+static const struct opt_row {
+    const char *name, *arg;
+    unsigned cmds;
+    int repeat;
+    size_t field;
+    const char *help;
+} opt_rows[] = {
+    { "--preset", "NAME", CMD_SOLVE | CMD_EVAL, 0, offsetof(options, preset),
+      "instead of MODEL.json: a preset (see `pdesolid presets`)" },
+    { "--template", "NAME", CMD_SOLVE | CMD_EVAL, 0, offsetof(options, template),
+      "instead of MODEL.json: a template (example1 to example4,\ndocs/API.md), its defaults changed by --param" },
+    { "--param", "NAME=VALUE", CMD_SOLVE | CMD_EVAL, 1, 0,
+      "with --preset or --template, a parameter; VALUE is a\nnumber as JSON writes one (2e5, -1.5), or x,y,z for a,\nb and c; repeatable" },
+    { "--format", "F", CMD_SOLVE, 0, offsetof(options, format), "one of the formats below" },
+    { "--res", "N|NU,NV,NW", CMD_SOLVE, 0, offsetof(options, res),
+      "samples per axis, or per face edge for the formats that\nmesh the skin (the defaults below)" },
+    { "--compress", "meshopt", CMD_SOLVE, 0, offsetof(options, compress),
+      "gltf, glb: EXT_meshopt_compression with KHR_mesh_quantization" },
+    { "-o", "FILE", CMD_SOLVE | CMD_EVAL | CMD_PRESETS, 0, offsetof(options, out),
+      "write to FILE instead of standard output (- is\nstandard output)" },
+    { "--server", "URL", CMD_SOLVE | CMD_EVAL | CMD_PRESETS, 0, offsetof(options, server),
+      "do it on a pdesolidd (its base URL, e.g.\nhttp://127.0.0.1:8080) instead of here; the output is\nthe same" },
+};
+
+static int cmd_solve(const options *o);
+static int cmd_eval(const options *o);
+static int cmd_presets(const options *o);
+
+/* One row a command: its files (the first, when a MODEL.json, replaced by --preset or --template), its usage
+ * after the name, and its help. */
+static const struct cmd_row {
+    const char *name;
+    unsigned bit;
+    const char *files[2];
+    const char *synopsis, *help;
+    int (*run)(const options *o);
+} cmd_rows[] = {
+    { "solve", CMD_SOLVE, { "MODEL.json" }, "[MODEL.json]",
+      "the closed form and the solid's properties, or the\n"
+      "solid in a format: --format's, or the one of -o\n"
+      "FILE's extension (with --format, an extension of\n"
+      "another format is refused)", cmd_solve },
+    { "eval", CMD_EVAL, { "MODEL.json", "POINTS.json" }, "MODEL.json POINTS.json",
+      "[[x,y,z], ...] at each [u,v,w] of POINTS.json, with\n17 significant digits", cmd_eval },
+    { "presets", CMD_PRESETS, { NULL }, "", "the paper's solids and the loft presets: name,\ntemplate and caption",
+      cmd_presets },
+};
+#define NCMDS (sizeof cmd_rows / sizeof *cmd_rows)
+#define NOPTS (sizeof opt_rows / sizeof *opt_rows)
+
+static const char about[] =
+    "Solves a solid of the fourth-order PDE a x_uuuu + b x_vvvv + c x_wwww = p\n"
+    "in closed form (You, Comninos and Zhang), here or on a pdesolidd.\n";
+
+static const char model_text_help[] =
+    "MODEL.json is a model, a loft ({\"loft\": {\"pde\": ..., \"sections\": [...]}}: a solid through\n"
+    "sections of your own) or a request ({\"preset\": \"fig4a\", \"params\": {...}});\n"
+    "either file may be - for standard input (not both). docs/API.md describes the format.\n";
+
+static const char exit_help[] =
+    "exit status: 0 success, 2 bad input (the message names the field as a JSON\n"
+    "pointer, or the argument), 1 anything else.\n";
+
+static const char **opt_slot(options *o, const struct opt_row *r)
+{
+    return (const char **)(void *)((char *)o + r->field);
+}
 
 /* Reads a whole file (or stdin for "-"); NULL with a message on failure. */
 static char *slurp(const char *path, size_t *len)
@@ -110,90 +148,94 @@ static int report(const char *what, const api_error *err)
     return 2;
 }
 
-/* The model of --preset (or --template) and --param. */
-static api_model *preset_model(const options *o, api_error *err)
+/* A refused option's value: the api's message starts with the query parameter's name ("res: ..."), the option's. */
+static int report_option(const char *name, const api_error *err)
 {
-    const api_template *t = NULL;
-    api_params p;
-    if (o->template) {
-        if (!(t = api_template_find(o->template))) {
-            char names[256] = "";
-            for (size_t i = 0, n = 0; i < api_template_count() && n < sizeof names; i++)
-                n += (size_t)snprintf(names + n, sizeof names - n, "%s%s", i ? ", " : "", api_template_name(api_template_at(i)));
-            api_fail(err, API_ERR_DOCUMENT, "/template", "no template \"%s\"; the templates are %s", o->template, names);
-            return NULL;
-        }
-        api_template_defaults(t, &p);
-    }
-    const api_preset *ps = t ? NULL : api_preset_find(o->preset);
-    cJSON *loft = ps || t ? NULL : api_loft_preset_tree(o->preset);
-    if (loft) {   /* a loft of the gallery: its document */
-        cJSON_Delete(loft);
-        if (o->nparams) {
-            api_fail(err, API_ERR_DOCUMENT, "/params", "the loft preset \"%s\" takes no --param; `pdesolid presets` shows its document", o->preset);
-            return NULL;
-        }
-        char body[128];
-        int n = snprintf(body, sizeof body, "{\"preset\": \"%.60s\"}", o->preset);
-        return api_model_parse(body, (size_t)n, err);
-    }
-    if (!ps && !t) {
-        api_fail(err, API_ERR_DOCUMENT, "/preset", "no preset \"%s\"; `pdesolid presets` lists them", o->preset);
+    size_t k = strlen(name);
+    int named = !strncmp(err->message, name, k) && err->message[k] == ':';
+    fprintf(stderr, "pdesolid: --%s%s%s\n", named ? "" : name, named ? "" : ": ", err->message);
+    return 2;
+}
+
+/* --param's VALUE: a number as JSON writes one, or x,y,z (three), checked by api_json_check as any request is.
+ * NULL after a message. */
+static cJSON *param_value(const char *name, const char *text)
+{
+    char json[256];
+    size_t n = strlen(text);
+    api_error err;
+    if (n == 0 || n > 200 || strspn(text, "0123456789+-.eE,") != n ||
+        api_json_check(json, (size_t)snprintf(json, sizeof json, strchr(text, ',') ? "[%s]" : "%s", text), &err)) {
+        fprintf(stderr, "pdesolid: --param %s: \"%s\" is not a number as JSON writes one (16, -1.5, 2e5), or x,y,z\n",
+                name, text);
         return NULL;
     }
-    if (ps) {
-        t = api_preset_template(ps);
-        api_preset_params(ps, &p);
-    }
-    for (int i = 0; i < o->nparams; i++) {
-        char name[64];
+    cJSON *v = cJSON_Parse(json);
+    if (!v)
+        fprintf(stderr, "pdesolid: out of memory\n");
+    return v;
+}
+
+/* The request {"preset" or "template": NAME, "params": {...}} of --preset or --template and --param, as JSON
+ * text (malloc'd), parsed by the api here or sent to a server alike; NULL after a message. */
+static char *request_text(const options *o, size_t *len)
+{
+    cJSON *req = cJSON_CreateObject(), *params = NULL;
+    int ok = req && cJSON_AddStringToObject(req, o->preset ? "preset" : "template", o->preset ? o->preset : o->template);
+    if (ok && o->nparams)
+        ok = (params = cJSON_AddObjectToObject(req, "params")) != NULL;
+    for (int i = 0; ok && i < o->nparams; i++) {
         const char *eq = strchr(o->params[i], '=');
-        if (!eq || eq == o->params[i] || (size_t)(eq - o->params[i]) >= sizeof name) {
-            api_fail(err, API_ERR_DOCUMENT, "", "--param %s: write NAME=VALUE", o->params[i]);
+        if (!eq || eq == o->params[i]) {
+            fprintf(stderr, "pdesolid: --param %s: write NAME=VALUE\n", o->params[i]);
+            cJSON_Delete(req);
             return NULL;
         }
-        snprintf(name, sizeof name, "%.*s", (int)(eq - o->params[i]), o->params[i]);
-        double v[3];
-        int n = 0;
-        const char *s = eq + 1;
-        char *end;
-        do {
-            v[n++] = strtod(s, &end);
-            if (end == s) {
-                api_fail(err, API_ERR_DOCUMENT, "", "--param %s: \"%s\" is not a number", name, s);
-                return NULL;
-            }
-            s = end + (*end == ',');
-        } while (*end == ',' && n < 3);
-        if (*end) {
-            api_fail(err, API_ERR_DOCUMENT, "", "--param %s: \"%s\" is not a number or x,y,z", name, eq + 1);
+        char *name = strndup(o->params[i], (size_t)(eq - o->params[i]));
+        cJSON *v = name ? param_value(name, eq + 1) : NULL;
+        if (!v || !cJSON_AddItemToObject(params, name, v)) {
+            cJSON_Delete(v);
+            free(name);
+            cJSON_Delete(req);
             return NULL;
         }
-        if (api_params_set(t, &p, name, v, n, err))
-            return NULL;
+        free(name);
     }
-    return api_template_expand(t, &p, err);
+    char *text = ok ? cJSON_PrintUnformatted(req) : NULL;
+    cJSON_Delete(req);
+    if (!text)
+        fprintf(stderr, "pdesolid: out of memory\n");
+    else
+        *len = strlen(text);
+    return text;
+}
+
+/* What the messages call the model: its file, or the preset or template. */
+static const char *model_name(const options *o)
+{
+    return o->preset ? o->preset : o->template ? o->template : o->args[0];
+}
+
+/* The model's JSON text (malloc'd): its file, or request_text(). NULL after a message, with the exit status. */
+static char *model_text(const options *o, size_t *len, int *status)
+{
+    *status = o->preset || o->template ? 2 : 1;
+    return o->preset || o->template ? request_text(o, len) : slurp(o->args[0], len);
 }
 
 /* Loads and solves the model; returns 0 or the exit status. id may be NULL. */
-static int load(const options *o, const char *path, pde_solution **sol, char *id)
+static int load(const options *o, pde_solution **sol, char *id)
 {
     api_error err;
-    api_model *m;
-    const char *what = path;
-    if (o->preset || o->template) {
-        what = o->preset ? o->preset : o->template;
-        m = preset_model(o, &err);
-    } else {
-        size_t len;
-        char *text = slurp(path, &len);
-        if (!text)
-            return 1;
-        m = api_model_parse(text, len, &err);
-        free(text);
-    }
+    size_t len;
+    int rc;
+    char *text = model_text(o, &len, &rc);
+    if (!text)
+        return rc;
+    api_model *m = api_model_parse(text, len, &err);
+    free(text);
     if (!m)
-        return report(what, &err);
+        return report(model_name(o), &err);
     int st = api_solve(m, sol, &err);
     if (!st && id)
         api_request_id(m, id, NULL);
@@ -202,28 +244,33 @@ static int load(const options *o, const char *path, pde_solution **sol, char *id
         fprintf(stderr, "pdesolid: out of memory\n");
         return 1;
     }
-    return st ? report(what, &err) : 0;
+    return st ? report(model_name(o), &err) : 0;
 }
 
-static int write_output(const options *o, const pde_solution *sol, const char *id)
+/* --format (json when not given), --res and --compress as the server reads them: 0, or 2 after a message. */
+static int output_options(const options *o, api_format *f, unsigned res[3], api_output_opts *opts)
 {
     api_error err;
-    api_format f;
-    unsigned res[3];
-    api_output_opts opts = { 0 };
-    if (api_format_parse(o->format, &f, &err) || api_res_parse(o->res, f, res, &err) ||
-        api_compress_parse(o->compress, f, &opts.compress, &err))
-        return report("option", &err);
-    if (!o->out && isatty(STDOUT_FILENO) && api_format_info_of(f)->binary) {
-        fprintf(stderr, "pdesolid: %s is binary; give -o FILE, or redirect standard output\n", o->format);
-        return 2;
-    }
+    if (api_format_parse(o->format ? o->format : "json", f, &err))
+        return report_option("format", &err);
+    if (api_res_parse(o->res, *f, res, &err))
+        return report_option("res", &err);
+    if (api_compress_parse(o->compress, *f, &opts->compress, &err))
+        return report_option("compress", &err);
+    return 0;
+}
+
+/* The solid in format f (output_options()'s) to -o's file or standard output. */
+static int write_output(const options *o, const pde_solution *sol, const char *id, api_format f, const unsigned res[3],
+                        const api_output_opts *opts)
+{
+    api_error err;
     FILE *out = o->out ? fopen(o->out, "wb") : stdout;
     if (!out) {
         fprintf(stderr, "pdesolid: %s: %s\n", o->out, strerror(errno));
         return 1;
     }
-    api_output *w = api_output_open_ex(sol, id, NULL, f, res, &opts, NULL, &err);
+    api_output *w = api_output_open_ex(sol, id, NULL, f, res, opts, NULL, &err);
     if (!w) {
         if (out != stdout)
             fclose(out);
@@ -243,68 +290,15 @@ static int write_output(const options *o, const pde_solution *sol, const char *i
     return 0;
 }
 
-/* The request for --server: the model file's text, or {"preset": NAME, "params": {...}}. NULL on error. */
-static char *request_text(const options *o, const char *path, size_t *len)
+static int remote_solve_to(const options *o)
 {
-    if (!o->preset && !o->template)
-        return slurp(path, len);
-    size_t cap = 256 + 96 * (size_t)o->nparams, n = 0;
-    char *b = malloc(cap);
-    if (!b)
-        return NULL;
-    n += (size_t)snprintf(b, cap, "{\"%s\":\"%.60s\",\"params\":{", o->preset ? "preset" : "template",
-                          o->preset ? o->preset : o->template);
-    for (int i = 0; i < o->nparams; i++) {
-        const char *eq = strchr(o->params[i], '=');
-        double v[3];
-        int k = 0;
-        char *end = NULL;
-        const char *s = eq ? eq + 1 : "";
-        do {
-            v[k++] = strtod(s, &end);
-            s = end + (*end == ',');
-        } while (end && *end == ',' && k < 3);
-        if (!eq || eq == o->params[i] || end == eq + 1 || *end || eq - o->params[i] > 40) {
-            fprintf(stderr, "pdesolid: --param %s: write NAME=VALUE, with a number or x,y,z\n", o->params[i]);
-            free(b);
-            return NULL;
-        }
-        n += (size_t)snprintf(b + n, cap - n, "%s\"%.*s\":", i ? "," : "", (int)(eq - o->params[i]), o->params[i]);
-        if (k == 3)
-            n += (size_t)snprintf(b + n, cap - n, "[%.17g,%.17g,%.17g]", v[0], v[1], v[2]);
-        else
-            n += (size_t)snprintf(b + n, cap - n, "%.17g", v[0]);
-    }
-    n += (size_t)snprintf(b + n, cap - n, "}}");
-    *len = n;
-    return b;
-}
-
-static int remote(const options *o, int eval)
-{
-    size_t len, plen = 0;
-    char *body = request_text(o, o->nargs && !o->preset && !o->template ? o->args[0] : NULL, &len);
-    if (!body)
-        return 2;
-    char *pts = eval ? slurp(o->args[o->nargs - 1], &plen) : NULL;
+    size_t len;
     int rc;
-    if (eval && !pts) {
-        rc = 1;
-    } else if (eval) {
-        rc = remote_eval(o->server, body, len, pts, plen, stdout);
-    } else {
-        FILE *out = o->out ? fopen(o->out, "wb") : stdout;
-        if (!out) {
-            fprintf(stderr, "pdesolid: %s: %s\n", o->out, strerror(errno));
-            rc = 1;
-        } else {
-            rc = remote_solve(o->server, body, len, o->format, o->res, o->compress, out);
-            if (out != stdout && fclose(out) != 0)
-                rc = 1;
-        }
-    }
+    char *body = model_text(o, &len, &rc);
+    if (!body)
+        return rc;
+    rc = remote_solve(o->server, body, len, o->format, o->res, o->compress, o->out);
     free(body);
-    free(pts);
     return rc;
 }
 
@@ -361,15 +355,24 @@ static int cmd_solve(const options *oo)
         fprintf(stderr, "pdesolid: --compress needs a format that takes it (--format glb, or -o FILE.glb)\n");
         return 2;
     }
+    api_format f;   /* checked here as the server checks them, with --server or without, --format or not */
+    unsigned res[3];
+    api_output_opts opts = { 0 };
+    if (output_options(o, &f, res, &opts))
+        return 2;
+    if (o->format && !o->out && isatty(STDOUT_FILENO) && api_format_info_of(f)->binary) {
+        fprintf(stderr, "pdesolid: %s is binary; give -o FILE, or redirect standard output\n", o->format);
+        return 2;
+    }
     if (o->server)
-        return remote(o, 0);
+        return remote_solve_to(o);
     pde_solution *sol;
     char id[API_ID_LEN + 1] = "";
-    int rc = load(o, o->nargs ? o->args[0] : NULL, &sol, id);
+    int rc = load(o, &sol, id);
     if (rc)
         return rc;
     if (o->format) {
-        rc = write_output(o, sol, id);
+        rc = write_output(o, sol, id, f, res, &opts);
         pde_solution_free(sol);
         return rc;
     }
@@ -386,10 +389,21 @@ static int cmd_solve(const options *oo)
     return 0;
 }
 
+/* The values at the points, in place, from a server (remote.h). */
+static int remote_values(const options *o, double *pts, size_t n, const char *points_path)
+{
+    size_t len;
+    int rc;
+    char *body = model_text(o, &len, &rc);
+    if (!body)
+        return rc;
+    rc = remote_eval(o->server, body, len, pts, n, points_path);
+    free(body);
+    return rc;
+}
+
 static int cmd_eval(const options *o)
 {
-    if (o->server)
-        return remote(o, 1);
     const char *points_path = o->args[o->nargs - 1];
     size_t len, n;
     char *text = slurp(points_path, &len);
@@ -401,14 +415,20 @@ static int cmd_eval(const options *o)
     free(text);
     if (rc)
         return report(points_path, &err);
-    pde_solution *sol;
-    if ((rc = load(o, o->nargs == 2 ? o->args[0] : NULL, &sol, NULL)) != 0) {
+    if (o->server) {
+        rc = remote_values(o, pts, n, points_path);
+    } else {
+        pde_solution *sol;
+        if ((rc = load(o, &sol, NULL)) == 0) {
+            for (size_t i = 0; i < n; i++)   /* in place: point i is read before its value is written */
+                pde_eval(sol, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], pts + 3 * i);
+            pde_solution_free(sol);
+        }
+    }
+    if (rc) {
         free(pts);
         return rc;
     }
-    for (size_t i = 0; i < n; i++)   /* in place: point i is read before its value is written */
-        pde_eval(sol, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], pts + 3 * i);
-    pde_solution_free(sol);
     if (api_eval_check(pts, NULL, NULL, NULL, n, &err)) {
         free(pts);
         /* The points file is the array itself: its pointer has no "/points" in front. */
@@ -423,23 +443,60 @@ static int cmd_eval(const options *o)
     return fflush(stdout) == 0 ? 0 : 1;
 }
 
-static int cmd_presets(void)
+static void preset_row(const char *name, const char *template, const char *caption)
 {
+    printf("%-6s %-9s %s\n", name, template, caption);
+}
+
+static int cmd_presets(const options *o)
+{
+    if (o->server)
+        return remote_presets(o->server, preset_row);
     for (size_t i = 0; i < api_preset_count(); i++) {
         const api_preset *p = api_preset_at(i);
-        printf("%-6s %-9s %s\n", p->name, p->template, p->caption);
+        preset_row(p->name, p->template, p->caption);
     }
     for (size_t i = 0; i < api_loft_preset_count(); i++) {
         const char *caption, *name = api_loft_preset_name(i, &caption);
-        printf("%-6s %-9s %s\n", name, "loft", caption);
+        preset_row(name, "loft", caption);
     }
-    return 0;
+    return fflush(stdout) == 0 ? 0 : 1;
 }
 
-/* The usage, then the formats as output.h's table has them. */
-static void print_usage(FILE *f)
+/* Each row's label in a column of width col - 2, its text after it (below it when the label is longer), the
+ * text's further lines indented to col. */
+static void print_row(FILE *f, int col, const char *label, const char *text)
 {
-    fputs(usage, f);
+    int used = fprintf(f, "  %s", label);
+    if (used >= col)
+        used = fprintf(f, "\n") - 1;
+    fprintf(f, "%*s", col - used, "");
+    for (const char *c = text; *c; c++)
+        if (*c == '\n')
+            fprintf(f, "\n%*s", col, "");
+        else
+            fputc(*c, f);
+    fputc('\n', f);
+}
+
+/* The options cmd takes (all when cmd is NULL). */
+static void print_options(FILE *f, const struct cmd_row *cmd)
+{
+    fputs("\noptions:\n", f);
+    for (size_t i = 0; i < NOPTS; i++)
+        if (!cmd || opt_rows[i].cmds & cmd->bit) {
+            char label[64];
+            snprintf(label, sizeof label, "%s %s", opt_rows[i].name, opt_rows[i].arg);
+            print_row(f, 23, label, opt_rows[i].help);
+        }
+    print_row(f, 23, "-h, --help", cmd ? "this text" : "this text; after a command, its usage and options");
+    if (!cmd)
+        print_row(f, 23, "--version", "the version");
+}
+
+/* The formats as output.h's table has them. */
+static void print_formats(FILE *f)
+{
     fputs("\nformats (--format NAME, or -o FILE ending with the extension):\n", f);
     for (int i = 0; i < API_FMT_COUNT; i++) {
         const api_format_info *fi = api_format_info_of((api_format)i);
@@ -449,64 +506,126 @@ static void print_usage(FILE *f)
     }
 }
 
+/* The whole usage (cmd NULL), or one command's: its usage, its options and what they refer to. */
+static void print_usage(FILE *f, const struct cmd_row *cmd)
+{
+    if (cmd) {
+        fprintf(f, "usage: pdesolid %s%s%s [OPTIONS]\n\n%s\n", cmd->name, cmd->synopsis[0] ? " " : "", cmd->synopsis,
+                cmd->help);
+    } else {
+        fprintf(f, "usage: pdesolid COMMAND [ARGS] [OPTIONS]\n       pdesolid COMMAND --help\n\n%s\ncommands:\n", about);
+        for (size_t i = 0; i < NCMDS; i++) {
+            char label[64];
+            snprintf(label, sizeof label, "%s %s", cmd_rows[i].name, cmd_rows[i].synopsis);
+            print_row(f, 28, label, cmd_rows[i].help);
+        }
+    }
+    if (!cmd || cmd->files[0])
+        fprintf(f, "\n%s", model_text_help);
+    print_options(f, cmd);
+    fprintf(f, "\n%s", exit_help);
+    if (!cmd || cmd->bit == CMD_SOLVE)
+        print_formats(f);
+}
+
+static const struct opt_row *opt_find(const char *name)
+{
+    for (size_t i = 0; i < NOPTS; i++)
+        if (!strcmp(opt_rows[i].name, name))
+            return &opt_rows[i];
+    return NULL;
+}
+
+static const struct cmd_row *cmd_find(const char *name)
+{
+    for (size_t i = 0; i < NCMDS; i++)
+        if (!strcmp(cmd_rows[i].name, name))
+            return &cmd_rows[i];
+    return NULL;
+}
+
+/* The files cmd takes, and whether o has the ones it needs: 0, or 2 after a one-line message naming what is
+ * missing or too many. */
+static int check_files(const struct cmd_row *cmd, const options *o)
+{
+    int files = cmd->files[0] ? cmd->files[1] ? 2 : 1 : 0;
+    int given = o->preset || o->template, want = files - (given && files);
+    const char *how = o->preset ? "--preset" : "--template";
+    if (o->nargs > want && given && o->nargs == files)
+        fprintf(stderr, "pdesolid: %s: %s and %s %s both give the model; give one\n", cmd->name, o->args[0], how,
+                model_name(o));
+    else if (o->nargs > want)
+        fprintf(stderr, "pdesolid: %s: an argument too many: \"%s\" (pdesolid %s%s%s [OPTIONS])\n", cmd->name,
+                o->args[want], cmd->name, cmd->synopsis[0] ? " " : "", cmd->synopsis);
+    else if (o->nargs < want)
+        fprintf(stderr, "pdesolid: %s: %s is missing%s (pdesolid %s %s [OPTIONS])\n", cmd->name,
+                cmd->files[o->nargs + given], o->nargs + given ? "" : "; or give --preset or --template", cmd->name,
+                cmd->synopsis);
+    else if (files == 2 && !given && !strcmp(o->args[0], "-") && !strcmp(o->args[1], "-"))
+        fprintf(stderr, "pdesolid: %s: %s and %s are both standard input (-); only one can be\n", cmd->name,
+                cmd->files[0], cmd->files[1]);
+    else
+        return 0;
+    return 2;
+}
+
 int main(int argc, char **argv)
 {
     options o = { 0 };
-    const char *cmd = NULL;
+    const struct cmd_row *cmd = NULL;
+    int help = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
-        const char **val = NULL;
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0 || strcmp(a, "help") == 0) {
-            print_usage(stdout);
-            return 0;
+        const struct opt_row *r;
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0 || (!cmd && strcmp(a, "help") == 0)) {
+            help = 1;
         } else if (strcmp(a, "--version") == 0) {
             printf("pdesolid %s\n", PDESOLID_VERSION);
             return 0;
-        } else if (strcmp(a, "--preset") == 0) {
-            val = &o.preset;
-        } else if (strcmp(a, "--template") == 0) {
-            val = &o.template;
-        } else if (strcmp(a, "--format") == 0) {
-            val = &o.format;
-        } else if (strcmp(a, "--res") == 0) {
-            val = &o.res;
-        } else if (strcmp(a, "--compress") == 0) {
-            val = &o.compress;
-        } else if (strcmp(a, "-o") == 0) {
-            val = &o.out;
-        } else if (strcmp(a, "--server") == 0) {
-            val = &o.server;
-        } else if (strcmp(a, "--param") == 0) {
-            if (i + 1 >= argc || o.nparams == 64) {
-                fprintf(stderr, "pdesolid: --param needs NAME=VALUE (at most 64)\n");
+        } else if (a[0] == '-' && a[1]) {
+            if (!(r = opt_find(a))) {
+                fprintf(stderr, "pdesolid: unknown option %s; `pdesolid --help` lists them\n", a);
                 return 2;
             }
-            o.params[o.nparams++] = argv[++i];
-            continue;
-        } else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "pdesolid: unknown option %s\n\n", a);
-            print_usage(stderr);
-            return 2;
+            if (i + 1 >= argc) {
+                fprintf(stderr, "pdesolid: %s needs a value (%s)\n", a, r->arg);
+                return 2;
+            }
+            const char *v = argv[++i], **slot = r->repeat ? &o.params[o.nparams] : opt_slot(&o, r);
+            if (r->repeat && o.nparams == (int)(sizeof o.params / sizeof *o.params)) {
+                fprintf(stderr, "pdesolid: --param: at most %d\n", o.nparams);
+                return 2;
+            }
+            if (*slot && !r->repeat) {
+                fprintf(stderr, "pdesolid: %s is given twice (%s, then %s); give it once\n", a, *slot, v);
+                return 2;
+            }
+            *slot = v;
+            o.nparams += r->repeat;
         } else if (!cmd) {
-            cmd = a;
-            continue;
-        } else if (o.nargs < 3) {
-            o.args[o.nargs++] = a;
-            continue;
+            if (!(cmd = cmd_find(a))) {
+                fprintf(stderr, "pdesolid: unknown command \"%s\"; the commands are", a);
+                for (size_t k = 0; k < NCMDS; k++)
+                    fprintf(stderr, "%s %s", k ? "," : "", cmd_rows[k].name);
+                fputc('\n', stderr);
+                return 2;
+            }
         } else {
-            fprintf(stderr, "pdesolid: too many arguments\n");
+            if (o.nargs < (int)(sizeof o.args / sizeof *o.args))
+                o.args[o.nargs] = a;
+            o.nargs++;
+        }
+    }
+    if (help || !cmd) {
+        print_usage(help ? stdout : stderr, cmd);
+        return help ? 0 : 2;
+    }
+    for (size_t i = 0; i < NOPTS; i++)
+        if (!(opt_rows[i].cmds & cmd->bit) && (opt_rows[i].repeat ? o.nparams > 0 : *opt_slot(&o, &opt_rows[i]) != NULL)) {
+            fprintf(stderr, "pdesolid: %s takes no %s (`pdesolid %s --help` lists its options)\n", cmd->name,
+                    opt_rows[i].name, cmd->name);
             return 2;
         }
-        if (i + 1 >= argc) {
-            fprintf(stderr, "pdesolid: %s needs a value\n", a);
-            return 2;
-        }
-        *val = argv[++i];
-    }
-    if (!cmd) {
-        print_usage(stderr);
-        return 2;
-    }
     if (o.nparams && !o.preset && !o.template) {
         fprintf(stderr, "pdesolid: --param goes with --preset or --template\n");
         return 2;
@@ -515,20 +634,18 @@ int main(int argc, char **argv)
         fprintf(stderr, "pdesolid: give --preset or --template, not both\n");
         return 2;
     }
-    int model_args = o.preset || o.template ? 0 : 1;
-    if (strcmp(cmd, "solve") == 0 && o.nargs == model_args)
-        return cmd_solve(&o);
-    int eval = strcmp(cmd, "eval") == 0 && o.nargs == model_args + 1;
-    int presets = strcmp(cmd, "presets") == 0 && o.nargs == 0;
-    if ((eval || presets) && o.out && !freopen(o.out, "wb", stdout)) {   /* -o is never ignored */
+    if (check_files(cmd, &o))
+        return 2;
+    if (o.out && !strcmp(o.out, "-"))
+        o.out = NULL;
+    if (o.server) {
+        if (remote_base(o.server, o.base, sizeof o.base))
+            return 2;
+        o.server = o.base;
+    }
+    if (cmd->bit != CMD_SOLVE && o.out && !freopen(o.out, "wb", stdout)) {   /* -o is never ignored */
         fprintf(stderr, "pdesolid: %s: %s\n", o.out, strerror(errno));
         return 1;
     }
-    if (eval)
-        return cmd_eval(&o);
-    if (presets)
-        return cmd_presets();
-    fprintf(stderr, "pdesolid: unknown command or wrong arguments: %s\n\n", cmd);
-    print_usage(stderr);
-    return 2;
+    return cmd->run(&o);
 }

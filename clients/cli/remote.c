@@ -1,8 +1,11 @@
 /*
  * remote.c: pdesolid --server (remote.h), with libcurl.
  */
+#include <errno.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include <cJSON.h>
 #include <curl/curl.h>
@@ -45,7 +48,8 @@ static size_t on_header(char *p, size_t size, size_t n, void *cls)
     return k;
 }
 
-/* POST body to url; 0 with the reply, or 1 after printing why the server could not be reached. */
+/* POST body to url (GET when body is NULL); 0 with the reply, or 1 after printing why the server could not be
+ * reached. */
 static int post(const char *url, const char *body, size_t len, reply *r)
 {
     memset(r, 0, sizeof *r);
@@ -57,9 +61,12 @@ static int post(const char *url, const char *body, size_t len, reply *r)
     struct curl_slist *h = curl_slist_append(NULL, "Content-Type: application/json");
     h = curl_slist_append(h, "Expect:");
     curl_easy_setopt(c, CURLOPT_URL, url);
-    curl_easy_setopt(c, CURLOPT_POST, 1L);
-    curl_easy_setopt(c, CURLOPT_POSTFIELDS, body);
-    curl_easy_setopt(c, CURLOPT_POSTFIELDSIZE_LARGE, (curl_off_t)len);
+    curl_easy_setopt(c, CURLOPT_PROTOCOLS_STR, "http,https");
+    if (body) {
+        curl_easy_setopt(c, CURLOPT_POST, 1L);
+        curl_easy_setopt(c, CURLOPT_POSTFIELDS, body);
+        curl_easy_setopt(c, CURLOPT_POSTFIELDSIZE_LARGE, (curl_off_t)len);
+    }
     curl_easy_setopt(c, CURLOPT_HTTPHEADER, h);
     curl_easy_setopt(c, CURLOPT_WRITEFUNCTION, on_data);
     curl_easy_setopt(c, CURLOPT_WRITEDATA, r);
@@ -109,7 +116,7 @@ static int print_solve(const char *json, FILE *out)
 }
 
 int remote_solve(const char *server, const char *body, size_t len, const char *format, const char *res,
-                 const char *compress, FILE *out)
+                 const char *compress, const char *path)
 {
     char url[2048];
     snprintf(url, sizeof url, "%s/solve?format=%s%s%s%s%s", server, format ? format : "json", res ? "&res=" : "",
@@ -117,69 +124,160 @@ int remote_solve(const char *server, const char *body, size_t len, const char *f
     reply r;
     if (post(url, body, len, &r))
         return 1;
-    int rc;
-    if (r.status != 200)
-        rc = problem(server, &r);
-    else if (!format)
+    int rc = r.status != 200 ? problem(server, &r) : 0;
+    FILE *out = rc || !path ? stdout : fopen(path, "wb");   /* no file for a refused request */
+    if (!rc && out && !format)
         rc = print_solve(r.data ? r.data : "", out);
-    else
-        rc = fwrite(r.data, 1, r.len, out) == r.len ? 0 : 1;
+    int bad = !out || (!rc && format && fwrite(r.data, 1, r.len, out) != r.len);
+    if (out && out != stdout)
+        bad |= fclose(out) != 0;
+    if (bad) {
+        fprintf(stderr, "pdesolid: %s: %s\n", path ? path : "standard output", strerror(errno));
+        rc = 1;
+    }
     free(r.data);
     return rc;
 }
 
-int remote_eval(const char *server, const char *body, size_t len, const char *points, size_t plen, FILE *out)
+int remote_base(const char *url, char *base, size_t n)
+{
+    size_t k = strlen(url);
+    const char *why = strncasecmp(url, "http://", 7) && strncasecmp(url, "https://", 8)
+                          ? "pdesolidd speaks http:// or https:// only"
+                      : strchr(url, '?') ? "a query (?...) has no place in it"
+                      : strchr(url, '#') ? "a fragment (#...) has no place in it"
+                      : k >= n           ? "too long"
+                                         : NULL;
+    if (!why) {   /* the rest as libcurl reads URLs: a host, a port that is a number, ... */
+        CURLU *u = curl_url();
+        CURLUcode rc = u ? curl_url_set(u, CURLUPART_URL, url, 0) : CURLUE_OUT_OF_MEMORY;
+        curl_url_cleanup(u);
+        if (rc != CURLUE_OK)
+            why = curl_url_strerror(rc);
+    }
+    if (why) {
+        fprintf(stderr, "pdesolid: --server %s: %s; give a pdesolidd's base URL, e.g. http://127.0.0.1:8080\n", url, why);
+        return 2;
+    }
+    while (k > 0 && url[k - 1] == '/')   /* joined with "/solve" and the like */
+        k--;
+    memcpy(base, url, k);
+    base[k] = '\0';
+    return 0;
+}
+
+/* A batch's point refused by the server (a problem whose pointer is /points/i...): named as offline, by its
+ * index in the points file, and 1; 0 for any other problem. */
+static int point_problem(const reply *r, size_t start, const char *points_name)
+{
+    cJSON *p = r->data ? cJSON_Parse(r->data) : NULL;
+    const cJSON *ptr = cJSON_GetObjectItemCaseSensitive(p, "pointer");
+    const cJSON *detail = cJSON_GetObjectItemCaseSensitive(p, "detail");
+    int named = 0;
+    if (cJSON_IsString(ptr) && cJSON_IsString(detail) && !strncmp(ptr->valuestring, "/points/", 8)) {
+        size_t k = strlen(ptr->valuestring);
+        char *end;
+        unsigned long i = strtoul(ptr->valuestring + 8, &end, 10);
+        if (end != ptr->valuestring + 8 && !strncmp(detail->valuestring, ptr->valuestring, k) &&
+            !strncmp(detail->valuestring + k, ": ", 2)) {
+            fprintf(stderr, "pdesolid: %s: /%zu%s: %s\n", points_name, start + i, end, detail->valuestring + k + 2);
+            named = 1;
+        }
+    }
+    cJSON_Delete(p);
+    return named;
+}
+
+/* The values of one batch's answer into pts (NAN for null); 0, or 1 after a message. */
+static int batch_values(const char *server, const reply *e, double *pts, size_t n)
+{
+    cJSON *d = cJSON_Parse(e->data ? e->data : "");
+    const cJSON *vals = cJSON_GetObjectItemCaseSensitive(d, "values");
+    int ok = cJSON_IsArray(vals) && (size_t)cJSON_GetArraySize(vals) == n;
+    size_t i = 0;
+    for (const cJSON *v = ok ? vals->child : NULL; v && ok; v = v->next, i++)
+        for (int c = 0; c < 3 && ok; c++) {
+            const cJSON *x = cJSON_GetArrayItem(v, c);
+            ok = cJSON_IsNumber(x) || cJSON_IsNull(x);   /* a server writes null for a value that is not finite */
+            pts[3 * i + c] = cJSON_IsNumber(x) ? x->valuedouble : NAN;
+        }
+    cJSON_Delete(d);
+    if (!ok)
+        fprintf(stderr, "pdesolid: %s: the server's answer does not have %zu values\n", server, n);
+    return !ok;
+}
+
+/* Points a batch starts with: 10,000 points of at most 77 bytes (%.17g) are under 1 MiB, the default
+ * --max-body, and under the default --max-points. */
+enum { BATCH_POINTS = 10000 };
+
+int remote_eval(const char *server, const char *body, size_t len, double *pts, size_t n, const char *points_name)
 {
     char url[2048];
     snprintf(url, sizeof url, "%s/solve?format=f32&res=2", server);
     reply r;
     if (post(url, body, len, &r))
         return 1;
-    if (r.status != 200) {
-        int rc = problem(server, &r);
-        free(r.data);
-        return rc;
-    }
+    int rc = r.status != 200 ? problem(server, &r) : 0;
     free(r.data);
-    char *req = malloc(plen + 32);
-    if (!req)
-        return 1;
-    int n = snprintf(req, plen + 32, "{\"points\":%.*s}", (int)plen, points);
-    snprintf(url, sizeof url, "%s/solids/%s/eval", server, r.id);
-    reply e;
-    int rc = post(url, req, (size_t)n, &e);
-    free(req);
     if (rc)
         return rc;
-    if (e.status != 200) {
-        rc = problem(server, &e);
-        free(e.data);
-        return rc;
+    snprintf(url, sizeof url, "%s/solids/%s/eval", server, r.id);
+    size_t batch = BATCH_POINTS;
+    char *req = malloc(32 + 80 * batch);
+    if (!req) {
+        fprintf(stderr, "pdesolid: out of memory\n");
+        return 1;
     }
-    cJSON *d = cJSON_Parse(e.data ? e.data : "");
-    const cJSON *vals = cJSON_GetObjectItemCaseSensitive(d, "values");
-    /* Every value a number, checked before anything is printed: a server writes null, never nan, for a
-     * value that is not finite, and that is an error here as it is offline. */
-    int i = 0;
-    for (const cJSON *v = vals ? vals->child : NULL; v && !rc; v = v->next, i++)
-        for (int c = 0; c < 3 && !rc; c++)
-            if (!cJSON_IsNumber(cJSON_GetArrayItem(v, c))) {
-                fprintf(stderr, "pdesolid: %s: /%d: x(u, v, w) is not a finite number at this point\n", server, i);
-                rc = 2;
-            }
-    if (!rc && !cJSON_IsArray(vals)) {
-        fprintf(stderr, "pdesolid: %s: the server's answer has no values\n", server);
+    for (size_t start = 0; start < n && !rc;) {
+        size_t m = n - start < batch ? n - start : batch, k = (size_t)sprintf(req, "{\"points\":[");
+        for (size_t i = start; i < start + m; i++)   /* 17 digits: the server reads the same doubles */
+            k += (size_t)sprintf(req + k, "%s[%.17g,%.17g,%.17g]", i > start ? "," : "", pts[3 * i], pts[3 * i + 1],
+                                 pts[3 * i + 2]);
+        k += (size_t)sprintf(req + k, "]}");
+        reply e;
+        if (post(url, req, k, &e)) {
+            rc = 1;
+            break;
+        }
+        if (e.status == 413 && batch > 1) {   /* a server with a smaller --max-body or --max-points */
+            batch /= 2;
+        } else if (e.status != 200) {
+            rc = point_problem(&e, start, points_name) ? 2 : problem(server, &e);
+        } else {
+            rc = batch_values(server, &e, pts + 3 * start, m);
+            start += m;
+        }
+        free(e.data);
+    }
+    free(req);
+    return rc;
+}
+
+int remote_presets(const char *server, void (*row)(const char *name, const char *template, const char *caption))
+{
+    char url[2048];
+    snprintf(url, sizeof url, "%s/presets", server);
+    reply r;
+    if (post(url, NULL, 0, &r))
+        return 1;
+    int rc = r.status != 200 ? problem(server, &r) : 0;
+    cJSON *d = rc ? NULL : cJSON_Parse(r.data ? r.data : "");
+    const cJSON *list = cJSON_GetObjectItemCaseSensitive(d, "presets"), *p;
+    if (!rc && !cJSON_IsArray(list)) {
+        fprintf(stderr, "pdesolid: %s: the server's answer has no presets\n", server);
         rc = 1;
     }
-    if (!rc) {
-        fputc('[', out);
-        i = 0;
-        for (const cJSON *v = vals->child; v; v = v->next, i++)
-            fprintf(out, "%s[%.17g,%.17g,%.17g]", i ? ",\n" : "", cJSON_GetArrayItem(v, 0)->valuedouble,
-                    cJSON_GetArrayItem(v, 1)->valuedouble, cJSON_GetArrayItem(v, 2)->valuedouble);
-        fputs("]\n", out);
+    const cJSON *items = rc ? NULL : list;
+    cJSON_ArrayForEach(p, items) {
+        const char *f[3] = { "name", "template", "caption" }, *v[3];
+        for (int i = 0; i < 3; i++) {
+            const cJSON *s = cJSON_GetObjectItemCaseSensitive(p, f[i]);
+            v[i] = cJSON_IsString(s) ? s->valuestring : "";
+        }
+        row(v[0], v[1], v[2]);
     }
     cJSON_Delete(d);
-    free(e.data);
+    free(r.data);
     return rc;
 }
