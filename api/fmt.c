@@ -191,26 +191,6 @@ void api_sampled_close(void *st)
 
 /* ---- meshes of the skin or the volume ---- */
 
-/* det J at 4 x 4 x 4 interior points, against the cube of its partials' size: a solid that is a surface, a
- * curve or a point (a loft of zero sections) has none, and no mesh of it is worth writing (its cells or
- * triangles would all be flat). Interior points at irrational places, so that no sample falls on a fold. */
-static int has_no_volume(const pde_solution *s)
-{
-    double jmax = 0, dmax = 0;
-    for (int i = 0; i < 64; i++) {
-        const double u = 0.1 + 0.8 * ((i & 3) + 0.5 * M_SQRT1_2) / 4, v = 0.1 + 0.8 * ((i >> 2 & 3) + 0.3 * M_SQRT2) / 4,
-                     w = 0.1 + 0.8 * ((i >> 4) + 0.1 * M_PI) / 4;
-        double d[3][3];
-        pde_eval_d(s, u, v, w, NULL, d[0], d[1], d[2]);
-        for (int a = 0; a < 3; a++)
-            dmax = fmax(dmax, fabs(d[a][0]) + fabs(d[a][1]) + fabs(d[a][2]));
-        const double j = d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1]) - d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0])
-                         + d[0][2] * (d[1][0] * d[2][1] - d[1][1] * d[2][0]);
-        jmax = fmax(jmax, fabs(j));
-    }
-    return jmax <= 1e-12 * dmax * dmax * dmax;
-}
-
 static int no_volume(api_error *err)
 {
     return api_fail(err, API_ERR_DOCUMENT, "", "the solid has no volume (det J is 0 throughout: it is a surface, a "
@@ -219,7 +199,7 @@ static int no_volume(api_error *err)
 
 int api_out_mesh(api_output *o, const pde_cancel *cancel, api_mesh *m, api_error *err)
 {
-    if (has_no_volume(o->sol))
+    if (pde_solution_is_flat(o->sol))
         return no_volume(err);
     if (api_mesh_build(o->sol, o->res, cancel, m, err))
         return -1;
@@ -247,7 +227,7 @@ void api_skin_close(void *st)
 
 int api_out_volmesh(api_output *o, const pde_cancel *cancel, api_volmesh *m, api_error *err)
 {
-    if (has_no_volume(o->sol))
+    if (pde_solution_is_flat(o->sol))
         return no_volume(err);
     if (api_volmesh_build(o->sol, o->res, cancel, m, err))
         return -1;

@@ -144,13 +144,6 @@ static int wedge_of(const uint32_t id[8], int sign, uint32_t out[6])
     return -1;
 }
 
-static double detj_at(const pde_solution *s, double u, double v, double w)
-{
-    double xu[3], xv[3], xw[3];
-    pde_eval_d(s, u, v, w, NULL, xu, xv, xw);
-    return det3(xu, xv, xw);
-}
-
 static int stopped(const pde_cancel *c)
 {
     return c && c->stop && c->stop(c->arg);
@@ -266,8 +259,8 @@ int api_volmesh_build(const pde_solution *s, const unsigned res[3], const pde_ca
                         m.nwedge++;
                     } else
                         continue;
-                    double dc = detj_at(s, (a[0] + 0.5) / (res[0] - 1), (a[1] + 0.5) / (res[1] - 1),
-                                        (a[2] + 0.5) / (res[2] - 1));
+                    double dc = pde_eval_detj(s, (a[0] + 0.5) / (res[0] - 1), (a[1] + 0.5) / (res[1] - 1),
+                                            (a[2] + 0.5) / (res[2] - 1));
                     int f = m.sign * dc <= 0;
                     for (int k = 0; k < 8; k++)
                         f |= m.sign * g.det[sx[k]] < -1e-9 * dmax;

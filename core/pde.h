@@ -248,6 +248,14 @@ void pde_eval(const pde_solution *sol, double u, double v, double w, double x[3]
 void pde_eval_d(const pde_solution *sol, double u, double v, double w,
                 double x[3], double xu[3], double xv[3], double xw[3]);
 
+/* det J = det(x_u, x_v, x_w) at (u, v, w). */
+double pde_eval_detj(const pde_solution *sol, double u, double v, double w);
+
+/* 1 if the solid has no volume: det J is 0 (against its columns' scale, 1e-12) at 64 interior points, so the
+ * solid is a surface, a curve or a point (a loft of zero sections), and a mesh of it would be all flat cells.
+ * A cheap test for outputs; pde_properties' certified det J range is the exact one. */
+int pde_solution_is_flat(const pde_solution *sol);
+
 /* d^(nu+nv+nw) x_comp / du^nu dv^nv dw^nw, for any orders (residuals, tests). */
 double pde_eval_partial(const pde_solution *sol, int comp, double u, double v, double w,
                         int nu, int nv, int nw);

@@ -226,6 +226,44 @@ static void eval_partial_should_agree_with_differences_and_first_derivatives(voi
     }
 }
 
+/* det J against the determinant of x's central differences (Richardson, as fd above) on figures that fold and
+ * that don't; and a solid whose z is cleared is flat, while every figure is not. */
+static void detj_should_be_the_determinant_of_differences_and_flat_solids_found(void **state)
+{
+    (void)state;
+    const char *figs[3] = { "fig4a", "fig3c", "fig1c" };
+    const double pts[3][3] = { { 0.4, 0.3, 0.55 }, { 0.91, 0.07, 0.33 }, { 0.15, 0.62, 0.8 } };
+    for (int f = 0; f < 3; f++) {
+        pde_solution *sol = solve_figure(figs[f]);
+        for (int k = 0; k < 3; k++) {
+            double d[3][3], scale = 1.0;
+            for (int axis = 0; axis < 3; axis++)
+                for (int c = 0; c < 3; c++) {
+                    d[axis][c] = fd(sol, c, pts[k], axis, 1, 1e-3);
+                    scale = fmax(scale, fabs(d[axis][c]));
+                }
+            const double j = d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1])
+                             - d[1][0] * (d[0][1] * d[2][2] - d[0][2] * d[2][1])
+                             + d[2][0] * (d[0][1] * d[1][2] - d[0][2] * d[1][1]);
+            assert_rel(pde_eval_detj(sol, pts[k][0], pts[k][1], pts[k][2]), j, 1e-6, scale * scale * scale);
+        }
+        assert_false(pde_solution_is_flat(sol));
+        pde_solution_free(sol);
+    }
+    for (size_t i = 0; i < paper_figure_count(); i++) {
+        pde_model m;
+        paper_figure_model(i, &m);
+        pde_solution *sol = NULL;
+        assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
+        assert_false(pde_solution_is_flat(sol));
+        pde_solution_free(sol);
+        m.comp[2].nbterms = m.comp[2].nfterms = 0;   /* z = 0: a surface */
+        assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
+        assert_true(pde_solution_is_flat(sol));
+        pde_solution_free(sol);
+    }
+}
+
 static void force_should_be_the_models_force(void **state)
 {
     (void)state;
@@ -370,6 +408,7 @@ int main(void)
         cmocka_unit_test(grid_should_give_faces_and_derivatives),
         cmocka_unit_test(narrow_grid_should_match_a_wide_grids_columns),
         cmocka_unit_test(eval_partial_should_agree_with_differences_and_first_derivatives),
+        cmocka_unit_test(detj_should_be_the_determinant_of_differences_and_flat_solids_found),
         cmocka_unit_test(force_should_be_the_models_force),
         cmocka_unit_test(factor_paths_should_match_a_general_complex_evaluation),
         cmocka_unit_test(sin_and_cos_bounds_should_hold_over_any_interval),
