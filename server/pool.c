@@ -23,12 +23,11 @@ struct srv_pool {
     pthread_t *threads;
 };
 
-/* A heavy part runs while fewer than threads - 1 do (one thread is kept for the rest), or when no other
- * job waits (no thread idles while work waits). */
+/* A heavy part runs while fewer than threads - 1 do (one thread is kept for the rest; with one thread, that
+ * is the thread), or when no other job waits (no thread idles while work waits). */
 static int heavy_next(const srv_pool *p)
 {
-    const size_t lanes = p->nthreads > 1 ? (size_t)p->nthreads - 1 : 1;
-    return p->hcount && (p->hrunning < lanes || p->count == 0);
+    return p->hcount && (p->hrunning + 1 < (size_t)p->nthreads || p->count == 0);
 }
 
 static void *worker(void *arg)

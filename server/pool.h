@@ -8,7 +8,8 @@
  * estimate, known only once it has parsed its request) defers it
  * (srv_pool_defer_heavy), and threads take deferred parts only while fewer
  * than threads - 1 run, or when nothing else waits. So a light request never
- * queues behind a row of heavy ones: with 2 threads, one serves the rest.
+ * queues behind a row of heavy ones: with 2 threads, one serves the rest; with
+ * one, a heavy part runs when no light job waits.
  */
 #ifndef SRV_POOL_H
 #define SRV_POOL_H

@@ -1,0 +1,161 @@
+/*
+ * test_pool.c: server/pool.c's order of jobs, driven directly: a gate job holds the threads while the test
+ * queues light jobs and heavy parts, then the order in which they ran is checked against the lanes that
+ * pool.h documents.
+ */
+#include <pthread.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "../server/pool.h"
+#include "support.h"
+
+typedef struct {
+    pthread_mutex_t lock;
+    pthread_cond_t open;
+    int gate_open, gates_in;
+    char order[32];
+    int n;
+} run_log;
+
+typedef struct {
+    run_log *log;
+    char name;
+} job_arg;
+
+static void gate(void *arg)
+{
+    run_log *l = ((job_arg *)arg)->log;
+    pthread_mutex_lock(&l->lock);
+    l->gates_in++;
+    pthread_cond_broadcast(&l->open);
+    while (!l->gate_open)
+        pthread_cond_wait(&l->open, &l->lock);
+    pthread_mutex_unlock(&l->lock);
+}
+
+static void record(void *arg)
+{
+    job_arg *a = arg;
+    pthread_mutex_lock(&a->log->lock);
+    a->log->order[a->log->n++] = a->name;
+    pthread_mutex_unlock(&a->log->lock);
+}
+
+/* threads gates hold every thread; then the test queues `queued` (L: a light job, H: a heavy part) in that
+ * order, opens the gates and returns the order in which the rest ran. */
+static void run_behind_gates(int threads, const char *queued, char *order)
+{
+    run_log l = { .n = 0 };
+    pthread_mutex_init(&l.lock, NULL);
+    pthread_cond_init(&l.open, NULL);
+    srv_pool *p = srv_pool_create(threads, 16, 0);
+    assert_non_null(p);
+    job_arg g = { &l, 'g' }, a[16];
+    for (int i = 0; i < threads; i++) {
+        assert_int_equal(srv_pool_reserve(p), 0);
+        srv_pool_submit(p, gate, &g);
+    }
+    pthread_mutex_lock(&l.lock);
+    while (l.gates_in < threads)
+        pthread_cond_wait(&l.open, &l.lock);
+    pthread_mutex_unlock(&l.lock);
+    size_t n = strlen(queued);
+    for (size_t i = 0; i < n; i++) {
+        a[i] = (job_arg){ &l, queued[i] };
+        if (queued[i] == 'H')
+            assert_int_equal(srv_pool_defer_heavy(p, record, &a[i], 8), 0);
+        else {
+            assert_int_equal(srv_pool_reserve(p), 0);
+            srv_pool_submit(p, record, &a[i]);
+        }
+    }
+    pthread_mutex_lock(&l.lock);
+    l.gate_open = 1;
+    pthread_cond_broadcast(&l.open);
+    pthread_mutex_unlock(&l.lock);
+    srv_pool_destroy(p);
+    assert_int_equal(l.n, (int)n);
+    memcpy(order, l.order, n);
+    order[n] = 0;
+    pthread_cond_destroy(&l.open);
+    pthread_mutex_destroy(&l.lock);
+}
+
+/* With one thread there is no lane to keep apart, but the one thread is the thread kept for the rest: a heavy
+ * part runs when no light job waits (it was the reverse: heavy parts deferred before light jobs ran first). */
+static void one_thread_should_run_light_jobs_before_heavy_parts(void **state)
+{
+    (void)state;
+    char order[32];
+    run_behind_gates(1, "HHLL", order);
+    assert_string_equal(order, "LLHH");
+    run_behind_gates(1, "LHLH", order);
+    assert_string_equal(order, "LLHH");
+}
+
+/* A heavy part that holds its thread until the test lets it go. */
+static void held(void *arg)
+{
+    job_arg *a = arg;
+    record(arg);
+    gate(&(job_arg){ a->log, 'g' });
+}
+
+/* Two threads: a heavy part takes one; the second heavy part waits while the other thread serves every light
+ * job, although the heavy parts were queued first, and runs once no light job waits. */
+static void two_threads_should_keep_a_thread_for_light_jobs(void **state)
+{
+    (void)state;
+    run_log l = { .n = 0 };
+    pthread_mutex_init(&l.lock, NULL);
+    pthread_cond_init(&l.open, NULL);
+    srv_pool *p = srv_pool_create(2, 16, 0);
+    assert_non_null(p);
+    job_arg h[2] = { { &l, 'H' }, { &l, 'H' } }, a[3] = { { &l, 'L' }, { &l, 'L' }, { &l, 'L' } };
+    for (int i = 0; i < 2; i++)
+        assert_int_equal(srv_pool_defer_heavy(p, held, &h[i], 8), 0);
+    for (int i = 0; i < 3; i++) {
+        assert_int_equal(srv_pool_reserve(p), 0);
+        srv_pool_submit(p, record, &a[i]);
+    }
+    double until = mono_now() + 30;
+    pthread_mutex_lock(&l.lock);
+    while (l.n < 5 && mono_now() < until) {
+        pthread_mutex_unlock(&l.lock);
+        usleep(1000);
+        pthread_mutex_lock(&l.lock);
+    }
+    l.order[l.n] = 0;
+    char order[32];
+    memcpy(order, l.order, sizeof order);
+    l.gate_open = 1;
+    pthread_cond_broadcast(&l.open);
+    pthread_mutex_unlock(&l.lock);
+    srv_pool_destroy(p);
+    /* the first H and the L's in either order (two threads record them), then the second H */
+    assert_int_equal(strlen(order), 5);
+    assert_int_equal(order[4], 'H');
+    int heavy_first = 0;
+    for (int i = 0; i < 4; i++)
+        heavy_first += order[i] == 'H';
+    assert_int_equal(heavy_first, 1);
+    pthread_cond_destroy(&l.open);
+    pthread_mutex_destroy(&l.lock);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(one_thread_should_run_light_jobs_before_heavy_parts),
+        cmocka_unit_test(two_threads_should_keep_a_thread_for_light_jobs),
+    };
+    test_filter_from_env();
+    return cmocka_run_group_tests_name("pool", tests, NULL, NULL);
+}
