@@ -666,10 +666,12 @@ static int await_idle(srv_server *s, double seconds)
 
 void srv_stop(srv_server *s)
 {
+    /* From now on every new request, on a connection open or new, answers 503 "shutting down" with
+     * Retry-After (handler()), which a balancer retries on another replica. The listening socket stays
+     * open until MHD_stop_daemon: libmicrohttpd 0.9.75-0.9.77's MHD_quiesce_daemon removes it from each
+     * polling thread's epoll set while that thread may be removing it too, and aborts the process when
+     * it loses that race (epoll_ctl's ENOENT). */
     atomic_store(&s->stopping, 1);
-    int fd = MHD_quiesce_daemon(s->d);   /* no new connections */
-    if (fd >= 0)
-        close(fd);
     /* Requests in flight may finish within the grace period. */
     if (!await_idle(s, s->cfg.grace)) {
         /* Then the rest ends: running jobs stop at their next poll, queued ones answer 503, streams end.

@@ -1,7 +1,7 @@
 /*
  * pdesolidd: the pdesolid solve server. Parses flags, starts the daemon,
- * and waits for SIGTERM or SIGINT, on which it stops accepting, finishes the
- * requests in flight and exits 0.
+ * and waits for SIGTERM or SIGINT, on which it answers new requests 503,
+ * finishes the requests in flight and exits 0.
  */
 #include <signal.h>
 #include <stdio.h>

@@ -813,7 +813,7 @@ static void two_content_lengths_and_stalled_clients_should_be_refused(void **sta
 
 /* ---- shutdown ---- */
 
-static void sigterm_should_let_a_request_in_flight_complete(void **state)
+static void sigterm_should_let_a_request_in_flight_complete_and_answer_new_ones_503(void **state)
 {
     (void)state;
     daemon_t d;
@@ -825,6 +825,23 @@ static void sigterm_should_let_a_request_in_flight_complete(void **state)
     for (int i = 0; i < 400 && metric(&d, "pdesolid_queue_depth") < 1; i++)
         usleep(5000);
     kill(d.pid, SIGTERM);
+    /* While the job finishes, a new connection is answered, not refused: 503 with Retry-After, which a
+     * balancer retries on another replica (libmicrohttpd's quiesce, which refused it, races its own polling
+     * threads and can abort the daemon). */
+    for (int i = 0; i < 400; i++) {
+        char *text = read_file(d.log, NULL);
+        int seen = text && strstr(text, "SIGTERM: finishing the requests in flight");
+        free(text);
+        if (seen)
+            break;
+        usleep(5000);
+    }
+    reply late = http(&d, "GET", "/livez", NULL, 0, NULL);
+    expect_problem(&late, 503, NULL, "shutting down");
+    char retry[16] = "";
+    assert_true(header_value(&late, "Retry-After", retry, sizeof retry));
+    assert_string_equal(retry, "1");
+    free(late.body);
     pthread_join(t, NULL);
     assert_int_equal(a.status, 200);
     int st;
@@ -1182,7 +1199,7 @@ int main(void)
         cmocka_unit_test(bad_requests_should_get_problems_and_the_daemon_should_keep_serving),
         cmocka_unit_test(a_loft_should_solve_and_a_bad_one_get_its_pointer),
         cmocka_unit_test(two_content_lengths_and_stalled_clients_should_be_refused),
-        cmocka_unit_test(sigterm_should_let_a_request_in_flight_complete),
+        cmocka_unit_test(sigterm_should_let_a_request_in_flight_complete_and_answer_new_ones_503),
         cmocka_unit_test(presets_version_health_metrics_and_cors_should_answer),
         cmocka_unit_test(formats_should_list_the_table_and_each_row_should_hold),
         cmocka_unit_test(compress_should_be_checked_like_every_query_parameter),
