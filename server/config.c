@@ -63,10 +63,11 @@ static const flag flags[] = {
     { "--max-mem-mb", "N", K_MB, AT(max_mem), 1, 1 << 20, "64", NULL,
       "scratch memory one request may use beyond\nthe caches, MiB" },
     { "--heavy-work", "N", K_REAL, AT(heavy_work), 0, 1e18, "5e7", NULL,
-      "a request estimated at N units or more waits\n"
-      "apart from the rest, and runs on at most all\n"
-      "threads but one while others wait: light\n"
-      "requests never queue behind heavy ones" },
+      "a request estimated at N units or more runs its\n"
+      "properties and output apart, on at most all\n"
+      "threads but one: light requests never wait for\n"
+      "heavy work (with one thread, a heavy request\n"
+      "waits for at most 8 light ones)" },
     { "--heavy-queue", "N", K_COUNT, AT(heavy_queue), 1, 1 << 20, "8", NULL,
       "heavy requests that may wait before 503" },
     { "--job-timeout", "S", K_REAL, AT(job_timeout), 0, 86400, "2", NULL,

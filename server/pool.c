@@ -19,15 +19,25 @@ struct srv_pool {
     size_t cap, limit, head, count, reserved, running;   /* limit: places for reserve; cap adds extra */
     job *heavy;                                          /* deferred heavy parts, a ring of cap places */
     size_t hhead, hcount, hrunning;
+    size_t lanes;        /* threads that may run heavy parts at once: all but one */
+    size_t passed;       /* with one thread: light jobs taken while a heavy part waited */
     int stopping, nthreads, alive;   /* alive: workers not yet past their last job */
     pthread_t *threads;
 };
 
-/* A heavy part runs while fewer than threads - 1 do (one thread is kept for the rest; with one thread, that
- * is the thread), or when no other job waits (no thread idles while work waits). */
+/* With one thread, a heavy part goes first once this many light jobs went before it. */
+#define HEAVY_PASSED 8
+
+/* A heavy part runs while fewer than threads - 1 do: one thread is kept for the rest, even while it idles, so
+ * that a light job never waits for heavy work. With one thread, a heavy part runs when no light job waits, or
+ * once HEAVY_PASSED have gone before it. */
 static int heavy_next(const srv_pool *p)
 {
-    return p->hcount && (p->hrunning + 1 < (size_t)p->nthreads || p->count == 0);
+    if (!p->hcount)
+        return 0;
+    if (p->lanes)
+        return p->hrunning < p->lanes;
+    return p->count == 0 || p->passed >= HEAVY_PASSED;
 }
 
 static void *worker(void *arg)
@@ -35,10 +45,12 @@ static void *worker(void *arg)
     srv_pool *p = arg;
     pthread_mutex_lock(&p->lock);
     for (;;) {
-        while (p->count == 0 && p->hcount == 0 && (!p->stopping || p->reserved))
+        /* A heavy part waiting for a lane is not work for this thread; the lane's thread signals when it is free. */
+        while (p->count == 0 && !heavy_next(p) && (!p->stopping || p->reserved || p->hcount))
             pthread_cond_wait(&p->work, &p->lock);
-        if (p->count == 0 && p->hcount == 0) {
+        if (p->count == 0 && !heavy_next(p)) {
             p->alive--;   /* stopping and drained: a push from now on is refused, not lost */
+            pthread_cond_broadcast(&p->work);   /* a thread that waited for a heavy part's lane sees it drained */
             break;
         }
         const int heavy = heavy_next(p);
@@ -48,7 +60,9 @@ static void *worker(void *arg)
             p->hhead = (p->hhead + 1) % p->cap;
             p->hcount--;
             p->hrunning++;
+            p->passed = 0;
         } else {
+            p->passed += p->hcount > 0;
             j = p->ring[p->head];
             p->head = (p->head + 1) % p->cap;
             p->count--;
@@ -59,6 +73,8 @@ static void *worker(void *arg)
         pthread_mutex_lock(&p->lock);
         p->running--;
         p->hrunning -= heavy;
+        if (heavy && p->hcount)
+            pthread_cond_signal(&p->work);   /* a lane is free for a waiting heavy part */
     }
     pthread_mutex_unlock(&p->lock);
     return NULL;
@@ -82,6 +98,7 @@ srv_pool *srv_pool_create(int threads, size_t queue, size_t extra)
         return NULL;
     }
     p->alive = threads;
+    p->lanes = threads > 1 ? (size_t)threads - 1 : 0;
     for (p->nthreads = 0; p->nthreads < threads; p->nthreads++)
         if (pthread_create(&p->threads[p->nthreads], NULL, worker, p)) {
             p->alive = p->nthreads;

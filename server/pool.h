@@ -6,10 +6,11 @@
  *
  * Heavy parts wait apart: a job that finds its remaining work heavy (its
  * estimate, known only once it has parsed its request) defers it
- * (srv_pool_defer_heavy), and threads take deferred parts only while fewer
- * than threads - 1 run, or when nothing else waits. So a light request never
- * queues behind a row of heavy ones: with 2 threads, one serves the rest; with
- * one, a heavy part runs when no light job waits.
+ * (srv_pool_defer_heavy), and at most threads - 1 threads run deferred parts
+ * at once: the last is kept for the rest, even while it idles, so a light
+ * request never waits for heavy work (with 2 threads, heavy parts run one at
+ * a time). With one thread, a heavy part runs when no light job waits, or
+ * once 8 light jobs have gone before it.
  */
 #ifndef SRV_POOL_H
 #define SRV_POOL_H

@@ -108,8 +108,24 @@ static void held(void *arg)
     gate(&(job_arg){ a->log, 'g' });
 }
 
-/* Two threads: a heavy part takes one; the second heavy part waits while the other thread serves every light
- * job, although the heavy parts were queued first, and runs once no light job waits. */
+/* Polls until n jobs have recorded (at most 30 s); their order. */
+static void await_records(run_log *l, int n, char *order)
+{
+    double until = mono_now() + 30;
+    pthread_mutex_lock(&l->lock);
+    while (l->n < n && mono_now() < until) {
+        pthread_mutex_unlock(&l->lock);
+        usleep(1000);
+        pthread_mutex_lock(&l->lock);
+    }
+    memcpy(order, l->order, (size_t)l->n);
+    order[l->n] = 0;
+    pthread_mutex_unlock(&l->lock);
+}
+
+/* Two threads: a heavy part takes one; the other serves every light job, although the heavy parts were queued
+ * first, and stays kept for them while it idles: the second heavy part waits for the first (it took the idle
+ * thread before, and a light job that came next waited a whole heavy part). */
 static void two_threads_should_keep_a_thread_for_light_jobs(void **state)
 {
     (void)state;
@@ -125,29 +141,30 @@ static void two_threads_should_keep_a_thread_for_light_jobs(void **state)
         assert_int_equal(srv_pool_reserve(p), 0);
         srv_pool_submit(p, record, &a[i]);
     }
-    double until = mono_now() + 30;
-    pthread_mutex_lock(&l.lock);
-    while (l.n < 5 && mono_now() < until) {
-        pthread_mutex_unlock(&l.lock);
-        usleep(1000);
-        pthread_mutex_lock(&l.lock);
-    }
-    l.order[l.n] = 0;
     char order[32];
-    memcpy(order, l.order, sizeof order);
+    await_records(&l, 4, order);
+    usleep(100000);   /* time for the idle thread to take the second heavy part, if it would */
+    await_records(&l, 4, order);
+    pthread_mutex_lock(&l.lock);
     l.gate_open = 1;
     pthread_cond_broadcast(&l.open);
     pthread_mutex_unlock(&l.lock);
     srv_pool_destroy(p);
-    /* the first H and the L's in either order (two threads record them), then the second H */
-    assert_int_equal(strlen(order), 5);
-    assert_int_equal(order[4], 'H');
-    int heavy_first = 0;
-    for (int i = 0; i < 4; i++)
-        heavy_first += order[i] == 'H';
-    assert_int_equal(heavy_first, 1);
+    /* the first H and the L's in either order (two threads record them), and no second H while H holds */
+    assert_int_equal(strlen(order), 4);
+    assert_int_equal(strchr(order, 'H') - order <= 1 && !strchr(strchr(order, 'H') + 1, 'H'), 1);
+    assert_int_equal(l.n, 5);
     pthread_cond_destroy(&l.open);
     pthread_mutex_destroy(&l.lock);
+}
+
+/* One thread: light jobs keep coming, yet a heavy part goes once 8 have gone before it. */
+static void one_thread_should_not_starve_a_heavy_part(void **state)
+{
+    (void)state;
+    char order[32];
+    run_behind_gates(1, "HLLLLLLLLLL", order);
+    assert_string_equal(order, "LLLLLLLLHLL");
 }
 
 int main(void)
@@ -155,6 +172,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(one_thread_should_run_light_jobs_before_heavy_parts),
         cmocka_unit_test(two_threads_should_keep_a_thread_for_light_jobs),
+        cmocka_unit_test(one_thread_should_not_starve_a_heavy_part),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("pool", tests, NULL, NULL);
