@@ -241,15 +241,13 @@ static int admit(srv_req *r, const char *method)
         srv_problem(r, 400, NULL, "%s holds a NUL (%%00), which no part of a request may", where);
         return 0;
     }
-    if (stopping) {
+    if (stopping) {   /* at once, body or not: waiting for a body would hold the exit back */
         r->decided = r->close = 1;
-        r->retry_after = 1;
         srv_problem(r, 503, NULL, "the server is shutting down");
-        return 0;
+        return 1;
     }
     if (cs && cs->over) {
         r->decided = r->close = 1;
-        r->retry_after = 1;
         srv_problem(r, 503, NULL, "the server has its limit of %u connections open (--max-conns); try again",
                     s->cfg.max_conns);
         return 0;
@@ -361,7 +359,6 @@ static enum MHD_Result dispatch_job(srv_req *r)
         }
     }
     if (srv_pool_reserve(s->pool)) {
-        r->retry_after = 1;
         if (atomic_load(&s->stopping))
             srv_problem(r, 503, NULL, "the server is shutting down");
         else
@@ -622,8 +619,12 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
     /* libmicrohttpd splits its limit evenly between the polling threads, which may accept unevenly: so that no
      * thread reaches its share (and stops accepting), each may hold all; accept_policy keeps the real limit. */
     unsigned workers = (unsigned)(c->http_threads > 1 ? c->http_threads : 1);
+    /* One polling thread is no pool: libmicrohttpd warns at a pool size of 0 or 1, so the option is left out. */
+    struct MHD_OptionItem pool[] = { { MHD_OPTION_THREAD_POOL_SIZE, workers, NULL }, { MHD_OPTION_END, 0, NULL } };
+    if (workers == 1)
+        pool[0] = pool[1];
     s->d = MHD_start_daemon(flags, (uint16_t)c->port, accept_policy, s, handler, s, MHD_OPTION_SOCK_ADDR, ai->ai_addr,
-                            MHD_OPTION_THREAD_POOL_SIZE, (unsigned)(c->http_threads > 1 ? c->http_threads : 0),
+                            MHD_OPTION_ARRAY, pool,
                             MHD_OPTION_CONNECTION_TIMEOUT, c->timeout, MHD_OPTION_PER_IP_CONNECTION_LIMIT, c->per_ip,
                             MHD_OPTION_CONNECTION_LIMIT, (c->max_conns + SPARE_CONNS + 1) * workers,
                             MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)CONN_MEMORY, MHD_OPTION_URI_LOG_CALLBACK,

@@ -60,6 +60,7 @@ void srv_problem(srv_req *r, int status, const char *pointer, const char *fmt, .
     cJSON_Delete(o);
     r->text_len = r->text ? strlen(r->text) : 0;
     r->status = status;
+    r->retry_after = status == 503;   /* every 503 is for now: docs/API.md promises Retry-After: 1 */
     r->ctype = "application/problem+json";
     r->etag[0] = '\0';   /* a problem is not the representation the ETag would name */
 }

@@ -43,10 +43,8 @@ static void get_livez(srv_req *r)
 static void get_readyz(srv_req *r)
 {
     srv_server *s = r->s;
-    if (atomic_load(&s->stopping)) {
-        r->retry_after = 1;
-        srv_problem(r, 503, NULL, "shutting down");
-    } else if (s->store && !srv_store_ready(s->store)) {
+    /* While the server stops, admit() answers every request, this one too. */
+    if (s->store && !srv_store_ready(s->store)) {
         /* Still ready: ids in memory and new solves are served; only ids known elsewhere answer 503. */
         char *text = malloc(1200);
         if (text)
@@ -117,7 +115,6 @@ int srv_job_stop(void *arg)
 /* The problem of a job that stopped: the deadline, or shutdown. */
 static void stopped(srv_req *r)
 {
-    r->retry_after = 1;
     if (atomic_load(&r->s->aborting))
         srv_problem(r, 503, NULL, "the server is shutting down");
     else
@@ -330,7 +327,6 @@ static void post_solve(srv_req *r)
 /* The problem of a store that cannot answer now (--store). */
 static void store_down(srv_req *r)
 {
-    r->retry_after = 1;
     srv_problem(r, 503, NULL, "the store %s cannot be reached now, and the solid %s is not in this server's memory; "
                 "try again later", srv_store_name(r->s->store), r->arg);
 }
@@ -531,7 +527,6 @@ static void job_end(srv_req *r)
             return;
         srv_cache_release(s->cache, r->heavy);
         r->heavy = NULL;
-        r->retry_after = 1;
         srv_problem(r, 503, NULL,
                     "the server is busy: %zu requests estimated at over %.3g units of work (--heavy-work) wait "
                     "already (--heavy-queue); try again shortly, or ask for a lower res",

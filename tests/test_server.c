@@ -842,6 +842,13 @@ static void sigterm_should_let_a_request_in_flight_complete_and_answer_new_ones_
     assert_true(header_value(&late, "Retry-After", retry, sizeof retry));
     assert_string_equal(retry, "1");
     free(late.body);
+    /* A new request whose body is slow to come gets its 503 at once, not after the body (up to 5 s of draining
+     * that held the exit back). */
+    static const char slow[] = "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: 5\r\n\r\n";
+    raw_reply rr = raw_request(d.port, slow, sizeof slow - 1, 2000);
+    assert_int_equal(rr.status, 503);
+    assert_false(rr.timed_out);
+    raw_reply_free(&rr);
     pthread_join(t, NULL);
     assert_int_equal(a.status, 200);
     int st;
@@ -851,6 +858,24 @@ static void sigterm_should_let_a_request_in_flight_complete_and_answer_new_ones_
     char *log = read_file(d.log, NULL);
     assert_non_null(strstr(log, "SIGTERM: finishing the requests in flight"));
     assert_non_null(strstr(log, "\"POST /solve?format=glb&res=400\" 200"));   /* the access log */
+    free(log);
+}
+
+/* One polling thread starts without libmicrohttpd's "Warning: ... thread pool size, is ignored" (a pool size of
+ * 0 was passed for it). */
+static void one_polling_thread_should_start_without_warnings(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--http-threads 1");
+    reply r = http(&d, "GET", "/livez", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    free(r.body);
+    stop(&d);
+    char *log = read_file(d.log, NULL);
+    assert_non_null(log);
+    if (strstr(log, "Warning"))
+        fail_msg("the log warns:\n%s", log);
     free(log);
 }
 
@@ -1200,6 +1225,7 @@ int main(void)
         cmocka_unit_test(a_loft_should_solve_and_a_bad_one_get_its_pointer),
         cmocka_unit_test(two_content_lengths_and_stalled_clients_should_be_refused),
         cmocka_unit_test(sigterm_should_let_a_request_in_flight_complete_and_answer_new_ones_503),
+        cmocka_unit_test(one_polling_thread_should_start_without_warnings),
         cmocka_unit_test(presets_version_health_metrics_and_cors_should_answer),
         cmocka_unit_test(formats_should_list_the_table_and_each_row_should_hold),
         cmocka_unit_test(compress_should_be_checked_like_every_query_parameter),
