@@ -47,29 +47,37 @@ void pde_eval(const pde_solution *sol, double u, double v, double w, double x[3]
     pde_eval_d(sol, u, v, w, x, NULL, NULL, NULL);
 }
 
-double pde_eval_detj(const pde_solution *sol, double u, double v, double w)
+/* det(x_u, x_v, x_w) from d[axis][component] */
+static double det_of(const double d[3][3])
 {
-    double d[3][3];
-    pde_eval_d(sol, u, v, w, NULL, d[0], d[1], d[2]);
     return d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1]) - d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0])
            + d[0][2] * (d[1][0] * d[2][1] - d[1][1] * d[2][0]);
 }
 
-/* 4 x 4 x 4 interior points at irrational places, so that no sample falls on a fold; det J against the
- * cube of its columns' size there. */
+double pde_eval_detj(const pde_solution *sol, double u, double v, double w)
+{
+    double d[3][3];
+    pde_eval_d(sol, u, v, w, NULL, d[0], d[1], d[2]);
+    return det_of(d);
+}
+
+/* 4 x 4 x 4 interior points at irrational places, so that no sample falls on a fold. At each, det J against
+ * Hadamard's bound, the product of the three components' gradient lengths: a scale of its own per coordinate
+ * (a solid 1e7 wide and 1 high is not flat), and no cube of a large number to overflow. */
 int pde_solution_is_flat(const pde_solution *sol)
 {
-    double jmax = 0, dmax = 0;
     for (int i = 0; i < 64; i++) {
         const double u = 0.1 + 0.8 * ((i & 3) + 0.5 * M_SQRT1_2) / 4, v = 0.1 + 0.8 * ((i >> 2 & 3) + 0.3 * M_SQRT2) / 4,
                      w = 0.1 + 0.8 * ((i >> 4) + 0.1 * M_PI) / 4;
         double d[3][3];
         pde_eval_d(sol, u, v, w, NULL, d[0], d[1], d[2]);
-        for (int a = 0; a < 3; a++)
-            dmax = fmax(dmax, fabs(d[a][0]) + fabs(d[a][1]) + fabs(d[a][2]));
-        jmax = fmax(jmax, fabs(pde_eval_detj(sol, u, v, w)));
+        double bound = 1e-12;
+        for (int c = 0; c < 3; c++)
+            bound *= hypot(hypot(d[0][c], d[1][c]), d[2][c]);
+        if (fabs(det_of(d)) > bound)
+            return 0;
     }
-    return jmax <= 1e-12 * dmax * dmax * dmax;
+    return 1;
 }
 
 double pde_eval_partial(const pde_solution *sol, int comp, double u, double v, double w,

@@ -251,7 +251,7 @@ void pde_eval_d(const pde_solution *sol, double u, double v, double w,
 /* det J = det(x_u, x_v, x_w) at (u, v, w). */
 double pde_eval_detj(const pde_solution *sol, double u, double v, double w);
 
-/* 1 if the solid has no volume: det J is 0 (against its columns' scale, 1e-12) at 64 interior points, so the
+/* 1 if the solid has no volume: det J is 0 (against Hadamard's bound, 1e-12) at 64 interior points, so the
  * solid is a surface, a curve or a point (a loft of zero sections), and a mesh of it would be all flat cells.
  * A cheap test for outputs; pde_properties' certified det J range is the exact one. */
 int pde_solution_is_flat(const pde_solution *sol);

@@ -257,6 +257,31 @@ static void detj_should_be_the_determinant_of_differences_and_flat_solids_found(
         assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
         assert_false(pde_solution_is_flat(sol));
         pde_solution_free(sol);
+        /* One coordinate 1e7 times and one 1e-7 times the rest, or 1e150 times: still a solid (the old test took
+         * the cube of the largest partial as det J's scale, and refused a solid 1e7 wide as flat). */
+        const double scales[3][3] = { { 1e7, 1, 1e-7 }, { 1, 1e150, 1 }, { 1e-150, 1, 1 } };
+        for (int k = 0; k < 3; k++) {
+            pde_bterm b[3][64];
+            pde_fterm f[3][64];
+            pde_model ms = m;
+            for (int c = 0; c < 3; c++) {
+                assert_true(m.comp[c].nbterms <= 64 && m.comp[c].nfterms <= 64);
+                for (size_t t = 0; t < m.comp[c].nbterms; t++) {
+                    b[c][t] = m.comp[c].bterms[t];
+                    b[c][t].w0 *= scales[k][c], b[c][t].dw0 *= scales[k][c];
+                    b[c][t].w1 *= scales[k][c], b[c][t].dw1 *= scales[k][c];
+                }
+                for (size_t t = 0; t < m.comp[c].nfterms; t++) {
+                    f[c][t] = m.comp[c].fterms[t];
+                    f[c][t].coef *= scales[k][c];
+                }
+                ms.comp[c].bterms = b[c];
+                ms.comp[c].fterms = f[c];
+            }
+            assert_int_equal(pde_solve(&ms, &sol, NULL), PDE_OK);
+            assert_false(pde_solution_is_flat(sol));
+            pde_solution_free(sol);
+        }
         m.comp[2].nbterms = m.comp[2].nfterms = 0;   /* z = 0: a surface */
         assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
         assert_true(pde_solution_is_flat(sol));
