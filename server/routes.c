@@ -272,6 +272,33 @@ static void keep(srv_req *r, const char *id, const api_model *m)
     free(request);
 }
 
+/* Model m's entry (id), solved through the cache (concurrent requests solve once) if its estimate is within
+ * budget; a new one is kept in the store when keep_new. Frees m. NULL with the problem set. */
+static srv_entry *solve_cached(srv_req *r, api_model *m, const char *id, int keep_new)
+{
+    api_cost part;
+    api_cost_model(m, &part);
+    if (over_budget(r, &part)) {
+        api_model_free(m);
+        return NULL;
+    }
+    api_error err;
+    solve_arg sa = { m, &r->cancel };
+    int hit;
+    double t0 = srv_now();
+    srv_entry *e = srv_cache_get(r->s->cache, id, solve_model, &sa, &hit, &err);
+    r->tm.solve = srv_now() - t0;
+    r->tm.cached = hit;
+    if (!hit)
+        srv_metrics_solve(r->s->metrics, r->tm.solve);
+    if (e && !hit && keep_new)
+        keep(r, id, m);
+    api_model_free(m);
+    if (!e)
+        failed(r, &err);
+    return e;
+}
+
 static void post_solve(srv_req *r)
 {
     srv_server *s = r->s;
@@ -301,27 +328,9 @@ static void post_solve(srv_req *r)
         srv_problem_api(r, &err);
         return;
     }
-    api_cost_model(m, &part);
-    if (over_budget(r, &part)) {
-        api_model_free(m);
-        return;
-    }
-    solve_arg sa = { m, &r->cancel };
-    int hit;
-    t0 = srv_now();
-    srv_entry *e = srv_cache_get(s->cache, id, solve_model, &sa, &hit, &err);
-    r->tm.solve = srv_now() - t0;
-    r->tm.cached = hit;
-    if (!hit)
-        srv_metrics_solve(s->metrics, r->tm.solve);
-    if (e && !hit)
-        keep(r, id, m);
-    api_model_free(m);
-    if (!e) {
-        failed(r, &err);
-        return;
-    }
-    answer_entry(r, e);
+    srv_entry *e = solve_cached(r, m, id, 1);
+    if (e)
+        answer_entry(r, e);
 }
 
 /* The problem of a store that cannot answer now (--store). */
@@ -357,24 +366,7 @@ static srv_entry *restore(srv_req *r, int *missing)
         srv_problem(r, 500, NULL, "the store's model of %s does not give that id back", r->arg);
         return NULL;
     }
-    api_cost part;
-    api_cost_model(m, &part);
-    if (over_budget(r, &part)) {
-        api_model_free(m);
-        return NULL;
-    }
-    solve_arg sa = { m, &r->cancel };
-    int hit;
-    double t0 = srv_now();
-    srv_entry *e = srv_cache_get(s->cache, id, solve_model, &sa, &hit, &err);
-    r->tm.solve = srv_now() - t0;
-    r->tm.cached = hit;
-    if (!hit)
-        srv_metrics_solve(s->metrics, r->tm.solve);
-    api_model_free(m);
-    if (!e)
-        failed(r, &err);
-    return e;
+    return solve_cached(r, m, id, 0);
 }
 
 static srv_entry *find_solid(srv_req *r)
