@@ -811,6 +811,27 @@ static void a_failed_command_should_leave_the_output_file_alone(void **state)
     expect(1, "solve --preset fig4a -o /dev/full --format json", 1, "/dev/full: No space left on device");
     expect(1, "eval --preset fig4a p3.json -o /dev/full", 1, "/dev/full: No space left on device");
     expect(1, "presets -o /dev/full", 1, "/dev/full: No space left on device");
+    /* a link is followed and stays a link; the file it names keeps its mode */
+    write_text("target.json", "old");
+    snprintf(path, sizeof path, "%s/target.json", dir);
+    assert_int_equal(chmod(path, 0600), 0);
+    snprintf(args, sizeof args, "%s/link.json", dir);
+    assert_int_equal(symlink("target.json", args), 0);
+    expect(1, "eval --preset fig4a p3.json -o link.json", 0, NULL);
+    assert_int_equal(lstat(args, &st), 0);
+    assert_true(S_ISLNK(st.st_mode));
+    assert_int_equal(stat(path, &st), 0);
+    assert_int_equal(st.st_mode & 0777, 0600);
+    got = read_file(path, NULL);
+    assert_non_null(got);
+    assert_true(got[0] == '[');
+    free(got);
+    /* ended by a signal while it writes (Ctrl-C): no temporary file left */
+    char cut[4300];
+    snprintf(cut, sizeof cut, "--version; timeout -s INT 0.3 %s solve --preset fig4a --format f32 --res 4096,4096,2 "
+             "-o cut.f32; true", bins[1]);
+    expect(1, cut, 0, NULL);
+    assert_false(file_with_prefix("cut.f32"));
     daemon_stop(&d);
 }
 

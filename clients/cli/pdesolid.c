@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <signal.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -305,6 +306,17 @@ typedef struct {
     mode_t mode;  /* the file's: the existing one's, or what creat() would give */
 } out_file;
 
+/* out_begin()'s temporary file while it exists: a signal that ends the command (Ctrl-C) removes it too. */
+static char *volatile out_tmp;
+
+static void out_on_signal(int sig)
+{
+    if (out_tmp)
+        unlink(out_tmp);   /* async-signal-safe */
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
 /* 0, or 1 after a message naming path. */
 static int out_begin(out_file *of, const char *path)
 {
@@ -339,6 +351,10 @@ static int out_begin(out_file *of, const char *path)
         return 1;
     }
     close(fd);
+    out_tmp = of->tmp;
+    static const int sigs[] = { SIGINT, SIGTERM, SIGHUP, SIGQUIT };
+    for (size_t i = 0; of->tmp && i < sizeof sigs / sizeof *sigs; i++)
+        signal(sigs[i], out_on_signal);
     return 0;
 }
 
@@ -357,6 +373,7 @@ static int out_end(out_file *of, int rc, const char *path)
         }
         if (rc || bad)
             unlink(of->tmp);
+        out_tmp = NULL;
     }
     if (bad) {
         fprintf(stderr, "pdesolid: %s: %s\n", path ? path : "standard output", strerror(err));
