@@ -11,6 +11,7 @@
 #include <curl/curl.h>
 
 #include "describe.h"
+#include "id.h"
 #include "output.h"
 #include "remote.h"
 
@@ -243,7 +244,7 @@ static int make_solid(const char *server, const char *body, size_t len, char id[
     free(url);
     if (rc)
         return 1;
-    if (r.id[0]) {
+    if (api_id_valid(r.id)) {   /* an id, and nothing else, goes into the eval's URL */
         memcpy(id, r.id, sizeof r.id);
     } else if (r.status != 200) {
         rc = problem(server, &r);
