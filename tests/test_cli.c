@@ -4,6 +4,7 @@
  * input exits 2 with the field's JSON pointer. $PDESOLID names the binary
  * (build/pdesolid), $PDESOLID_SAN its sanitised twin for the error paths.
  */
+#include <dirent.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -13,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -625,7 +627,7 @@ static void arguments_should_be_refused_with_a_specific_message(void **state)
         { "solve --preset fig4a --param p0=.5", "\".5\" is not a number" },
         { "solve --preset fig4a --param p0=+5", "\"+5\" is not a number" },
         { "solve --preset fig4a --param p0=inf", "\"inf\" is not a number" },
-        { "solve --preset fig4a --param p0=1e999", "/params/p0" },
+        { "solve --preset fig4a --param p0=1e999", "--param p0: 1e999 must be a finite number" },
         { "solve --preset fig4a --param c=1,2", "/params/c" },
         { "solve --preset fig4a --param 'c=1, 2, 3'", "\"1, 2, 3\" is not a number" },
         { "solve --preset fig4a --param p0=", "\"\" is not a number" },
@@ -694,6 +696,201 @@ static void arguments_should_be_refused_with_a_specific_message(void **state)
     free(err);
 }
 
+/* eval --server gives the offline answer: the solid's id is the CLI's own, so a solid beyond float32 (which
+ * the f32 solve it asked for first refused) evaluates through the server as here, and a server with a tight
+ * --max-work gets smaller batches (it answered 422 to the first batch, and the CLI gave up). */
+static void eval_through_the_server_should_give_the_offline_answer(void **state)
+{
+    (void)state;
+    write_text("p.json", "[[0.5,0.5,0.5],[0.25,0.75,1]]");
+    assert_true(write_points("work.json", 20000) > 0);
+    char args[512], *want, *got, *err;
+    const struct {
+        const char *daemon, *args;
+    } cases[] = {
+        { "--quiet", "eval --template example1 --param a0=1e300 p.json" },
+        { "--quiet --max-work 1e6", "eval --preset fig4b work.json" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        daemon_t d;
+        daemon_start(&d, dir, cases[i].daemon);
+        assert_int_equal(run(1, cases[i].args, &want, &err), 0);
+        free(err);
+        snprintf(args, sizeof args, "%s --server %s", cases[i].args, d.base);
+        if (run(1, args, &got, &err) != 0 || strcmp(got, want))
+            fail_msg("pdesolid %s (daemon %s): %s", args, cases[i].daemon, err);
+        free(got);
+        free(err);
+        /* again, now that the server has it: the same */
+        if (run(1, args, &got, &err) != 0 || strcmp(got, want))
+            fail_msg("pdesolid %s (daemon %s), twice: %s", args, cases[i].daemon, err);
+        free(got);
+        free(err);
+        free(want);
+        daemon_stop(&d);
+    }
+}
+
+/* 1 if dir holds a file whose name starts with prefix (a temporary file left behind). */
+static int file_with_prefix(const char *prefix)
+{
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    int found = 0;
+    for (struct dirent *e; (e = readdir(d)) != NULL;)
+        found |= !strncmp(e->d_name, prefix, strlen(prefix));
+    closedir(d);
+    return found;
+}
+
+/* A failed command never creates or truncates -o's file: eval's points file given as -o was emptied before it
+ * was read, and a refused request left a 0-byte file or truncated a good one; here or through a server. */
+static void a_failed_command_should_leave_the_output_file_alone(void **state)
+{
+    (void)state;
+    daemon_t d;
+    daemon_start(&d, dir, "--quiet");
+    char args[512], path[256], *out, *err, *want;
+    /* the points file as -o: read first, then replaced by the values */
+    write_text("p2.json", "[[0.5,0.25,0.5],[0.1,0.2,0.3]]");
+    write_text("p3.json", "[[0.5,0.25,0.5],[0.1,0.2,0.3]]");
+    assert_int_equal(run(1, "eval --preset fig4a p3.json", &want, &err), 0);
+    free(err);
+    assert_int_equal(run(1, "eval --preset fig4a p2.json -o p2.json", &out, &err), 0);
+    free(out);
+    free(err);
+    snprintf(path, sizeof path, "%s/p2.json", dir);
+    char *got = read_file(path, NULL);
+    assert_non_null(got);
+    assert_string_equal(got, want);
+    free(got);
+    free(want);
+    mode_t mask = umask(0);
+    umask(mask);
+    struct stat st;
+    assert_int_equal(stat(path, &st), 0);
+    assert_int_equal(st.st_mode & 0777, 0666 & ~mask);
+    /* refused: no file made, none truncated */
+    write_text("good.f32", "good");
+    write_text("good.json", "good");
+    const char *refused[] = { "eval --preset nosuch p3.json -o none.json",
+                              "solve --template example1 --param a0=1e300 -o none.f32",
+                              "solve --template example1 --param a0=1e300 -o good.f32",
+                              "eval --preset nosuch p3.json -o good.json",
+                              "solve --preset fig4a --format dae -o good.json" };
+    for (int remote = 0; remote < 2; remote++)
+        for (size_t i = 0; i < sizeof refused / sizeof *refused; i++) {
+            snprintf(args, sizeof args, "%s%s%s", refused[i], remote ? " --server " : "", remote ? d.base : "");
+            int rc = run(1, args, &out, &err);
+            if (rc != 2)
+                fail_msg("pdesolid %s: exit %d: %s", args, rc, err);
+            free(out);
+            free(err);
+            const char *file = strstr(refused[i], "-o ") + 3;
+            snprintf(path, sizeof path, "%s/%s", dir, file);
+            if (!strncmp(file, "none", 4)) {
+                if (access(path, F_OK) == 0)
+                    fail_msg("pdesolid %s: made %s", args, file);
+            } else {
+                got = read_file(path, NULL);
+                if (!got || strcmp(got, "good"))
+                    fail_msg("pdesolid %s: %s is now \"%s\"", args, file, got ? got : "(gone)");
+                free(got);
+            }
+        }
+    assert_false(file_with_prefix("none"));
+    assert_false(file_with_prefix("good.json."));
+    assert_false(file_with_prefix("good.f32."));
+    assert_false(file_with_prefix("p2.json."));
+    /* a device is written, not replaced */
+    assert_int_equal(run(1, "solve --preset fig4a -o /dev/null --format json", &out, &err), 0);
+    free(out);
+    free(err);
+    assert_int_equal(stat("/dev/null", &st), 0);
+    assert_true(S_ISCHR(st.st_mode));
+    expect(1, "solve --preset fig4a -o /dev/full --format json", 1, "/dev/full: No space left on device");
+    expect(1, "eval --preset fig4a p3.json -o /dev/full", 1, "/dev/full: No space left on device");
+    expect(1, "presets -o /dev/full", 1, "/dev/full: No space left on device");
+    /* a link is followed and stays a link; the file it names keeps its mode */
+    write_text("target.json", "old");
+    snprintf(path, sizeof path, "%s/target.json", dir);
+    assert_int_equal(chmod(path, 0600), 0);
+    snprintf(args, sizeof args, "%s/link.json", dir);
+    assert_int_equal(symlink("target.json", args), 0);
+    expect(1, "eval --preset fig4a p3.json -o link.json", 0, NULL);
+    assert_int_equal(lstat(args, &st), 0);
+    assert_true(S_ISLNK(st.st_mode));
+    assert_int_equal(stat(path, &st), 0);
+    assert_int_equal(st.st_mode & 0777, 0600);
+    got = read_file(path, NULL);
+    assert_non_null(got);
+    assert_true(got[0] == '[');
+    free(got);
+    /* ended by a signal while it writes (Ctrl-C): no temporary file left */
+    char cut[4300];
+    snprintf(cut, sizeof cut, "--version; timeout -s INT 0.3 %s solve --preset fig4a --format f32 --res 4096,4096,2 "
+             "-o cut.f32; true", bins[1]);
+    expect(1, cut, 0, NULL);
+    assert_false(file_with_prefix("cut.f32"));
+    daemon_stop(&d);
+}
+
+/* --param r0=1e400 overflows a double: it was sent as null and refused as "not null". */
+static void params_that_overflow_a_double_should_be_named(void **state)
+{
+    (void)state;
+    write_text("p.json", "[[0.5,0.5,0.5]]");
+    expect(1, "solve --template example2 --param r0=1e400", 2,
+           "--param r0: 1e400 must be a finite number; this one overflows a double");
+    expect(1, "solve --template example1 --param c=-1,-1e999,-1", 2,
+           "--param c: -1,-1e999,-1 must be a finite number; this one overflows a double");
+    expect(1, "eval --template example2 --param r0=-1e400 p.json", 2, "overflows a double");
+    expect(1, "solve --template example2 --param r0=1e-400", 0, NULL);   /* underflows to 0: a number */
+}
+
+/* A --server URL as long as --server takes (2047 bytes) was cut short in the request URLs built from it,
+ * silently: with dot segments that libcurl removes, it names the server and must work as offline. */
+static void long_server_urls_should_not_be_cut_short(void **state)
+{
+    (void)state;
+    daemon_t d;
+    daemon_start(&d, dir, "--quiet");
+    char url[2048], args[4096], *want, *got, *err;
+    size_t k = (size_t)snprintf(url, sizeof url, "%s", d.base);
+    while (k + 2 < 2040)
+        k += (size_t)snprintf(url + k, sizeof url - k, "/.");
+    write_text("p.json", "[[0.5,0.5,0.5],[0.25,0.75,1]]");
+    const char *cmds[] = { "solve --preset fig3d", "eval --preset fig3d p.json", "presets" };
+    for (size_t i = 0; i < sizeof cmds / sizeof *cmds; i++) {
+        assert_int_equal(run(1, cmds[i], &want, &err), 0);
+        free(err);
+        snprintf(args, sizeof args, "%s --server %s", cmds[i], url);
+        if (run(1, args, &got, &err) != 0 || strcmp(got, want))
+            fail_msg("pdesolid %s --server (%zu bytes): %s", cmds[i], strlen(url), err);
+        free(got);
+        free(err);
+        free(want);
+    }
+    daemon_stop(&d);
+}
+
+/* solve takes one file: its help said "either file may be - ... (not both)". */
+static void help_should_describe_the_command_s_own_files(void **state)
+{
+    (void)state;
+    char *out, *err;
+    assert_int_equal(run(1, "solve --help", &out, &err), 0);
+    assert_null(strstr(out, "not both"));
+    assert_null(strstr(out, "ither file"));
+    assert_non_null(strstr(out, "MODEL.json may be - for standard input"));
+    free(out);
+    free(err);
+    assert_int_equal(run(1, "eval --help", &out, &err), 0);
+    assert_non_null(strstr(out, "Either file may be - for standard input (not both)."));
+    free(out);
+    free(err);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -708,6 +905,11 @@ int main(void)
         cmocka_unit_test(server_urls_should_be_joined_cleanly_or_refused),
         cmocka_unit_test(eval_through_the_server_should_batch_large_point_files),
         cmocka_unit_test(arguments_should_be_refused_with_a_specific_message),
+        cmocka_unit_test(eval_through_the_server_should_give_the_offline_answer),
+        cmocka_unit_test(a_failed_command_should_leave_the_output_file_alone),
+        cmocka_unit_test(params_that_overflow_a_double_should_be_named),
+        cmocka_unit_test(long_server_urls_should_not_be_cut_short),
+        cmocka_unit_test(help_should_describe_the_command_s_own_files),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

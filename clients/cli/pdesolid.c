@@ -3,11 +3,15 @@
  * closed form, properties, values at points, sampled grids and meshes.
  */
 #include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <signal.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cJSON.h>
@@ -95,7 +99,7 @@ static const char about[] =
 static const char model_text_help[] =
     "MODEL.json is a model, a loft ({\"loft\": {\"pde\": ..., \"sections\": [...]}}: a solid through\n"
     "sections of your own) or a request ({\"preset\": \"fig4a\", \"params\": {...}});\n"
-    "either file may be - for standard input (not both). docs/API.md describes the format.\n";
+    "docs/API.md describes the format.\n";
 
 static const char exit_help[] =
     "exit status: 0 success, 2 bad input (the message names the field as a JSON\n"
@@ -170,9 +174,17 @@ static cJSON *param_value(const char *name, const char *text)
                 name, text);
         return NULL;
     }
-    cJSON *v = cJSON_Parse(json);
+    cJSON *v = cJSON_Parse(json), *x;
     if (!v)
         fprintf(stderr, "pdesolid: out of memory\n");
+    int finite = !cJSON_IsNumber(v) || isfinite(v->valuedouble);
+    cJSON_ArrayForEach(x, (cJSON_IsArray(v) ? v : NULL))
+        finite &= isfinite(x->valuedouble);
+    if (v && !finite) {   /* cJSON reads 1e400 as inf, and would write it as null */
+        fprintf(stderr, "pdesolid: --param %s: %s must be a finite number; this one overflows a double\n", name, text);
+        cJSON_Delete(v);
+        return NULL;
+    }
     return v;
 }
 
@@ -260,34 +272,116 @@ static int output_options(const options *o, api_format *f, unsigned res[3], api_
     return 0;
 }
 
-/* The solid in format f (output_options()'s) to -o's file or standard output. */
-static int write_output(const options *o, const pde_solution *sol, const char *id, api_format f, const unsigned res[3],
+/* The solid in format f (output_options()'s) to standard output (-o's file: out_begin()). */
+static int write_output(const pde_solution *sol, const char *id, api_format f, const unsigned res[3],
                         const api_output_opts *opts)
 {
     api_error err;
-    FILE *out = o->out ? fopen(o->out, "wb") : stdout;
-    if (!out) {
-        fprintf(stderr, "pdesolid: %s: %s\n", o->out, strerror(errno));
-        return 1;
-    }
     api_output *w = api_output_open_ex(sol, id, NULL, f, res, opts, NULL, &err);
-    if (!w) {
-        if (out != stdout)
-            fclose(out);
+    if (!w)
         return report("output", &err);
-    }
     static char buf[1 << 16];
     long n;
     while ((n = api_output_read(w, buf, sizeof buf)) > 0)
-        if (fwrite(buf, 1, (size_t)n, out) != (size_t)n)
+        if (fwrite(buf, 1, (size_t)n, stdout) != (size_t)n)
             break;
-    int bad = n != 0 || ferror(out);
     api_output_free(w);
-    if ((out != stdout ? fclose(out) : fflush(out)) != 0 || bad) {
-        fprintf(stderr, "pdesolid: %s: %s\n", o->out ? o->out : "standard output", n < 0 ? "out of memory" : strerror(errno));
+    if (n < 0) {
+        fprintf(stderr, "pdesolid: out of memory\n");
         return 1;
     }
+    return 0;   /* a write error: out_end() names it */
+}
+
+/*
+ * -o FILE, written whole or not at all: the commands write to standard output, which out_begin() points at a
+ * temporary file beside FILE (so that rename() stays on one file system); out_end() renames it over FILE when
+ * the command succeeded and removes it otherwise, so a failed command never creates or truncates FILE, and
+ * eval's POINTS.json may be its own -o. A FILE that exists and is not a regular file (/dev/null, a pipe) is
+ * written in place: there is nothing to replace. A symbolic link is followed, and stays a link.
+ */
+typedef struct {
+    char *path;   /* where the output goes (a link resolved); NULL: standard output as it is */
+    char *tmp;    /* the temporary file, NULL when written in place */
+    mode_t mode;  /* the file's: the existing one's, or what creat() would give */
+} out_file;
+
+/* out_begin()'s temporary file while it exists: a signal that ends the command (Ctrl-C) removes it too. */
+static char *volatile out_tmp;
+
+static void out_on_signal(int sig)
+{
+    if (out_tmp)
+        unlink(out_tmp);   /* async-signal-safe */
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+/* 0, or 1 after a message naming path. */
+static int out_begin(out_file *of, const char *path)
+{
+    memset(of, 0, sizeof *of);
+    if (!path)
+        return 0;
+    struct stat st;
+    int exists = stat(path, &st) == 0;
+    of->path = exists ? realpath(path, NULL) : strdup(path);
+    int fd = -1;
+    if (of->path && exists && !S_ISREG(st.st_mode)) {
+        fd = open(of->path, O_WRONLY | O_TRUNC);
+    } else if (of->path && (of->tmp = malloc(strlen(of->path) + 8)) != NULL) {
+        sprintf(of->tmp, "%s.XXXXXX", of->path);
+        mode_t mask = umask(0);
+        umask(mask);
+        of->mode = exists ? st.st_mode & 07777 : 0666 & ~mask;
+        fd = mkstemp(of->tmp);
+        if (fd < 0) {
+            free(of->tmp);
+            of->tmp = NULL;
+        }
+    }
+    if (fd < 0 || dup2(fd, STDOUT_FILENO) < 0) {
+        fprintf(stderr, "pdesolid: %s: %s\n", path, strerror(errno));
+        if (fd >= 0)
+            close(fd);
+        if (of->tmp)
+            unlink(of->tmp);
+        free(of->tmp);
+        free(of->path);
+        return 1;
+    }
+    close(fd);
+    out_tmp = of->tmp;
+    static const int sigs[] = { SIGINT, SIGTERM, SIGHUP, SIGQUIT };
+    for (size_t i = 0; of->tmp && i < sizeof sigs / sizeof *sigs; i++)
+        signal(sigs[i], out_on_signal);
     return 0;
+}
+
+/* Ends what out_begin() began with the command's exit status rc; returns it, or 1 after a message when the
+ * output could not be written. */
+static int out_end(out_file *of, int rc, const char *path)
+{
+    int bad = fflush(stdout) != 0 || ferror(stdout);
+    int err = errno;
+    if (of->tmp) {
+        bad = bad || fchmod(STDOUT_FILENO, of->mode) != 0 || close(STDOUT_FILENO) != 0;
+        err = bad ? errno : 0;
+        if (!rc && !bad && rename(of->tmp, of->path) != 0) {
+            bad = 1;
+            err = errno;
+        }
+        if (rc || bad)
+            unlink(of->tmp);
+        out_tmp = NULL;
+    }
+    if (bad) {
+        fprintf(stderr, "pdesolid: %s: %s\n", path ? path : "standard output", strerror(err));
+        rc = rc ? rc : 1;
+    }
+    free(of->tmp);
+    free(of->path);
+    return rc;
 }
 
 static int remote_solve_to(const options *o)
@@ -297,7 +391,7 @@ static int remote_solve_to(const options *o)
     char *body = model_text(o, &len, &rc);
     if (!body)
         return rc;
-    rc = remote_solve(o->server, body, len, o->format, o->res, o->compress, o->out);
+    rc = remote_solve(o->server, body, len, o->format, o->res, o->compress);
     free(body);
     return rc;
 }
@@ -372,7 +466,7 @@ static int cmd_solve(const options *oo)
     if (rc)
         return rc;
     if (o->format) {
-        rc = write_output(o, sol, id, f, res, &opts);
+        rc = write_output(sol, id, f, res, &opts);
         pde_solution_free(sol);
         return rc;
     }
@@ -389,7 +483,9 @@ static int cmd_solve(const options *oo)
     return 0;
 }
 
-/* The values at the points, in place, from a server (remote.h). */
+/* The values at the points, in place, from a server (remote.h), at the id the server would give the model:
+ * computed here, so that the server solves it only when it does not have it. A model this api cannot read
+ * goes to the server without an id, which then names what is wrong with it (as POST /solve does). */
 static int remote_values(const options *o, double *pts, size_t n, const char *points_path)
 {
     size_t len;
@@ -397,7 +493,13 @@ static int remote_values(const options *o, double *pts, size_t n, const char *po
     char *body = model_text(o, &len, &rc);
     if (!body)
         return rc;
-    rc = remote_eval(o->server, body, len, pts, n, points_path);
+    char id[API_ID_LEN + 1] = "";
+    api_error err;
+    api_model *m = api_model_parse(body, len, &err);
+    if (!m || api_request_id(m, id, NULL) != PDE_OK)
+        id[0] = '\0';
+    api_model_free(m);
+    rc = remote_eval(o->server, body, len, id, pts, n, points_path);
     free(body);
     return rc;
 }
@@ -440,7 +542,7 @@ static int cmd_eval(const options *o)
         printf("%s[%.17g,%.17g,%.17g]", i ? ",\n" : "", pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
     fputs("]\n", stdout);
     free(pts);
-    return fflush(stdout) == 0 ? 0 : 1;
+    return 0;
 }
 
 static void preset_row(const char *name, const char *template, const char *caption)
@@ -460,7 +562,7 @@ static int cmd_presets(const options *o)
         const char *caption, *name = api_loft_preset_name(i, &caption);
         preset_row(name, "loft", caption);
     }
-    return fflush(stdout) == 0 ? 0 : 1;
+    return 0;
 }
 
 /* Each row's label in a column of width col - 2, its text after it (below it when the label is longer), the
@@ -520,8 +622,10 @@ static void print_usage(FILE *f, const struct cmd_row *cmd)
             print_row(f, 28, label, cmd_rows[i].help);
         }
     }
-    if (!cmd || cmd->files[0])
-        fprintf(f, "\n%s", model_text_help);
+    if (!cmd || cmd->files[0])   /* standard input: the one file of solve, one of eval's two */
+        fprintf(f, "\n%s%s\n", model_text_help,
+                !cmd ? "Either file may be - for standard input (eval: not both)." :
+                cmd->files[1] ? "Either file may be - for standard input (not both)." : "MODEL.json may be - for standard input.");
     print_options(f, cmd);
     fprintf(f, "\n%s", exit_help);
     if (!cmd || cmd->bit == CMD_SOLVE)
@@ -643,9 +747,8 @@ int main(int argc, char **argv)
             return 2;
         o.server = o.base;
     }
-    if (cmd->bit != CMD_SOLVE && o.out && !freopen(o.out, "wb", stdout)) {   /* -o is never ignored */
-        fprintf(stderr, "pdesolid: %s: %s\n", o.out, strerror(errno));
+    out_file of;   /* -o is never ignored */
+    if (out_begin(&of, o.out))
         return 1;
-    }
-    return cmd->run(&o);
+    return out_end(&of, cmd->run(&o), o.out);
 }

@@ -1,8 +1,8 @@
 /*
  * remote.c: pdesolid --server (remote.h), with libcurl.
  */
-#include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -11,6 +11,7 @@
 #include <curl/curl.h>
 
 #include "describe.h"
+#include "id.h"
 #include "output.h"
 #include "remote.h"
 
@@ -84,6 +85,27 @@ static int post(const char *url, const char *body, size_t len, reply *r)
     return 0;
 }
 
+/* server followed by fmt's text, malloc'd at its whole length (a long --server is never cut short); NULL after
+ * a message. */
+static char *url_of(const char *server, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int k = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    size_t n = strlen(server);
+    char *url = k >= 0 ? malloc(n + (size_t)k + 1) : NULL;
+    if (!url) {
+        fprintf(stderr, "pdesolid: out of memory\n");
+        return NULL;
+    }
+    memcpy(url, server, n);
+    va_start(ap, fmt);
+    vsnprintf(url + n, (size_t)k + 1, fmt, ap);
+    va_end(ap);
+    return url;
+}
+
 /* A problem answer, printed as offline errors are; returns the exit status. */
 static int problem(const char *server, const reply *r)
 {
@@ -116,25 +138,20 @@ static int print_solve(const char *json, FILE *out)
 }
 
 int remote_solve(const char *server, const char *body, size_t len, const char *format, const char *res,
-                 const char *compress, const char *path)
+                 const char *compress)
 {
-    char url[2048];
-    snprintf(url, sizeof url, "%s/solve?format=%s%s%s%s%s", server, format ? format : "json", res ? "&res=" : "",
-             res ? res : "", compress ? "&compress=" : "", compress ? compress : "");
+    char *url = url_of(server, "/solve?format=%s%s%s%s%s", format ? format : "json", res ? "&res=" : "",
+                       res ? res : "", compress ? "&compress=" : "", compress ? compress : "");
     reply r;
-    if (post(url, body, len, &r))
+    int rc = !url || post(url, body, len, &r);
+    free(url);
+    if (rc)
         return 1;
-    int rc = r.status != 200 ? problem(server, &r) : 0;
-    FILE *out = rc || !path ? stdout : fopen(path, "wb");   /* no file for a refused request */
-    if (!rc && out && !format)
-        rc = print_solve(r.data ? r.data : "", out);
-    int bad = !out || (!rc && format && fwrite(r.data, 1, r.len, out) != r.len);
-    if (out && out != stdout)
-        bad |= fclose(out) != 0;
-    if (bad) {
-        fprintf(stderr, "pdesolid: %s: %s\n", path ? path : "standard output", strerror(errno));
-        rc = 1;
-    }
+    rc = r.status != 200 ? problem(server, &r) : 0;
+    if (!rc && !format)
+        rc = print_solve(r.data ? r.data : "", stdout);
+    else if (!rc && r.len)
+        fwrite(r.data, 1, r.len, stdout);   /* a write error stays in stdout's error flag: the caller's to name */
     free(r.data);
     return rc;
 }
@@ -211,18 +228,49 @@ static int batch_values(const char *server, const reply *e, double *pts, size_t 
  * --max-body, and under the default --max-points. */
 enum { BATCH_POINTS = 10000 };
 
-int remote_eval(const char *server, const char *body, size_t len, double *pts, size_t n, const char *points_name)
+/*
+ * Makes the solid on the server: POST /solve, whose X-Solid-Id (into id) names it. The server solves and
+ * caches the solid before it checks the output it was asked for, and says its id in a refusal of that
+ * output too; so the cheapest output, f32 at 2 x 2 x 2 (8 points, no properties), makes any solid the server
+ * can solve, even one beyond float32, which f32 then refuses (json has no float32 check, but it computes the
+ * properties, and refuses a solid whose properties overflow a double). 0, or the exit status after the
+ * server's problem: one with no id is about the model (or the budget of its solve), and is the answer.
+ */
+static int make_solid(const char *server, const char *body, size_t len, char id[64])
 {
-    char url[2048];
-    snprintf(url, sizeof url, "%s/solve?format=f32&res=2", server);
+    char *url = url_of(server, "/solve?format=f32&res=2");
     reply r;
-    if (post(url, body, len, &r))
+    int rc = !url || post(url, body, len, &r);
+    free(url);
+    if (rc)
         return 1;
-    int rc = r.status != 200 ? problem(server, &r) : 0;
+    if (api_id_valid(r.id)) {   /* an id, and nothing else, goes into the eval's URL */
+        memcpy(id, r.id, sizeof r.id);
+    } else if (r.status != 200) {
+        rc = problem(server, &r);
+    } else {
+        fprintf(stderr, "pdesolid: %s: the server's answer names no solid (X-Solid-Id)\n", server);
+        rc = 1;
+    }
     free(r.data);
+    return rc;
+}
+
+/* 1 if the problem is a budget of the server (--max-work, --max-mem-mb), which a smaller batch may meet. */
+static int over_budget(const reply *r)
+{
+    return r->status == 422 && r->data &&
+           (strstr(r->data, "(--max-work)") || strstr(r->data, "(--max-mem-mb)")) && !strstr(r->data, "\"pointer\"");
+}
+
+int remote_eval(const char *server, const char *body, size_t len, const char *local_id, double *pts, size_t n,
+                const char *points_name)
+{
+    char id[64];
+    snprintf(id, sizeof id, "%s", local_id ? local_id : "");
+    int made = !id[0], rc = made ? make_solid(server, body, len, id) : 0;
     if (rc)
         return rc;
-    snprintf(url, sizeof url, "%s/solids/%s/eval", server, r.id);
     size_t batch = BATCH_POINTS;
     char *req = malloc(32 + 80 * batch);
     if (!req) {
@@ -235,12 +283,18 @@ int remote_eval(const char *server, const char *body, size_t len, double *pts, s
             k += (size_t)sprintf(req + k, "%s[%.17g,%.17g,%.17g]", i > start ? "," : "", pts[3 * i], pts[3 * i + 1],
                                  pts[3 * i + 2]);
         k += (size_t)sprintf(req + k, "]}");
+        char *url = url_of(server, "/solids/%s/eval", id);
         reply e;
-        if (post(url, req, k, &e)) {
+        if (!url || post(url, req, k, &e)) {
+            free(url);
             rc = 1;
             break;
         }
-        if (e.status == 413 && batch > 1) {   /* a server with a smaller --max-body or --max-points */
+        free(url);
+        if (e.status == 404 && !made) {   /* not solved there yet (or evicted): make it, then ask again */
+            rc = make_solid(server, body, len, id);
+            made = 1;
+        } else if ((e.status == 413 || over_budget(&e)) && batch > 1) {   /* --max-body, --max-points, --max-work */
             batch /= 2;
         } else if (e.status != 200) {
             rc = point_problem(&e, start, points_name) ? 2 : problem(server, &e);
@@ -256,12 +310,13 @@ int remote_eval(const char *server, const char *body, size_t len, double *pts, s
 
 int remote_presets(const char *server, void (*row)(const char *name, const char *template, const char *caption))
 {
-    char url[2048];
-    snprintf(url, sizeof url, "%s/presets", server);
+    char *url = url_of(server, "/presets");
     reply r;
-    if (post(url, NULL, 0, &r))
+    int rc = !url || post(url, NULL, 0, &r);
+    free(url);
+    if (rc)
         return 1;
-    int rc = r.status != 200 ? problem(server, &r) : 0;
+    rc = r.status != 200 ? problem(server, &r) : 0;
     cJSON *d = rc ? NULL : cJSON_Parse(r.data ? r.data : "");
     const cJSON *list = cJSON_GetObjectItemCaseSensitive(d, "presets"), *p;
     if (!rc && !cJSON_IsArray(list)) {
