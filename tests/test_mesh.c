@@ -1,0 +1,78 @@
+/*
+ * test_mesh.c: api/mesh.c's paths that no preset takes. The skins of every
+ * preset (closed, welded, normals and det J from the closed form) are
+ * test_output.c's; here, solids built to reach the rest.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "mesh.h"
+#include "model.h"
+#include "support.h"
+
+/* A cone by a loft: the unit circle at w = 0 (x = u cos 2 pi v, y = u sin 2 pi v), the point (0, 0, 1) at
+ * w = 1. Face u = 0 is its axis (every row one point: no triangle), and face u = 1, the cone's side, keeps
+ * triangles though its row w = 1 is one point, the apex (exactly: each harmonic's h(1) is 0). */
+static const char cone[] =
+    "{\"loft\": {\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], \"c\": [4, 4, 4]}, \"sections\": ["
+    "{\"w\": 0, \"terms\": {\"x\": [{\"u\": {\"pow\": 1}, \"v\": {\"cos\": 2}, \"c\": 1}],"
+    " \"y\": [{\"u\": {\"pow\": 1}, \"v\": {\"sin\": 2}, \"c\": 1}], \"z\": [{\"c\": 0}]}},"
+    "{\"w\": 1, \"terms\": {\"x\": [{\"c\": 0}], \"y\": [{\"c\": 0}], \"z\": [{\"c\": 1}]}}]}}";
+
+/* A face row that is one point takes no derivatives with its positions (mesh.c, one_point); where its face
+ * keeps triangles they are taken after the live test. The apex's det J must then be the closed form's (0:
+ * x_v vanishes there), not what the kept block held: a mesh built into a block whose det J and normals
+ * were overwritten with NaN is the same, bit for bit, as one built into fresh memory. */
+static void a_one_point_row_of_a_kept_face_should_take_its_det_j_from_the_closed_form(void **state)
+{
+    (void)state;
+    api_error err;
+    api_model *m = api_model_parse(cone, strlen(cone), &err);
+    assert_non_null(m);
+    pde_solution *sol;
+    assert_int_equal(api_solve(m, &sol, &err), 0);
+    api_model_free(m);
+    const unsigned res[3] = { 40, 12, 8 };
+    api_mesh fresh, dirty, kept;
+    api_mesh_release_spares();
+    assert_int_equal(api_mesh_build(sol, res, NULL, &fresh, &err), 0);
+    assert_int_equal(api_mesh_build(sol, res, NULL, &dirty, &err), 0);
+    for (size_t v = 0; v < dirty.nverts; v++) {   /* covers the apex row's samples: u = 1 comes before w = 0 */
+        dirty.detj[v] = NAN;
+        for (int c = 0; c < 3; c++)
+            dirty.nrm[3 * v + c] = NAN;
+    }
+    api_mesh_free(&dirty);
+    assert_int_equal(api_mesh_build(sol, res, NULL, &kept, &err), 0);   /* into dirty's block */
+    assert_int_equal(kept.nverts, fresh.nverts);
+    assert_int_equal(kept.ntris, fresh.ntris);
+    assert_memory_equal(kept.detj, fresh.detj, fresh.nverts * sizeof *fresh.detj);
+    assert_memory_equal(kept.nrm, fresh.nrm, 3 * fresh.nverts * sizeof *fresh.nrm);
+    size_t apex = 0;
+    for (size_t v = 0; v < kept.nverts; v++) {
+        assert_true(isfinite(kept.detj[v]));
+        if (kept.pos[3 * v] == 0.0f && kept.pos[3 * v + 1] == 0.0f && kept.pos[3 * v + 2] == 1.0f) {
+            apex++;
+            assert_true(kept.detj[v] == 0.0f);
+        }
+    }
+    assert_int_equal(apex, 1);   /* the side's; the axis (u = 0) and the top (w = 1) keep no vertex */
+    api_mesh_free(&fresh);
+    api_mesh_free(&kept);
+    api_mesh_release_spares();
+    pde_solution_free(sol);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(a_one_point_row_of_a_kept_face_should_take_its_det_j_from_the_closed_form),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
