@@ -446,6 +446,12 @@ static size_t join_near(uint32_t *up, const float *p, const float *q, uint32_t i
             m |= (unsigned)_mm_movemask_ps(_mm_cmple_ps(d, e)) << (4 * k);
         }
         m &= (m >> 1) & (m >> 2) & 01111u;   /* bit 3j: all three axes of sample i + j */
+        if (m == 01111u) {   /* a run: a collapsed row's, a seam's */
+            for (uint32_t j = 0; j < 4; j++)
+                join(up, ip + (uint32_t)i + j, iq + (uint32_t)i + j);
+            joined += 4;
+            continue;
+        }
         for (; m; m &= m - 1, joined++) {
             const uint32_t j = (uint32_t)(i + (size_t)__builtin_ctz(m) / 3);
             join(up, ip + j, iq + j);
@@ -456,6 +462,19 @@ static size_t join_near(uint32_t *up, const float *p, const float *q, uint32_t i
         if (near(p + 3 * i, q + 3 * i, eps))
             join(up, ip + (uint32_t)i, iq + (uint32_t)i), joined++;
     return joined;
+}
+
+/* Joins samples i0 .. i0 + n - 1 into one set: the joins of each with the next, the root kept at hand. */
+static void join_chain(uint32_t *up, uint32_t i0, size_t n)
+{
+    uint32_t r = find(up, i0);
+    for (uint32_t i = 1; i < (uint32_t)n; i++) {
+        const uint32_t s = find(up, i0 + i);
+        if (s < r)
+            up[r] = s, r = s;
+        else if (r < s)
+            up[s] = r;
+    }
 }
 
 /* The first k' >= k below end with fl[k'] & bits, or end; 16 flags a step where SSE2 is. */
@@ -811,9 +830,17 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         for (size_t b = 0; b < nb; b++) {
             const uint32_t row = (uint32_t)(f->base + b * na);
             const float *p = P + 3 * (size_t)row;
-            /* along the row, then to the next row */
-            join_near(up, p, p + 3, row, row + 1, na - 1, epsf);
-            if (b + 1 < nb)
+            /* along the row, then to the next row; a row that is one point (u = 0, 1: one_point) is near all
+             * along, and near all of the next row, or none of it, where that is one point too: then one join
+             * does, the next row joining all its samples next */
+            const int pt = fi < 2 && sp.point[fi][b], pt1 = pt && b + 1 < nb && sp.point[fi][b + 1];
+            if (pt)
+                join_chain(up, row, na);
+            else
+                join_near(up, p, p + 3, row, row + 1, na - 1, epsf);
+            if (pt1 && near(p, p + 3 * na, epsf))
+                join(up, row, (uint32_t)(row + na));
+            else if (b + 1 < nb && !pt1)
                 join_near(up, p, p + 3 * na, row, (uint32_t)(row + na), na, epsf);
             /* the neighbouring faces this row's samples lie on: its ends, or all of an edge row */
             const int edge_row = b == 0 || b + 1 == nb;
