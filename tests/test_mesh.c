@@ -26,6 +26,18 @@ static const char cone[] =
     " \"y\": [{\"u\": {\"pow\": 1}, \"v\": {\"sin\": 2}, \"c\": 1}], \"z\": [{\"c\": 0}]}},"
     "{\"w\": 1, \"terms\": {\"x\": [{\"c\": 0}], \"y\": [{\"c\": 0}], \"z\": [{\"c\": 1}]}}]}}";
 
+/* The solid of a model or loft document. */
+static pde_solution *solve_doc(const char *doc)
+{
+    api_error err;
+    api_model *m = api_model_parse(doc, strlen(doc), &err);
+    assert_non_null(m);
+    pde_solution *sol = NULL;
+    assert_int_equal(api_solve(m, &sol, &err), 0);
+    api_model_free(m);
+    return sol;
+}
+
 /* Directed edges by position id. */
 static int edge_cmp(const void *pa, const void *pb)
 {
@@ -61,11 +73,7 @@ static void a_one_point_row_of_a_kept_face_should_take_its_det_j_from_the_closed
 {
     (void)state;
     api_error err;
-    api_model *m = api_model_parse(cone, strlen(cone), &err);
-    assert_non_null(m);
-    pde_solution *sol;
-    assert_int_equal(api_solve(m, &sol, &err), 0);
-    api_model_free(m);
+    pde_solution *sol = solve_doc(cone);
     const unsigned res[3] = { 40, 12, 8 };
     api_mesh fresh, dirty, kept;
     api_mesh_release_spares();
@@ -110,11 +118,7 @@ static void a_face_that_is_one_point_should_leave_a_closed_skin(void **state)
         "\"y\": [{\"u\": {\"pow\": 1}, \"v\": {\"cos\": 2}, \"w0\": 0.5, \"w1\": 1}],"
         "\"z\": [{\"u\": {\"pow\": 1}, \"w0\": 0, \"w1\": 1}]}}";
     api_error err;
-    api_model *md = api_model_parse(point, strlen(point), &err);
-    assert_non_null(md);
-    pde_solution *sol;
-    assert_int_equal(api_solve(md, &sol, &err), 0);
-    api_model_free(md);
+    pde_solution *sol = solve_doc(point);
     const unsigned res[3] = { 9, 16, 11 };
     api_mesh m;
     assert_int_equal(api_mesh_build(sol, res, NULL, &m, &err), 0);
