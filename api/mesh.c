@@ -863,24 +863,25 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
      * bits (the root, the least sample, is settled before any other of its set). Almost every sample
      * is its own root and needs no store: 4 a step in SSE2 find the others. */
     memset(flag, 0, nraw);
-    for (size_t i = 0; i < nraw; i++) {
+    for (size_t i = 0; i < nraw;) {
 #if defined(__SSE2__)
         const __m128i step4 = _mm_set1_epi32(4);
         for (__m128i ids = _mm_add_epi32(_mm_set1_epi32((int)i), _mm_setr_epi32(0, 1, 2, 3));
              i + 4 <= nraw && _mm_movemask_epi8(_mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)(up + i)), ids)) == 0xffff;
              i += 4)
             ids = _mm_add_epi32(ids, step4);
-        if (i == nraw)
-            break;
 #endif
-        const uint32_t r = up[up[i]];   /* up[i] < i is a root already, or points at one */
-        if (r == i)
-            continue;
-        up[i] = r;
-        flag[i] = SHARED;
-        if (!flag[r])   /* the root's first joined sample (a collapsed row's first sample has na - 1 more) */
-            flag[r] = SHARED, vof[r] = pid[r] = UINT32_MAX;
-        memcpy(P + 3 * i, P + 3 * (size_t)r, 3 * sizeof *P);
+        /* the next 4 one at a time (a run of joined samples, a collapsed row's or a seam's, costs no 4-test each) */
+        for (const size_t end = i + 4 < nraw ? i + 4 : nraw; i < end; i++) {
+            const uint32_t r = up[up[i]];   /* up[i] < i is a root already, or points at one */
+            if (r == i)
+                continue;
+            up[i] = r;
+            flag[i] = SHARED;
+            if (!flag[r])   /* the root's first joined sample (a collapsed row's first sample has na - 1 more) */
+                flag[r] = SHARED, vof[r] = pid[r] = UINT32_MAX;
+            memcpy(P + 3 * i, P + 3 * (size_t)r, 3 * sizeof *P);
+        }
     }
     if (stopped(cancel)) {
         cancelled = 1;
