@@ -268,8 +268,23 @@ static void emit(float *out, size_t nu, const double *const tab[3], const double
         float *restrict o = out;
         size_t i = 0;
 #if defined(__SSE2__)
-        /* two points a step: the same products, rounded to float as below, interleaved */
+        /* four, then two points a step: the same products, rounded to float as below, interleaved */
         const __m128d K0 = _mm_set1_pd(k0), K1 = _mm_set1_pd(k1), K2 = _mm_set1_pd(k2);
+        for (; i + 4 <= nu; i += 4) {   /* four points: x, y, z of each as below, then interleaved */
+            const __m128 x = _mm_movelh_ps(_mm_cvtpd_ps(_mm_mul_pd(K0, _mm_loadu_pd(t0 + i))),
+                                           _mm_cvtpd_ps(_mm_mul_pd(K0, _mm_loadu_pd(t0 + i + 2))));
+            const __m128 y = _mm_movelh_ps(_mm_cvtpd_ps(_mm_mul_pd(K1, _mm_loadu_pd(t1 + i))),
+                                           _mm_cvtpd_ps(_mm_mul_pd(K1, _mm_loadu_pd(t1 + i + 2))));
+            const __m128 z = _mm_movelh_ps(_mm_cvtpd_ps(_mm_mul_pd(K2, _mm_loadu_pd(t2 + i))),
+                                           _mm_cvtpd_ps(_mm_mul_pd(K2, _mm_loadu_pd(t2 + i + 2))));
+            const __m128 xy = _mm_unpacklo_ps(x, y), xy2 = _mm_unpackhi_ps(x, y);         /* x0 y0 x1 y1, x2 y2 x3 y3 */
+            const __m128 zx = _mm_shuffle_ps(z, x, _MM_SHUFFLE(1, 1, 0, 0));                /* z0 z0 x1 x1 */
+            const __m128 yz = _mm_shuffle_ps(y, z, _MM_SHUFFLE(1, 1, 1, 1));                /* y1 y1 z1 z1 */
+            const __m128 zxy = _mm_shuffle_ps(z, xy2, _MM_SHUFFLE(3, 2, 3, 2));             /* z2 z3 x3 y3 */
+            _mm_storeu_ps(o + 3 * i, _mm_shuffle_ps(xy, zx, _MM_SHUFFLE(2, 0, 1, 0)));      /* x0 y0 z0 x1 */
+            _mm_storeu_ps(o + 3 * i + 4, _mm_shuffle_ps(yz, xy2, _MM_SHUFFLE(1, 0, 2, 0))); /* y1 z1 x2 y2 */
+            _mm_storeu_ps(o + 3 * i + 8, _mm_shuffle_ps(zxy, zxy, _MM_SHUFFLE(1, 3, 2, 0))); /* z2 x3 y3 z3 */
+        }
         for (; i + 2 <= nu; i += 2) {
             const __m128 x = _mm_cvtpd_ps(_mm_mul_pd(K0, _mm_loadu_pd(t0 + i)));
             const __m128 y = _mm_cvtpd_ps(_mm_mul_pd(K1, _mm_loadu_pd(t1 + i)));
