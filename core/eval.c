@@ -301,8 +301,23 @@ static void emit(float *out, size_t nu, const double *const tab[3], const double
         float *restrict o = out;
         size_t i = 0;
 #if defined(__SSE2__)
-        /* two points a step: the same products, rounded to float as below, interleaved */
+        /* four, then two points a step: the same products, rounded to float as below, interleaved */
         const __m128d K0 = _mm_set1_pd(k0), K1 = _mm_set1_pd(k1), K2 = _mm_set1_pd(k2);
+        for (; i + 4 <= nu; i += 4) {   /* four points: x, y, z of each as below, then interleaved */
+            const __m128 x = _mm_movelh_ps(_mm_cvtpd_ps(_mm_mul_pd(K0, _mm_loadu_pd(t0 + i))),
+                                           _mm_cvtpd_ps(_mm_mul_pd(K0, _mm_loadu_pd(t0 + i + 2))));
+            const __m128 y = _mm_movelh_ps(_mm_cvtpd_ps(_mm_mul_pd(K1, _mm_loadu_pd(t1 + i))),
+                                           _mm_cvtpd_ps(_mm_mul_pd(K1, _mm_loadu_pd(t1 + i + 2))));
+            const __m128 z = _mm_movelh_ps(_mm_cvtpd_ps(_mm_mul_pd(K2, _mm_loadu_pd(t2 + i))),
+                                           _mm_cvtpd_ps(_mm_mul_pd(K2, _mm_loadu_pd(t2 + i + 2))));
+            const __m128 xy = _mm_unpacklo_ps(x, y), xy2 = _mm_unpackhi_ps(x, y);         /* x0 y0 x1 y1, x2 y2 x3 y3 */
+            const __m128 zx = _mm_shuffle_ps(z, x, _MM_SHUFFLE(1, 1, 0, 0));                /* z0 z0 x1 x1 */
+            const __m128 yz = _mm_shuffle_ps(y, z, _MM_SHUFFLE(1, 1, 1, 1));                /* y1 y1 z1 z1 */
+            const __m128 zxy = _mm_shuffle_ps(z, xy2, _MM_SHUFFLE(3, 2, 3, 2));             /* z2 z3 x3 y3 */
+            _mm_storeu_ps(o + 3 * i, _mm_shuffle_ps(xy, zx, _MM_SHUFFLE(2, 0, 1, 0)));      /* x0 y0 z0 x1 */
+            _mm_storeu_ps(o + 3 * i + 4, _mm_shuffle_ps(yz, xy2, _MM_SHUFFLE(1, 0, 2, 0))); /* y1 z1 x2 y2 */
+            _mm_storeu_ps(o + 3 * i + 8, _mm_shuffle_ps(zxy, zxy, _MM_SHUFFLE(1, 3, 2, 0))); /* z2 x3 y3 z3 */
+        }
         for (; i + 2 <= nu; i += 2) {
             const __m128 x = _mm_cvtpd_ps(_mm_mul_pd(K0, _mm_loadu_pd(t0 + i)));
             const __m128 y = _mm_cvtpd_ps(_mm_mul_pd(K1, _mm_loadu_pd(t1 + i)));
@@ -341,6 +356,41 @@ static inline float dot_k(const double *k, size_t ks, const double *t, size_t ts
     return (float)s;
 }
 
+#if defined(__SSE2__)
+/* col_coefs' sums for the 8 rows from j of u-factor d, in registers: kx[s i] for row j + i (kv, kw likewise). */
+static inline void col_block(const pde_grid *g, int c, size_t d, size_t j, int xonly, size_t s, double *restrict kx,
+                             double *restrict kv, double *restrict kw)
+{
+    const size_t nm = g->nm[c], nv = g->nv;
+    __m128d ax[4], av[4], aw[4];
+    for (int q = 0; q < 4; q++)
+        ax[q] = av[q] = aw[q] = _mm_setzero_pd();
+    for (size_t m = 0; m < nm; m++) {
+        if (g->group[c][m] != d)
+            continue;
+        const __m128d h = _mm_set1_pd(g->h[c][m]), dh = _mm_set1_pd(g->dh[c][m]);
+        const double *p = g->psi[c] + m * nv + j, *dp = g->dpsi[c] + m * nv + j;
+        if (xonly)
+            for (int q = 0; q < 4; q++)
+                ax[q] = _mm_add_pd(ax[q], _mm_mul_pd(h, _mm_loadu_pd(p + 2 * q)));
+        else
+            for (int q = 0; q < 4; q++) {
+                const __m128d pq = _mm_loadu_pd(p + 2 * q);
+                ax[q] = _mm_add_pd(ax[q], _mm_mul_pd(h, pq));
+                av[q] = _mm_add_pd(av[q], _mm_mul_pd(h, _mm_loadu_pd(dp + 2 * q)));
+                aw[q] = _mm_add_pd(aw[q], _mm_mul_pd(dh, pq));
+            }
+    }
+    for (size_t q = 0; q < 4; q++) {
+        _mm_storel_pd(kx + s * 2 * q, ax[q]), _mm_storeh_pd(kx + s * (2 * q + 1), ax[q]);
+        if (!xonly) {
+            _mm_storel_pd(kv + s * 2 * q, av[q]), _mm_storeh_pd(kv + s * (2 * q + 1), av[q]);
+            _mm_storel_pd(kw + s * 2 * q, aw[q]), _mm_storeh_pd(kw + s * (2 * q + 1), aw[q]);
+        }
+    }
+}
+#endif
+
 /*
  * Component c's coefficients of rows j0 .. j0 + n - 1 of a narrow grid, grid_coefs' sums in the same order: u-factor d's
  * of row j at kx[s (d n + j)] (kv, kw likewise; not written when xonly), BLK rows at a time in registers, summed over
@@ -354,6 +404,12 @@ static void col_coefs(const pde_grid *g, int c, size_t j0, size_t n, int xonly, 
     for (size_t d = 0; d < nd; d++)
         for (size_t jb = 0; jb < n; jb += BLK) {
             const size_t nb = n - jb < BLK ? n - jb : BLK;
+#if defined(__SSE2__)
+            if (nb == BLK) {   /* the loops below, two rows to a pair of lanes: the same products and sums */
+                col_block(g, c, d, j0 + jb, xonly, s, kx + s * (d * n + jb), kv + s * (d * n + jb), kw + s * (d * n + jb));
+                continue;
+            }
+#endif
             double ax[BLK] = { 0 }, av[BLK] = { 0 }, aw[BLK] = { 0 };
             for (size_t m = 0; m < nm; m++) {
                 if (g->group[c][m] != d)
