@@ -737,24 +737,21 @@ static void expect_props_match_reference(const char *name, const pde_props *p, c
      * and 3d do not, but x is linear in u: lines along u are exact between the closed-form roots of
      * det J, and the (v, w) panels are refined (core/quad.c). All come within 1e-9 (run under the
      * sanitisers with PDESOLID_SLOW_TESTS=1). */
-    const double tol = 1e-9, area_tol = 3e-8;
+    const double tol = 1e-9;
     double imax = 0, size = cbrt(r->volume);
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
             imax = fmax(imax, fabs(r->inertia[i][j]));
-#define EXPECT_TOL(what, got, want, floor, t)                                                               \
+#define EXPECT(what, got, want, floor)                                                                      \
     do {                                                                                                   \
-        if (!close_rel((got), (want), (t), (floor)))                                                       \
+        if (!close_rel((got), (want), tol, (floor)))                                                       \
             fail_msg("%s: %s = %.15g, reference %.15g", name, what, (double)(got), (double)(want));        \
     } while (0)
-#define EXPECT(what, got, want, floor) EXPECT_TOL(what, got, want, floor, tol)
     EXPECT("volume", p->volume, r->volume, 0);
     EXPECT("signed_volume", p->signed_volume, r->signed_volume, r->volume);
-    /* The area element vanishes at points of a skin (cusps of a skin that folds, cone points)
-     * where core/quad.c's refinement of a face's panels converges slowly: within 3e-8 (fig. 2c:
-     * 1.5e-8, where the fold is rounded: |x_v x x_w| dips to 1e-4 of its largest without
-     * vanishing). Issue 9 leaves 1e-9 open there; fig. 4a is within 2e-11. */
-    EXPECT_TOL("surface_area", p->surface_area, r->surface_area, 0, area_tol);
+    /* The area too, where the element vanishes (cusps of a skin that folds, cone points) or nearly
+     * (fig. 2c's rounded fold: |x_v x x_w| dips to 1e-4 of its largest; it was 1.5e-8 off). */
+    EXPECT("surface_area", p->surface_area, r->surface_area, 0);
     for (int i = 0; i < 3; i++) {
         EXPECT("centroid", p->centroid[i], r->centroid[i], size);
         EXPECT("principal_moments", p->principal_moments[i], r->principal_moments[i], imax);
@@ -762,7 +759,6 @@ static void expect_props_match_reference(const char *name, const pde_props *p, c
             EXPECT("inertia", p->inertia[i][j], r->inertia[i][j], imax);
     }
 #undef EXPECT
-#undef EXPECT_TOL
     assert_int_equal(!!p->folds, r->volume - fabs(r->signed_volume) > 1e-9 * r->volume);
     /* The reported error of the integrals covers what they are off by (the reference: within 1e-12), and
      * is near rounding where the rules resolve the solid (all but fig. 3). */
