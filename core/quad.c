@@ -26,6 +26,10 @@
  * and the integrals over t are exact (separable_moments); so do the skin's
  * faces whose element separates too (face_separates).
  *
+ * The skin's faces run on lines the same way, with |x_a x x_b| for |det J|: cut at the roots of its
+ * component along its direction (a cuspidal edge), and where a fold is rounded (the element dips
+ * near 0 without vanishing) at the located least, with pieces graded towards it (face_toward).
+ *
  * Each panel tabulates every mode's factor of each axis at its rules' points
  * once (axis_tab), so a point on a line is four multiply-adds per mode; only
  * roots, dips and the rules of pieces between roots evaluate factors afresh.

@@ -971,6 +971,37 @@ static void reference_surface_area_should_agree_with_the_mesh_of_every_preset(vo
     print_message("largest relative difference of mesh and reference areas: %.3g\n", worst);
 }
 
+/*
+ * fig3a's face w = 0 is flat (z = Z(0)) with the element x_u x x_v = u (0, 0, g(v)), |g| with 18 kinks,
+ * the same on every line: the reference's adaptive Gauss-Kronrod missed 3.1e-7 of it (2.3e-7 of the
+ * face) at every tolerance until it cut its lines at the element's least values. Against half the
+ * midpoint sum of |g| over 2e5 points (1e-11 off that of 4e6 points).
+ */
+static void reference_surface_area_should_match_a_midpoint_sum_on_a_face_with_kinks(void **state)
+{
+    (void)state;
+    pde_solution *sol = preset_solution("fig3a");
+    const ref_props_out *r = preset_ref(preset_index("fig3a"), sol);
+    enum { N = 200000 };
+    double sum = 0, x[3], xu[3], xv[3], xw[3];
+    for (int j = 0; j < N; j++) {
+        pde_eval_d(sol, 1, (j + 0.5) / N, 0, x, xu, xv, xw);
+        sum += fabs(xu[0] * xv[1] - xu[1] * xv[0]);
+        assert_true(xu[2] == 0 && xv[2] == 0);
+    }
+    for (int k = 1; k < 8; k++) {   /* the element is u times its value at u = 1 */
+        double g1, gu, v = k / 8.0 + 0.01, u = k / 9.0;
+        pde_eval_d(sol, 1, v, 0, x, xu, xv, xw);
+        g1 = xu[0] * xv[1] - xu[1] * xv[0];
+        pde_eval_d(sol, u, v, 0, x, xu, xv, xw);
+        gu = xu[0] * xv[1] - xu[1] * xv[0];
+        assert_true(close_rel(gu, u * g1, 1e-12, fabs(g1)));
+    }
+    if (!close_rel(r->face_area[4], 0.5 * sum / N, 1e-9, 0))
+        fail_msg("fig3a face w = 0: reference %.15g, midpoint sum %.15g", r->face_area[4], 0.5 * sum / N);
+    pde_solution_free(sol);
+}
+
 /* x, y, z (what 0..2) or det J (3) at p. */
 static double sample_at(const pde_solution *sol, int what, const double p[3])
 {
@@ -1278,6 +1309,7 @@ int main(void)
         cmocka_unit_test(reference_quadrature_should_match_the_hand_derived_cuboid_and_frustum),
         cmocka_unit_test(reference_quadrature_should_match_the_160_digit_volume_of_fig4a_which_folds),
         cmocka_unit_test(reference_surface_area_should_agree_with_the_mesh_of_every_preset),
+        cmocka_unit_test(reference_surface_area_should_match_a_midpoint_sum_on_a_face_with_kinks),
         cmocka_unit_test(props_should_give_the_cuboid_of_figure_1a_its_hand_derived_mass_properties),
         cmocka_unit_test(props_should_give_the_square_frustum_of_figure_1c_its_hand_derived_mass_properties),
         cmocka_unit_test(props_should_match_the_160_digit_volume_of_fig4a_which_folds),
