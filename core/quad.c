@@ -26,6 +26,10 @@
  * and the integrals over t are exact (separable_moments); so do the skin's
  * faces whose element separates too (face_separates).
  *
+ * The skin's faces run on lines the same way, with |x_a x x_b| for |det J|: cut at the roots of its
+ * component along its direction (a cuspidal edge), and where a fold is rounded (the element dips
+ * near 0 without vanishing) at the located least, with pieces graded towards it (face_toward).
+ *
  * Each panel tabulates every mode's factor of each axis at its rules' points
  * once (axis_tab), so a point on a line is four multiply-adds per mode; only
  * roots, dips and the rules of pieces between roots evaluate factors afresh.
@@ -52,6 +56,11 @@
 #define FACE_DEEP 30.0        /* (fig. 4a: two panels at a cusp of the fold, 8.7e-7 apart at depth 4) */
 #define FACE_EST 1e4          /* a face panel whose estimate is below this times the tolerance is not split */
 #define FACE_EST_MIN 0.3      /* ... unless its element falls below this of its largest at the nodes */
+#define GRADE_RATIO 0.15      /* a rounded fold: pieces graded towards its least, each this of the distance left, */
+#define GRADE_POINTS 10       /* ... the first with this rule, each next with 2 points fewer, 4 at least */
+#define GRADE_LEVELS 12       /* ... this many pieces at most */
+#define GRADE_MIN 1e-7        /* ... where the least is above this of the line's largest (below, |t| there) */
+#define DIP_WORK (0.7 * OFF_WORK)   /* ... while the points off the tables stay below this (the rest: roots) */
 /* Face panels refined, at most: every panel of the six faces. At 256 (fig. 4's, not all of fig. 3's),
  * fig. 3d's area was 6.6e-8 off the reference, now 2.4e-10 (fig. 3c: 7.3e-10 -> 8e-13) for 6% and 8%
  * more instructions; REFINE_WORK bounds the work. */
@@ -134,6 +143,13 @@ static int off_budget(qctx *q)
         return 1;
     q->r.roots_skipped = 1;
     return 0;
+}
+
+/* A face's rounded folds (face_toward) take DIP_WORK at most: the rest is for the roots (fig. 3b's
+ * face u = 1 took it all once, and its faces w = 0 and 1 were 1e-3 off without their roots). */
+static int dip_budget(const qctx *q)
+{
+    return q->off_evals * q->modes < DIP_WORK;
 }
 
 /* Gauss-Legendre nodes and weights on [0, 1], by Newton on P_n. */
@@ -1393,29 +1409,110 @@ static double legendre_tail(const double *f, int n)
     return fabs(a[0]) + fabs(a[1]);
 }
 
+/* The n-point rule's sum of the element over [a, b] (either order), off the tables. */
+static double face_rule(const face_line *f, double a, double b, int n)
+{
+    double sum = 0.0, dummy;
+    for (int i = 0; i < n; i++)
+        sum += f->q->gw[n][i] * face_elem(f, a + (b - a) * f->q->gx[n][i], &dummy);
+    return fabs(b - a) * sum;
+}
+
+/*
+ * A rounded fold: where |x_a x x_b| has a minimum m > 0 at c, it is about sqrt(m^2 + g^2 (t - c)^2),
+ * smooth only on the scale m / g (fig. 2c: 1e-4 of its largest, 3e-4 wide in w), and a rule over
+ * [far, c] loses its order. So pieces graded geometrically towards c (each GRADE_RATIO of the
+ * distance left), until the element at the piece's start is within twice m: the rest is smooth on
+ * its own scale. The error falls exponentially with the pieces (hp-style), and the nearer pieces,
+ * which hold less of the integral, take fewer points.
+ */
+static double face_toward(const face_line *f, double far, double c, double m)
+{
+    double sum = 0.0, lo = far, dummy;
+    int np = GRADE_POINTS;
+    for (int k = 0; k < GRADE_LEVELS && dip_budget(f->q) && face_elem(f, lo, &dummy) > 2.0 * m; k++) {
+        const double e = c - GRADE_RATIO * (c - lo);
+        sum += face_rule(f, lo, e, np);
+        lo = e;
+        np = np > 6 ? np - 2 : 4;
+    }
+    return sum + face_rule(f, lo, c, np);
+}
+
+/* |x_a x x_b|'s least in [a, b], bracketed by the samples, by golden section on its square (smooth,
+ * where the element itself has a kink at a cusp), to a bracket well inside the dip's width: *m the
+ * least. */
+static double face_min(const face_line *f, double a, double b, double *m)
+{
+    const double g = 0.5 * (3.0 - sqrt(5.0)), len = b - a;
+    double dummy, c = a + g * (b - a), d = b - g * (b - a);
+    double fc = face_elem(f, c, &dummy), fd = face_elem(f, d, &dummy);
+    const double slope = fmax(face_elem(f, a, &dummy), face_elem(f, b, &dummy)) / len;
+    for (int it = 0; it < 60 && b - a > 1e-12 * len && (b - a) * slope > 0.2 * fmin(fc, fd); it++) {
+        if (fc < fd) {
+            b = d, d = c, fd = fc;
+            c = a + g * (b - a);
+            fc = face_elem(f, c, &dummy);
+        } else {
+            a = c, c = d, fc = fd;
+            d = b - g * (b - a);
+            fd = face_elem(f, d, &dummy);
+        }
+    }
+    *m = fmin(fc, fd);
+    return fc < fd ? c : d;
+}
+
 /* The integral of |x_a x x_b| along the current line over the panel [a, b], with the table's n-point
  * rule at its nodes; and the flux's (smooth: the rule alone) into *flux, into *tail a bound on the
- * rule's error on the element (legendre_tail; infinite where the element changes sign), and the
- * element's values at the nodes widen range [min, max]. */
+ * rule's error on the element (legendre_tail; infinite where the element changes sign or dips), and
+ * the element's values at the nodes widen range [min, max]. The line is cut at the roots of the
+ * element's component along nu and at the least of every dip of the element below FACE_EST_MIN of
+ * its largest, and each piece's rule graded towards a cut where the element stays above GRADE_MIN
+ * of its largest there (face_toward). */
 static double face_line_integral(const face_line *f, double a, double b, int n, const double *gw, double *flux,
                                  double *tail, double range[2])
 {
-    double v[GMAX + 2] = { 0 }, sd[GMAX + 2], fl[GMAX + 2];
+    double v[GMAX + 2] = { 0 }, sd[GMAX + 2], fl[GMAX + 2], vmax = 0.0;
     const double *t = f->q->tab[f->q->k].t;
-    for (int i = 0; i < n + 2; i++)
+    for (int i = 0; i < n + 2; i++) {
         v[i] = face_elem_at(f, i, &sd[i], &fl[i]);
+        vmax = fmax(vmax, v[i]);
+    }
     *flux = 0.0;
     for (int i = 0; i < n; i++)
         *flux += (b - a) * gw[i] * fl[i + 1];
-    double cut[GMAX + 2], sum = 0.0;
-    int ncut = 0, last = 0;
+    /* cuts: cut[0] = a, cut[ncut - 1] = b; cm[k] the element there where graded towards, else -1 */
+    double cut[3 * GMAX], cm[3 * GMAX], sum = 0.0, dummy;
+    int ncut = 1, last = 0, crossed[GMAX + 2] = { 0 }, at_b = 0;
+    cut[0] = a, cm[0] = -1.0;
+    const double floor = GRADE_MIN * vmax;
     for (int i = 1; i < n + 2 && off_budget(f->q); i++) {
-        if (sign_changes(sd[last], sd[i], f->tol))
-            cut[ncut++] = face_root(f, t[last], t[i], sd[last], sd[i]);
+        if (sign_changes(sd[last], sd[i], f->tol)) {
+            cut[ncut] = face_root(f, t[last], t[i], sd[last], sd[i]);
+            const double m = face_elem(f, cut[ncut], &dummy);
+            cm[ncut++] = m > floor ? m : -1.0;
+            crossed[last] = crossed[i] = 1;
+        }
         if (fabs(sd[i]) > f->tol || fabs(sd[last]) <= f->tol)
             last = i;
     }
-    if (!ncut) {
+    for (int i = 0; i < n + 2 && dip_budget(f->q); i++) {
+        const int l = i > 0 ? i - 1 : 0, r = i < n + 1 ? i + 1 : n + 1;
+        if (!(v[i] < FACE_EST_MIN * vmax && v[i] > floor && v[i] <= v[l] && v[i] <= v[r]) || crossed[i] ||
+            crossed[l] || crossed[r])
+            continue;
+        double m, at = face_min(f, t[l], t[r], &m);
+        if (!(m > floor))
+            continue;
+        if (at - a <= 1e-9 * (b - a))
+            cm[0] = m;
+        else if (b - at > 1e-9 * (b - a))
+            cut[ncut] = at, cm[ncut++] = m;
+        else if (!at_b)
+            cut[ncut] = b, cm[ncut++] = m, at_b = 1;
+    }
+    if (ncut == 1 && cm[0] < 0.0) {
         for (int i = 0; i < n; i++) {
             sum += (b - a) * gw[i] * v[i + 1];
             range[0] = fmin(range[0], v[i + 1]), range[1] = fmax(range[1], v[i + 1]);
@@ -1424,14 +1521,26 @@ static double face_line_integral(const face_line *f, double a, double b, int n, 
         return sum;
     }
     *tail = INFINITY;
-    double t0 = a, dummy;
-    for (int c = 0; c <= ncut; c++) {
-        double t1 = c < ncut ? cut[c] : b;
+    if (!at_b)
+        cut[ncut] = b, cm[ncut++] = -1.0;
+    for (int i = 1; i < ncut; i++)   /* in order: few cuts, an insertion sort */
+        for (int j = i; j > 1 && cut[j] < cut[j - 1]; j--) {
+            double tc = cut[j], tm = cm[j];
+            cut[j] = cut[j - 1], cm[j] = cm[j - 1];
+            cut[j - 1] = tc, cm[j - 1] = tm;
+        }
+    for (int c = 0; c + 1 < ncut; c++) {
+        const double t0 = cut[c], t1 = cut[c + 1], mid = 0.5 * (t0 + t1);
         if (!(t1 > t0))
             continue;
-        for (int i = 0; i < n; i++)   /* the panel's rule: the element's root is a kink of sqrt */
-            sum += (t1 - t0) * gw[i] * face_elem(f, t0 + (t1 - t0) * f->q->gx[n][i], &dummy);
-        t0 = t1;
+        if (cm[c] < 0.0 && cm[c + 1] < 0.0)
+            sum += face_rule(f, t0, t1, n);   /* the panel's rule: the element's root is a kink of sqrt */
+        else if (cm[c] < 0.0)
+            sum += face_toward(f, t0, t1, cm[c + 1]);
+        else if (cm[c + 1] < 0.0)
+            sum += face_toward(f, t1, t0, cm[c]);
+        else
+            sum += face_toward(f, mid, t0, cm[c]) + face_toward(f, mid, t1, cm[c + 1]);
     }
     return sum;
 }
@@ -1482,21 +1591,28 @@ static double face_panel(face_ctx *c, const double lo[2], const double h[2], dou
         f->nu[k] = nn > 0 ? f->nu[k] / nn : (k == 2);
     /* Sampled evenly, not at the rules' nodes: the lines' direction decides how well a cuspidal
      * edge is integrated (fig. 3a's area moved by 1.5e-7 when sampled at the nodes). */
-    double sd[S][S];
+    double sd[S][S], el[S][S], least = INFINITY;
     for (int i = 0; i < S; i++)
         for (int j = 0; j < S; j++) {
             double d[3][3];
             at[f->o[0]] = i, at[f->o[1]] = j;
             tab_partials(q, at, d);
-            big = fmax(big, face_elem_of(f, d, &sd[i][j]));
+            el[i][j] = face_elem_of(f, d, &sd[i][j]);
+            big = fmax(big, el[i][j]), least = fmin(least, el[i][j]);
         }
     f->tol = 1e-13 * big;
     int cross[2] = { 0, 0 };
+    double vary[2] = { 0, 0 };
     for (int i = 0; i < S; i++)
         for (int j = 0; j + 1 < S; j++) {
             cross[0] += sign_changes(sd[j][i], sd[j + 1][i], f->tol);
             cross[1] += sign_changes(sd[i][j], sd[i][j + 1], f->tol);
+            vary[0] += fabs(el[j + 1][i] - el[j][i]), vary[1] += fabs(el[i][j + 1] - el[i][j]);
         }
+    /* Where the element dips and no fold decides, the lines run across the valley, along the parameter
+     * the element varies along most (fig. 2c: across the rounded fold) */
+    if (cross[0] == cross[1] && least < FACE_EST_MIN * big)
+        cross[1] += vary[1] > vary[0], cross[0] += vary[0] > vary[1];
     f->la = c->flat >= 0 ? 1 - c->flat : cross[1] > cross[0];
     const int lb = 1 - f->la, na = rule_points(c->f[f->la] * h[f->la]);
     const int nb = lb == c->flat ? 1 : rule_points(c->f[lb] * h[lb]);
