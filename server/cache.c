@@ -9,6 +9,7 @@
  * and the list; an unlinked entry is freed when its last reference goes.
  */
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -27,6 +28,8 @@ struct srv_entry {
     pthread_mutex_t props_lock;   /* one computes the properties; the others wait for them */
     pde_props props;
     int props_ok;
+    _Atomic unsigned long long shown[8];   /* representations opened once (srv_entry_shown), a ring */
+    atomic_uint shown_next;
 };
 
 #define BUCKETS 4096
@@ -260,6 +263,27 @@ const pde_props *srv_entry_props(srv_entry *e, const pde_cancel *cancel, int *ca
 }
 
 /* Whether the properties are there already (then they cost nothing). */
+/* FNV-1a of a representation's name, never 0 (an empty slot) */
+static unsigned long long rep_hash(const char *rep)
+{
+    unsigned long long h = 14695981039346656037ull;
+    for (; *rep; rep++)
+        h = (h ^ (unsigned char)*rep) * 1099511628211ull;
+    return h ? h : 1;
+}
+
+int srv_entry_shown(srv_entry *e, const char *rep, int mark)
+{
+    const unsigned long long h = rep_hash(rep);
+    for (size_t i = 0; i < sizeof e->shown / sizeof *e->shown; i++)
+        if (atomic_load_explicit(&e->shown[i], memory_order_relaxed) == h)
+            return 1;
+    if (mark)
+        atomic_store_explicit(&e->shown[atomic_fetch_add(&e->shown_next, 1) % (sizeof e->shown / sizeof *e->shown)], h,
+                              memory_order_relaxed);
+    return 0;
+}
+
 int srv_entry_has_props(srv_entry *e)
 {
     pthread_mutex_lock(&e->props_lock);

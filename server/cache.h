@@ -48,6 +48,10 @@ const char *srv_entry_id(const srv_entry *e);
 const pde_props *srv_entry_props(srv_entry *e, const pde_cancel *cancel, int *cancelled);
 /* 1 if the properties are computed already. */
 int srv_entry_has_props(srv_entry *e);
+/* 1 if the representation rep (its ETag) of the entry was opened before: the last 8 are kept, by a 64-bit
+ * hash. With mark, a rep not seen is recorded. So a revalidation (If-None-Match) of an output known to open
+ * answers 304 without building it again. */
+int srv_entry_shown(srv_entry *e, const char *rep, int mark);
 
 void srv_cache_stats_get(srv_cache *c, srv_cache_stats *out);
 

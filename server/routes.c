@@ -167,6 +167,21 @@ static int solve_model(void *arg, pde_solution **out, api_error *err)
 
 static void answer_heavy(srv_req *r, srv_entry *e);
 
+/* 304 Not Modified, releasing e, when If-None-Match names this request's representation (or is *) and the
+ * output is known to exist: opened by this request (opened), or by one before. An ETag (or *) of an output
+ * that is refused (a limit, float32, no skin) names no representation, and the refusal is the answer. */
+static int revalidated(srv_req *r, srv_entry *e, int opened)
+{
+    const int shown = srv_entry_shown(e, r->etag, opened);
+    const char *inm = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
+    if (!inm || !(opened || shown) || !(strstr(inm, r->etag) || !strcmp(inm, "*")))
+        return 0;
+    srv_cache_release(r->s->cache, e);
+    r->status = 304;
+    r->ctype = NULL;
+    return 1;
+}
+
 /* The response of a solved entry: its ETag and the budget's checks, then answer_heavy() now or, when the
  * estimate is --heavy-work or more, apart from lighter requests (pool.h). Takes over the reference. */
 static void answer_entry(srv_req *r, srv_entry *e)
@@ -178,6 +193,8 @@ static void answer_entry(srv_req *r, srv_entry *e)
     api_output_opts opts = { .compress = r->q.comp };
     snprintf(r->etag, sizeof r->etag, "\"%s.%s%s%s.%ux%ux%u\"", r->id, api_format_info_of(f)->name,
              opts.compress ? "." : "", opts.compress ? api_compress_name(opts.compress) : "", res[0], res[1], res[2]);
+    if (revalidated(r, e, 0))
+        return;
     const pde_solution *sol = srv_entry_solution(e);
     int with_props = api_format_info_of(f)->props;
     api_cost part;
@@ -227,14 +244,8 @@ static void answer_heavy(srv_req *r, srv_entry *e)
         failed(r, &err);
         return;
     }
-    /* Not modified only once the output is known to exist: an ETag (or *) of an output this request is
-     * refused (a limit, float32, no skin) names no representation, and the refusal is the answer. */
-    const char *inm = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_IF_NONE_MATCH);
-    if (inm && (strstr(inm, r->etag) || !strcmp(inm, "*"))) {
+    if (revalidated(r, e, 1)) {
         api_output_free(o);
-        srv_cache_release(s->cache, e);
-        r->status = 304;
-        r->ctype = NULL;
         return;
     }
     r->status = 200;
