@@ -292,10 +292,14 @@ static void timestamps_should_be_rfc3339_utc_at_the_time_of_writing(void **state
     (void)state;
     srv_log_rec r = { .ip = "127.0.0.1", .method = "GET", .path = "/", .status = 200 };
     for (int fmt = 0; fmt < 2; fmt++) {
-        time_t before = time(NULL);
+        /* The log's clock, CLOCK_REALTIME: time() reads the coarse clock, a tick behind, and failed this test
+         * in CI when a second turned between them (stamp ...409.004, time() still ...408). */
+        struct timespec t0, t1;
+        clock_gettime(CLOCK_REALTIME, &t0);
         size_t n;
         char *b = log_one(fmt ? SRV_LOG_JSON : SRV_LOG_TEXT, &r, &n);
-        time_t after = time(NULL);
+        clock_gettime(CLOCK_REALTIME, &t1);
+        const time_t before = t0.tv_sec, after = t1.tv_sec;
         char stamp[64];
         if (fmt) {
             cJSON *j = cJSON_Parse(b);
