@@ -42,12 +42,18 @@ struct srv_cache {
     srv_entry *head, *tail;        /* most recently used first */
 };
 
+/* FNV-1a: ids' buckets, and representations' names (srv_entry_shown) */
+static unsigned long long fnv1a(const char *s)
+{
+    unsigned long long h = 14695981039346656037ull;
+    for (; *s; s++)
+        h = (h ^ (unsigned char)*s) * 1099511628211ull;
+    return h;
+}
+
 static size_t bucket_of(const char *id)
 {
-    size_t h = 14695981039346656037ull;
-    for (; *id; id++)
-        h = (h ^ (unsigned char)*id) * 1099511628211ull;
-    return h % BUCKETS;
+    return (size_t)(fnv1a(id) % BUCKETS);
 }
 
 srv_cache *srv_cache_create(size_t max_bytes)
@@ -262,19 +268,9 @@ const pde_props *srv_entry_props(srv_entry *e, const pde_cancel *cancel, int *ca
     return e->props_ok ? &e->props : NULL;
 }
 
-/* Whether the properties are there already (then they cost nothing). */
-/* FNV-1a of a representation's name, never 0 (an empty slot) */
-static unsigned long long rep_hash(const char *rep)
-{
-    unsigned long long h = 14695981039346656037ull;
-    for (; *rep; rep++)
-        h = (h ^ (unsigned char)*rep) * 1099511628211ull;
-    return h ? h : 1;
-}
-
 int srv_entry_shown(srv_entry *e, const char *rep, int mark)
 {
-    const unsigned long long h = rep_hash(rep);
+    const unsigned long long h = fnv1a(rep) | 1;   /* never 0, an empty slot */
     for (size_t i = 0; i < sizeof e->shown / sizeof *e->shown; i++)
         if (atomic_load_explicit(&e->shown[i], memory_order_relaxed) == h)
             return 1;
@@ -284,6 +280,7 @@ int srv_entry_shown(srv_entry *e, const char *rep, int mark)
     return 0;
 }
 
+/* Whether the properties are there already (then they cost nothing). */
 int srv_entry_has_props(srv_entry *e)
 {
     pthread_mutex_lock(&e->props_lock);
