@@ -34,9 +34,9 @@ void srv_pool_submit(srv_pool *p, srv_job_fn fn, void *arg);
  * reserved places; 0, or -1 when all extra places are taken. */
 int srv_pool_push(srv_pool *p, srv_job_fn fn, void *arg);
 /* Queues fn(arg), the heavy remainder of a job that has ended, apart from the queue (above); at most
- * limit wait. 0, or -1 when limit wait already or every thread is past its last job (a job that defers runs
- * on a thread, so while stopping its part is still taken, and sees the server stopping). Call it as the job's last act:
- * fn may run at once on another thread. */
+ * limit wait. 0, or -1 when limit wait already or every thread is past its last job (a job that defers
+ * runs on a thread, so while stopping its part is still taken, and sees the server stopping). Call it as
+ * the job's last act: fn may run at once on another thread. */
 int srv_pool_defer_heavy(srv_pool *p, srv_job_fn fn, void *arg, size_t limit);
 /* Jobs waiting or running now. */
 size_t srv_pool_depth(srv_pool *p);
