@@ -12,9 +12,11 @@
 #include <unistd.h>
 
 #include "config.h"
+#include "host.h"
 
 typedef enum {
     K_STR,       /* char array; lo is the least length */
+    K_HOSTS,     /* char array: host names, comma-separated, or * (host.h) */
     K_UNSIGNED,  /* unsigned, a whole number in [lo, hi] */
     K_INT,       /* int, a whole number in [lo, hi] */
     K_COUNT,     /* size_t, a whole number in [lo, hi] */
@@ -90,6 +92,11 @@ static const flag flags[] = {
       "seconds to finish requests on SIGTERM or SIGINT" },
     { "--cors-origin", "LIST", K_STR, AT(cors), 0, 0, "", "none: same origin only",
       "origins allowed cross-origin calls, comma-separated,\nor * for any" },
+    { "--allow-host", "LIST", K_HOSTS, AT(allow_host), 0, 0, "", "none",
+      "host names served besides IP addresses and\n"
+      "localhost (others get 403: DNS rebinding),\n"
+      "comma-separated; .NAME: NAME and the names\n"
+      "under it; * for any" },
     { "--web", "DIR", K_STR, AT(web), 1, 0, NULL, "clients/web by the binary",
       "the browser front-end's files; DIR/index.html\nmust be readable; installed: found in\nPREFIX/share/pdesolid/web" },
     { "--log-format", "F", K_LOGFMT, AT(log_format), 0, 0, "text", NULL,
@@ -200,9 +207,13 @@ static int set(const flag *r, const char *v, srv_config *c)
     unsigned long long n;
     size_t z;
     double d;
-    if (r->k != K_STR && r->size != kind_size[r->k])
+    if (r->k != K_STR && r->k != K_HOSTS && r->size != kind_size[r->k])
         return -1;   /* a row whose kind does not fit its field: the defaults test fails */
     switch (r->k) {
+    case K_HOSTS:
+        if (srv_host_list_check(v))
+            return -1;
+        /* fall through */
     case K_STR:
         if (strlen(v) < (size_t)r->lo || strlen(v) >= r->size)
             return -1;
@@ -257,6 +268,10 @@ static void describe(const flag *r, char *out, size_t n)
     switch (r->k) {
     case K_STR:
         snprintf(out, n, "%sat most %zu characters", r->lo ? "not empty, " : "", r->size - 1);
+        break;
+    case K_HOSTS:
+        snprintf(out, n, "host names separated by commas (.NAME: NAME and the names under it), or *; at most %zu "
+                 "characters", r->size - 1);
         break;
     case K_UNSIGNED:
     case K_INT:
@@ -399,6 +414,19 @@ int srv_config_parse(int argc, char **argv, srv_config *c, FILE *out, FILE *err)
     return 0;
 }
 
+size_t srv_config_item(const char *p, const char **item, const char **next)
+{
+    const char *comma = strchr(p, ',');
+    size_t n = comma ? (size_t)(comma - p) : strlen(p);
+    while (n && *p == ' ')
+        p++, n--;
+    while (n && p[n - 1] == ' ')
+        n--;
+    *item = p;
+    *next = comma ? comma + 1 : NULL;
+    return n;
+}
+
 void srv_config_print(const srv_config *c, FILE *f)
 {
     fprintf(f, "pdesolidd %s:", PDESOLID_VERSION);
@@ -407,6 +435,7 @@ void srv_config_print(const srv_config *c, FILE *f)
         const void *p = (const char *)c + r->off;
         switch (r->k) {
         case K_STR:
+        case K_HOSTS:
             fprintf(f, *(const char *)p ? " %s %s" : " %s ''", r->name, (const char *)p);
             break;
         case K_UNSIGNED:

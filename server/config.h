@@ -36,6 +36,7 @@ typedef struct {
     size_t max_body;        /* --max-body */
     size_t max_points;      /* --max-points: per eval request */
     char cors[1024];        /* --cors-origin: comma-separated origins, or * */
+    char allow_host[1024];  /* --allow-host: host names answered besides IP addresses and localhost, or * (host.h) */
     unsigned timeout;       /* --timeout: seconds a connection may idle */
     unsigned per_ip;        /* --max-conns-per-ip */
     unsigned max_conns;     /* --max-conns */
@@ -61,6 +62,10 @@ typedef struct {
 int srv_config_parse(int argc, char **argv, srv_config *c, FILE *out, FILE *err);
 /* One line: "pdesolidd VERSION: --bind ... --port ..." with every flag's value. */
 void srv_config_print(const srv_config *c, FILE *f);
+
+/* The item that starts at p of a flag's comma-separated list (--cors-origin, --allow-host), spaces around it
+ * trimmed: its length, with *item its start and *next the next item's, or NULL after the last. */
+size_t srv_config_item(const char *p, const char **item, const char **next);
 
 /* The daemon's version is the project's (api/version.h); http.c says SRV_VERSION. */
 #define SRV_VERSION PDESOLID_VERSION

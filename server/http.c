@@ -29,6 +29,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "host.h"
 #include "http.h"
 #include "internal.h"
 #include "strict.h"
@@ -239,6 +240,15 @@ static int admit(srv_req *r, const char *method)
         if (!strstr(r->path, "%00"))
             MHD_get_connection_values(r->conn, MHD_GET_ARGUMENT_KIND, find_nul, where);
         srv_problem(r, 400, NULL, "%s holds a NUL (%%00), which no part of a request may", where);
+        return 0;
+    }
+    /* Before the route, so that a rebound name learns nothing, not even which paths exist (host.h). */
+    const char *host = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
+    if (!srv_host_allowed(s->cfg.allow_host, host)) {
+        r->decided = 1;
+        srv_problem(r, 403, NULL, "the Host header %.200s names neither an IP address, localhost nor a host allowed "
+                    "here (a guard against DNS rebinding); if it is this server's name, start pdesolidd with "
+                    "--allow-host %.*s", host, (int)strcspn(host, ":"), host);
         return 0;
     }
     if (stopping) {   /* at once, body or not: waiting for a body would hold the exit back */

@@ -108,16 +108,11 @@ void srv_set_text(srv_req *r, int status, const char *ctype, char *text)
 static int listed(const char *list, const char *origin)
 {
     size_t n = strlen(origin);
-    for (const char *p = list; *p;) {
-        const char *e = strchr(p, ',');
-        size_t len = e ? (size_t)(e - p) : strlen(p);
-        while (len && *p == ' ')
-            p++, len--;
-        while (len && p[len - 1] == ' ')
-            len--;
-        if (len == n && !strncmp(p, origin, n))
+    const char *item;
+    for (const char *p = list; p;) {
+        size_t len = srv_config_item(p, &item, &p);
+        if (len == n && !strncmp(item, origin, n))
             return 1;
-        p = e ? e + 1 : p + len;
     }
     return 0;
 }

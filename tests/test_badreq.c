@@ -81,7 +81,7 @@ static char *with_head(const char *head, const char *body, size_t blen, size_t *
 static char *post_body(const char *target, const char *body, size_t blen, size_t *len)
 {
     char head[256];
-    snprintf(head, sizeof head, "POST %s HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: %zu\r\n\r\n", target, blen);
+    snprintf(head, sizeof head, "POST %s HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: %zu\r\n\r\n", target, blen);
     return with_head(head, body, blen, len);
 }
 
@@ -93,7 +93,7 @@ static char *long_target(const char *prefix, size_t n, size_t *len)
     memcpy(u, prefix, strlen(prefix));
     u[n] = '\0';
     char *r = malloc(n + 64);
-    *len = (size_t)sprintf(r, "GET %s HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n", u);
+    *len = (size_t)sprintf(r, "GET %s HTTP/1.1\r\nHost: localhost\r\n" CLOSE "\r\n", u);
     free(u);
     return r;
 }
@@ -108,7 +108,7 @@ static char *gen_huge_header(size_t *len)
 {
     size_t n = 40000;
     char *r = malloc(n + 128);
-    size_t k = (size_t)sprintf(r, "GET /livez HTTP/1.1\r\nHost: x\r\n" CLOSE "X-Big: ");
+    size_t k = (size_t)sprintf(r, "GET /livez HTTP/1.1\r\nHost: localhost\r\n" CLOSE "X-Big: ");
     memset(r + k, 'b', n);
     k += n;
     k += (size_t)sprintf(r + k, "\r\n\r\n");
@@ -120,7 +120,7 @@ static char *gen_many_headers(size_t *len)
 {
     size_t cap = 3000 * 24 + 128, k = 0;
     char *r = malloc(cap);
-    k += (size_t)sprintf(r, "GET /livez HTTP/1.1\r\nHost: x\r\n" CLOSE);
+    k += (size_t)sprintf(r, "GET /livez HTTP/1.1\r\nHost: localhost\r\n" CLOSE);
     for (int i = 0; i < 3000; i++)
         k += (size_t)sprintf(r + k, "X-H%d: %d\r\n", i, i);
     k += (size_t)sprintf(r + k, "\r\n");
@@ -142,7 +142,7 @@ static char *gen_chunked_over_limit(size_t *len)
 {
     size_t chunk = 8192, chunks = 10, cap = 256 + chunks * (chunk + 16), k = 0;
     char *r = malloc(cap);
-    k += (size_t)sprintf(r, "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\n");
+    k += (size_t)sprintf(r, "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\n");
     for (size_t i = 0; i < chunks; i++) {
         k += (size_t)sprintf(r + k, "%zx\r\n", chunk);
         memset(r + k, ' ', chunk);
@@ -203,14 +203,14 @@ static const row rows[] = {
      * or a close) before pdesolidd sees a request, so they are MHD rows. -- */
     RAW(MHD, "no request line at all, only junk", "HELLO\r\n\r\n"),
     RAW(MHD, "a request line without a version", "GET /livez\r\n\r\n"),
-    RAW(MHD, "version HTTP/2.0 on an HTTP/1 connection", "GET /livez HTTP/2.0\r\nHost: x\r\n" CLOSE "\r\n"),
-    RAW(MHD, "version HTTP/1.1x", "GET /livez HTTP/1.1x\r\nHost: x\r\n" CLOSE "\r\n"),
-    RAW(MHD, "version HTTP/9.9", "GET /livez HTTP/9.9\r\nHost: x\r\n" CLOSE "\r\n"),
-    RAW(MHD, "version in lower case", "GET /livez http/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
+    RAW(MHD, "version HTTP/2.0 on an HTTP/1 connection", "GET /livez HTTP/2.0\r\nHost: localhost\r\n" CLOSE "\r\n"),
+    RAW(MHD, "version HTTP/1.1x", "GET /livez HTTP/1.1x\r\nHost: localhost\r\n" CLOSE "\r\n"),
+    RAW(MHD, "version HTTP/9.9", "GET /livez HTTP/9.9\r\nHost: localhost\r\n" CLOSE "\r\n"),
+    RAW(MHD, "version in lower case", "GET /livez http/1.1\r\nHost: localhost\r\n" CLOSE "\r\n"),
     RAW(400, "HTTP/1.1 without Host", "GET /livez HTTP/1.1\r\n" CLOSE "\r\n"),
-    RAW(MHD, "a CR without LF ending the request line", "GET /livez HTTP/1.1\rHost: x\r\n" CLOSE "\r\n"),
-    RAW(MHD, "a NUL in the request target", "GET /li\0vez HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
-    RAW(MHD, "a tab between method and target", "GET\t/livez HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
+    RAW(MHD, "a CR without LF ending the request line", "GET /livez HTTP/1.1\rHost: localhost\r\n" CLOSE "\r\n"),
+    RAW(MHD, "a NUL in the request target", "GET /li\0vez HTTP/1.1\r\nHost: localhost\r\n" CLOSE "\r\n"),
+    RAW(MHD, "a tab between method and target", "GET\t/livez HTTP/1.1\r\nHost: localhost\r\n" CLOSE "\r\n"),
     /* -- the request target: over 32 KiB a 414 problem, up to libmicrohttpd's buffer (128 KiB) -- */
     GEN(404, "a URL of 32 KiB, the limit: an unknown path", gen_url_at_limit),
     GEN(414, "a URL of 32 KiB and a byte", gen_url_over_limit),
@@ -218,9 +218,9 @@ static const row rows[] = {
     GEN(414, "a 33 kB query of the page's own (/?solid=...)", gen_page_query_over_limit),
     GEN(MHD, "a 300 kB URL, past libmicrohttpd's buffer", gen_url_past_the_buffer),
     /* -- methods: these reach pdesolidd's router -- */
-    RAW(405, "a method in lower case", "get /livez HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
-    RAW(405, "an unknown method BREW", "BREW /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
-    RAW(405, "TRACE, which could echo headers", "TRACE /livez HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
+    RAW(405, "a method in lower case", "get /livez HTTP/1.1\r\nHost: localhost\r\n" CLOSE "\r\n"),
+    RAW(405, "an unknown method BREW", "BREW /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "\r\n"),
+    RAW(405, "TRACE, which could echo headers", "TRACE /livez HTTP/1.1\r\nHost: localhost\r\n" CLOSE "\r\n"),
     REQ(405, "DELETE /solve", "DELETE", "/solve"),
     REQ(405, "PUT /solids/{id}", "PUT", "/solids/{ID}"),
     REQ(405, "PATCH /presets", "PATCH", "/presets"),
@@ -231,56 +231,56 @@ static const row rows[] = {
     /* -- headers: MHD_OPTION_STRICT_FOR_CLIENT makes libmicrohttpd refuse a missing Host and a space
      * before the colon; a name that is not a token and a bare CR in a value reach pdesolidd, which
      * must refuse them (a 400 problem also passes an MHD row). -- */
-    RAW(MHD, "a header line without a colon", "GET /livez HTTP/1.1\r\nHost: x\r\nNoColonHere\r\n" CLOSE "\r\n"),
+    RAW(MHD, "a header line without a colon", "GET /livez HTTP/1.1\r\nHost: localhost\r\nNoColonHere\r\n" CLOSE "\r\n"),
     RAW(400, "a space before the colon", "GET /livez HTTP/1.1\r\nHost : x\r\n" CLOSE "\r\n"),
-    RAW(MHD, "a non-ASCII header name", "GET /livez HTTP/1.1\r\nHost: x\r\nX-\xff: 1\r\n" CLOSE "\r\n"),
-    RAW(MHD, "a CR without LF inside the headers", "GET /livez HTTP/1.1\r\nHost: x\r\nX-A: 1\rX-B: 2\r\n" CLOSE "\r\n"),
+    RAW(MHD, "a non-ASCII header name", "GET /livez HTTP/1.1\r\nHost: localhost\r\nX-\xff: 1\r\n" CLOSE "\r\n"),
+    RAW(MHD, "a CR without LF inside the headers", "GET /livez HTTP/1.1\r\nHost: localhost\r\nX-A: 1\rX-B: 2\r\n" CLOSE "\r\n"),
     RAW(404, "a UTF-8 header value on an unknown route",
-        "GET /nowhere HTTP/1.1\r\nHost: x\r\nX-Name: caf\xc3\xa9\r\n" CLOSE "\r\n"),
+        "GET /nowhere HTTP/1.1\r\nHost: localhost\r\nX-Name: caf\xc3\xa9\r\n" CLOSE "\r\n"),
     RAW(404, "an invalid UTF-8 header value on an unknown route",
-        "GET /nowhere HTTP/1.1\r\nHost: x\r\nX-Name: \xc0\xaf\xff\r\n" CLOSE "\r\n"),
+        "GET /nowhere HTTP/1.1\r\nHost: localhost\r\nX-Name: \xc0\xaf\xff\r\n" CLOSE "\r\n"),
     GEN(431, "a 40 kB header", gen_huge_header),
     GEN(MHD, "3000 headers", gen_many_headers),
     /* -- framing: Content-Length and Transfer-Encoding (libmicrohttpd parses both) -- */
-    RAW(MHD, "Content-Length: -1", "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: -1\r\n\r\n" FIG4A),
-    RAW(MHD, "Content-Length: abc", "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: abc\r\n\r\n" FIG4A),
-    RAW(MHD, "Content-Length: 18, 18", "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: 18, 18\r\n\r\n" FIG4A),
+    RAW(MHD, "Content-Length: -1", "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: -1\r\n\r\n" FIG4A),
+    RAW(MHD, "Content-Length: abc", "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: abc\r\n\r\n" FIG4A),
+    RAW(MHD, "Content-Length: 18, 18", "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: 18, 18\r\n\r\n" FIG4A),
     RAW(MHD, "Content-Length: 2^64",
-        "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: 18446744073709551616\r\n\r\n" FIG4A),
-    RAW(MHD, "Content-Length: +18", "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: +18\r\n\r\n" FIG4A),
-    RAW(MHD, "Content-Length: 0x12", "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: 0x12\r\n\r\n" FIG4A),
+        "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: 18446744073709551616\r\n\r\n" FIG4A),
+    RAW(MHD, "Content-Length: +18", "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: +18\r\n\r\n" FIG4A),
+    RAW(MHD, "Content-Length: 0x12", "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: 0x12\r\n\r\n" FIG4A),
     RAW(MHD, "two different Content-Lengths",
-        "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: 18\r\nContent-Length: 5\r\n\r\n" FIG4A),
+        "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: 18\r\nContent-Length: 5\r\n\r\n" FIG4A),
     RAW(MHD, "two equal Content-Lengths",
-        "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: 18\r\nContent-Length: 18\r\n\r\n" FIG4A),
+        "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: 18\r\nContent-Length: 18\r\n\r\n" FIG4A),
     /* libmicrohttpd takes both and uses chunked: pdesolidd sees both headers and must refuse. */
     RAW(400, "Transfer-Encoding: chunked with Content-Length",
-        "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: 18\r\nTransfer-Encoding: chunked\r\n\r\n"
+        "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: 18\r\nTransfer-Encoding: chunked\r\n\r\n"
         "12\r\n" FIG4A "\r\n0\r\n\r\n"),
     RAW(MHD, "Transfer-Encoding: gzip, chunked",
-        "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Transfer-Encoding: gzip, chunked\r\n\r\n12\r\n" FIG4A "\r\n0\r\n\r\n"),
+        "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Transfer-Encoding: gzip, chunked\r\n\r\n12\r\n" FIG4A "\r\n0\r\n\r\n"),
     RAW(MHD, "Transfer-Encoding: chunked, gzip",
-        "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Transfer-Encoding: chunked, gzip\r\n\r\n12\r\n" FIG4A "\r\n0\r\n\r\n"),
+        "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Transfer-Encoding: chunked, gzip\r\n\r\n12\r\n" FIG4A "\r\n0\r\n\r\n"),
     RAWF(MHD, SLOW, "a chunk size of ffffffffffffffff",
-        "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\nffffffffffffffff\r\n" FIG4A "\r\n"),
+        "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\nffffffffffffffff\r\n" FIG4A "\r\n"),
     RAW(MHD, "a chunk size that is not hex",
-        "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\nzz\r\n" FIG4A "\r\n0\r\n\r\n"),
+        "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\nzz\r\n" FIG4A "\r\n0\r\n\r\n"),
     RAW(MHD, "a chunk longer than its size",
-        "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\n2\r\n" FIG4A "\r\n0\r\n\r\n"),
+        "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\n2\r\n" FIG4A "\r\n0\r\n\r\n"),
     /* libmicrohttpd does not act on a half-close mid-request: its timeout closes these. */
     RAWF(MHD, SHUT | SLOW, "a body cut short, then a half-close",
-         "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: 18\r\n\r\n{\"preset\""),
+         "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: 18\r\n\r\n{\"preset\""),
     RAWF(MHD, SHUT | SLOW, "chunks without the last one, then a half-close",
-         "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\n12\r\n" FIG4A "\r\n"),
+         "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Transfer-Encoding: chunked\r\n\r\n12\r\n" FIG4A "\r\n"),
     RAWF(MHD, SLOW, "a body cut short, then silence",
-         "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: 18\r\n\r\n{\"preset\""),
-    RAWF(MHD, SLOW, "headers without their blank line, then silence", "GET /livez HTTP/1.1\r\nHost: x\r\n"),
-    RAW(400, "a POST without Content-Length or a body", "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "\r\n"),
-    RAW(400, "Content-Length: 0", "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: 0\r\n\r\n"),
+         "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: 18\r\n\r\n{\"preset\""),
+    RAWF(MHD, SLOW, "headers without their blank line, then silence", "GET /livez HTTP/1.1\r\nHost: localhost\r\n"),
+    RAW(400, "a POST without Content-Length or a body", "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "\r\n"),
+    RAW(400, "Content-Length: 0", "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: 0\r\n\r\n"),
     RAW(413, "Expect: 100-continue with a body over --max-body",
-        "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: 1000000\r\nExpect: 100-continue\r\n\r\n"),
+        "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: 1000000\r\nExpect: 100-continue\r\n\r\n"),
     RAW(413, "a declared Content-Length over --max-body, no body sent",
-        "POST /solve HTTP/1.1\r\nHost: x\r\n" CLOSE "Content-Length: 99999999\r\n\r\n"),
+        "POST /solve HTTP/1.1\r\nHost: localhost\r\n" CLOSE "Content-Length: 99999999\r\n\r\n"),
     GEN(413, "a body over --max-body", gen_body_over_limit),
     GEN(413, "a chunked body growing over --max-body", gen_chunked_over_limit),
     /* -- query -- */
@@ -467,7 +467,7 @@ static char *build(const row *w, const char *id, size_t *len)
     else
         snprintf(target, sizeof target, "%s", w->target);
     char head[400];
-    int n = snprintf(head, sizeof head, "%s %s HTTP/1.1\r\nHost: x\r\n" CLOSE, w->method, target);
+    int n = snprintf(head, sizeof head, "%s %s HTTP/1.1\r\nHost: localhost\r\n" CLOSE, w->method, target);
     if (w->body)
         n += snprintf(head + n, sizeof head - (size_t)n, "Content-Length: %zu\r\n", w->body_len);
     snprintf(head + n, sizeof head - (size_t)n, "\r\n");
@@ -544,7 +544,7 @@ static void every_malformed_request_should_get_one_4xx_problem_or_a_documented_c
     daemon_start(&d, dir, "--max-points 10 --max-body 64KiB --timeout 2");
     /* The id of a solved solid, for the eval and solids rows. */
     char id[64] = "";
-    const char *req = "POST /solve?format=f32&res=2 HTTP/1.1\r\nHost: x\r\nConnection: close\r\n"
+    const char *req = "POST /solve?format=f32&res=2 HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n"
                       "Content-Length: 18\r\n\r\n" FIG4A;
     raw_reply r = raw_request(d.port, req, strlen(req), 5000);
     assert_int_equal(r.status, 200);
@@ -582,7 +582,7 @@ static void every_malformed_request_should_get_one_4xx_problem_or_a_documented_c
         raw_reply_free(&r);
     }
     /* Still serving. */
-    req = "GET /livez HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n";
+    req = "GET /livez HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n";
     r = raw_request(d.port, req, strlen(req), 5000);
     int alive = r.status == 200;
     raw_reply_free(&r);

@@ -82,6 +82,7 @@ static void defaults_should_be_those_the_usage_gives(void **state)
     assert_int_equal(c.max_body, 1u << 20);
     assert_int_equal(c.max_points, 100000);
     assert_string_equal(c.cors, "");
+    assert_string_equal(c.allow_host, "");
     assert_int_equal(c.timeout, 30);
     assert_int_equal(c.per_ip, 128);
     assert_int_equal(c.max_conns, 1024);
@@ -116,6 +117,7 @@ static const struct {
     { "--web", "clients/web" },    { "--log-format", "json" },
     { "--store", "redis://127.0.0.1:6379/2" }, { "--store-mb", "3" }, { "--store-prefix", "pde:" },
     { "--store-ttl", "86400" },    { "--heavy-work", "2.5e8" },    { "--heavy-queue", "3" },
+    { "--allow-host", "pdesolid.example.org,.Example.COM." },
 };
 
 static void expect(srv_config *e, const char *flag)
@@ -158,6 +160,8 @@ static void expect(srv_config *e, const char *flag)
         e->grace = 4;
     else if (!strcmp(flag, "--cors-origin"))
         strcpy(e->cors, "http://a.example,http://b.example");
+    else if (!strcmp(flag, "--allow-host"))
+        strcpy(e->allow_host, "pdesolid.example.org,.Example.COM.");
     else if (!strcmp(flag, "--web"))
         strcpy(e->web, "clients/web");
     else if (!strcmp(flag, "--log-format"))
@@ -221,7 +225,7 @@ static void every_flag_in_the_usage_should_be_tested(void **state)
         if (!found)
             fail_msg("%s is in the usage but not in every_flag", name);
     }
-    assert_int_equal(flags, 27);   /* 25 with values, --quiet, --version ("-h, --help" starts otherwise) */
+    assert_int_equal(flags, 28);   /* 26 with values, --quiet, --version ("-h, --help" starts otherwise) */
     assert_non_null(strstr(r.out, "-h, --help"));
 }
 
@@ -260,6 +264,10 @@ static void each_error_should_exit_2_naming_its_argument(void **state)
         { ARGS("--cache-mb", "99999999999999999999999"), "--cache-mb 99999999999999999999999: not a valid" },
         { ARGS("--log-format=xml"), "--log-format=xml: not a valid value; give text or json" },
         { ARGS("--bind="), "--bind=: not a valid value" },
+        { ARGS("--allow-host=http://a.example"), "--allow-host=http://a.example: not a valid value; give host names" },
+        { ARGS("--allow-host", "a.example:8080"), "--allow-host a.example:8080: not a valid value" },
+        { ARGS("--allow-host", "a.example,,b.example"), "--allow-host a.example,,b.example: not a valid value" },
+        { ARGS("--allow-host=*.example.com"), "--allow-host=*.example.com: not a valid value" },
     };
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
         srv_config c;

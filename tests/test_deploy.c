@@ -188,7 +188,7 @@ static void the_installed_daemon_should_serve_the_installed_front_end(void **sta
     const char *paths[] = { "/", "/app.js", "/vendor/three/three.module.js" };
     for (int i = 0; i < 3; i++) {
         char req[256];
-        int n = snprintf(req, sizeof req, "GET %s HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n", paths[i]);
+        int n = snprintf(req, sizeof req, "GET %s HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n", paths[i]);
         raw_reply r = raw_request(d.port, req, (size_t)n, 5000);
         if (r.status != 200)
             fail_msg("GET %s from the installed daemon: %d", paths[i], r.status);

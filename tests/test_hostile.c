@@ -8,7 +8,8 @@
  * a per-address limit that does not lock an address out, a 413 that clients
  * can read, bounded shutdown, budgets, strict input, a response cache keyed
  * by the whole request, an access log that cannot be forged, request ids,
- * honest Server-Timing and CORS refused before work.
+ * honest Server-Timing, CORS refused before work, and a Host header that
+ * names neither this machine nor a name allowed (DNS rebinding) refused.
  */
 #define _GNU_SOURCE   /* strcasestr */
 #include <errno.h>
@@ -67,13 +68,14 @@ static int kill_leftover(void **state)
 
 /* ---- helpers ---- */
 
-/* A request with Host and Connection: close, extra headers (each ending in CRLF) and a body or NULL. */
-static raw_reply ask(const daemon_t *d, const char *method, const char *target, const char *headers, const char *body,
-                     size_t blen, int timeout_ms)
+/* A request to host (the Host header's value) with Connection: close, extra headers (each ending in CRLF) and a
+ * body or NULL. */
+static raw_reply ask_host(const daemon_t *d, const char *host, const char *method, const char *target,
+                          const char *headers, const char *body, size_t blen, int timeout_ms)
 {
-    size_t cap = strlen(target) + (headers ? strlen(headers) : 0) + blen + 256;
+    size_t cap = strlen(host) + strlen(target) + (headers ? strlen(headers) : 0) + blen + 256;
     char *req = malloc(cap);
-    int n = snprintf(req, cap, "%s %s HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n%s", method, target,
+    int n = snprintf(req, cap, "%s %s HTTP/1.1\r\nHost: %s\r\nConnection: close\r\n%s", method, target, host,
                      headers ? headers : "");
     if (body)
         n += snprintf(req + n, cap - (size_t)n, "Content-Length: %zu\r\n", blen);
@@ -85,6 +87,12 @@ static raw_reply ask(const daemon_t *d, const char *method, const char *target, 
     raw_reply r = raw_request(d->port, req, (size_t)n, timeout_ms);
     free(req);
     return r;
+}
+
+static raw_reply ask(const daemon_t *d, const char *method, const char *target, const char *headers, const char *body,
+                     size_t blen, int timeout_ms)
+{
+    return ask_host(d, "127.0.0.1", method, target, headers, body, blen, timeout_ms);
 }
 
 static raw_reply get(const daemon_t *d, const char *target)
@@ -381,7 +389,7 @@ static void a_body_sent_one_byte_each_half_second_should_be_cut_off_at_the_reque
     start(&d, "--request-timeout 2");
     int fd = raw_dial(d.port);
     assert_true(fd >= 0);
-    const char *head = "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: 100\r\n\r\n";
+    const char *head = "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: 100\r\n\r\n";
     double t0 = mono_now();
     assert_int_equal(send_all(fd, head, strlen(head), 1), 0);
     int cut = 0;
@@ -408,7 +416,7 @@ static void slow_bodies_at_the_per_address_limit_should_not_lock_the_address_out
     start(&d, "--request-timeout 2 --max-conns-per-ip 8");
     enum { N = 8 };
     int fd[N];
-    const char *head = "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: 1000\r\n\r\n";
+    const char *head = "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: 1000\r\n\r\n";
     for (int i = 0; i < N; i++) {
         fd[i] = raw_dial(d.port);
         assert_true(fd[i] >= 0);
@@ -446,7 +454,7 @@ static void a_connection_over_max_conns_should_get_a_prompt_503_while_the_others
     daemon_t d;
     start(&d, "--max-conns 4 --max-conns-per-ip 200 --http-threads 2");
     enum { N = 4 };
-    const char *keep = "GET /livez HTTP/1.1\r\nHost: x\r\n\r\n";
+    const char *keep = "GET /livez HTTP/1.1\r\nHost: localhost\r\n\r\n";
     int fd[N];
     for (int i = 0; i < N; i++) {   /* each open and accepted: it has had an answer, and stays */
         fd[i] = raw_dial(d.port);
@@ -517,7 +525,7 @@ static void an_oversized_body_with_expect_100_continue_should_get_413_before_any
     (void)state;
     daemon_t d;
     start(&d, "--max-body 1MiB");
-    const char *req = "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+    const char *req = "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Type: application/json\r\n"
                       "Content-Length: 2097152\r\nExpect: 100-continue\r\n\r\n";
     raw_reply r = raw_request(d.port, req, strlen(req), 3000);
     expect_problem(&r, 413, NULL, NULL);   /* with no body sent: a daemon waiting for one times out */
@@ -533,7 +541,7 @@ static void a_client_that_writes_all_its_body_before_reading_should_read_the_413
     start(&d, "--max-body 1MiB");
     size_t big = 2u << 20;
     char head[160];
-    int hl = snprintf(head, sizeof head, "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+    int hl = snprintf(head, sizeof head, "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Type: application/json\r\n"
                                          "Content-Length: %zu\r\n\r\n", big);
     char *req = malloc((size_t)hl + big);
     memcpy(req, head, (size_t)hl);
@@ -578,7 +586,7 @@ static void a_chunked_body_growing_over_the_limit_should_get_a_readable_413(void
     start(&d, "--max-body 1MiB");
     size_t chunk = 65536, chunks = 32, cap = 256 + chunks * (chunk + 16);
     char *req = malloc(cap);
-    size_t n = (size_t)snprintf(req, cap, "POST /solve HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\n\r\n");
+    size_t n = (size_t)snprintf(req, cap, "POST /solve HTTP/1.1\r\nHost: localhost\r\nTransfer-Encoding: chunked\r\n\r\n");
     for (size_t i = 0; i < chunks; i++) {
         n += (size_t)snprintf(req + n, cap - n, "%zx\r\n", chunk);
         memset(req + n, ' ', chunk);
@@ -607,7 +615,7 @@ static void *heavy_client(void *arg)
     job_arg *a = arg;
     size_t blen = strlen(a->body), cap = blen + 256;
     char *req = malloc(cap);
-    int n = snprintf(req, cap, "POST /solve?format=glb&res=512 HTTP/1.1\r\nHost: x\r\nConnection: close\r\n"
+    int n = snprintf(req, cap, "POST /solve?format=glb&res=512 HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n"
                                "Content-Length: %zu\r\n\r\n%s", blen, a->body);
     a->r = raw_request(a->port, req, (size_t)n, 9000);
     free(req);
@@ -941,20 +949,20 @@ static void bad_framing_should_get_one_error_response_or_a_close_within_2_s(void
         const char *name, *req;
         int mhd;
     } rows[] = {
-        { "Content-Length: -1", "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: -1\r\n\r\n" BODY18, 1 },
-        { "Content-Length: abc", "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: abc\r\n\r\n" BODY18, 1 },
-        { "Content-Length: 18, 18", "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: 18, 18\r\n\r\n" BODY18, 1 },
+        { "Content-Length: -1", "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: -1\r\n\r\n" BODY18, 1 },
+        { "Content-Length: abc", "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: abc\r\n\r\n" BODY18, 1 },
+        { "Content-Length: 18, 18", "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: 18, 18\r\n\r\n" BODY18, 1 },
         { "Content-Length: 2^64",
-          "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: 18446744073709551616\r\n\r\n" BODY18, 1 },
+          "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: 18446744073709551616\r\n\r\n" BODY18, 1 },
         { "two Content-Lengths",
-          "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: 18\r\nContent-Length: 5\r\n\r\n" BODY18, 0 },
+          "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: 18\r\nContent-Length: 5\r\n\r\n" BODY18, 0 },
         { "Transfer-Encoding with Content-Length",
-          "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: 18\r\nTransfer-Encoding: chunked\r\n\r\n"
+          "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: 18\r\nTransfer-Encoding: chunked\r\n\r\n"
           "12\r\n" BODY18 "\r\n0\r\n\r\n", 0 },
         { "Transfer-Encoding: gzip, chunked",
-          "POST /solve HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: gzip, chunked\r\n\r\n12\r\n" BODY18 "\r\n0\r\n\r\n", 0 },
+          "POST /solve HTTP/1.1\r\nHost: localhost\r\nTransfer-Encoding: gzip, chunked\r\n\r\n12\r\n" BODY18 "\r\n0\r\n\r\n", 0 },
         { "chunk size ffffffffffffffff",
-          "POST /solve HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\n\r\nffffffffffffffff\r\n" BODY18 "\r\n", 1 },
+          "POST /solve HTTP/1.1\r\nHost: localhost\r\nTransfer-Encoding: chunked\r\n\r\nffffffffffffffff\r\n" BODY18 "\r\n", 1 },
     };
 #undef BODY18
     int failed = 0;
@@ -1170,6 +1178,112 @@ static void a_post_from_a_disallowed_origin_should_get_403_and_solve_nothing(voi
     stop(&d);
 }
 
+/* ---- Host: DNS rebinding ---- */
+
+/* The status of GET target with Host: host (formatted with the daemon's port, if host has a %d). */
+static int status_as(const daemon_t *d, const char *host, const char *target)
+{
+    char h[128];
+    snprintf(h, sizeof h, host, d->port);
+    raw_reply r = ask_host(d, h, "GET", target, NULL, NULL, 0, 5000);
+    int status = r.status;
+    raw_reply_free(&r);
+    return status;
+}
+
+static void expect_hosts(const daemon_t *d, const char *const *hosts, size_t n, int status)
+{
+    for (size_t i = 0; i < n; i++) {
+        int got = status_as(d, hosts[i], "/livez");
+        if (got != status)
+            fail_msg("Host: %s: %d, expected %d", hosts[i], got, status);
+    }
+}
+
+/* A page at evil.example that rebinds its name to 127.0.0.1 sends Host: evil.example:PORT, and an Origin to match,
+ * so that the same-origin check passes: every route refuses it, the front-end's files too, before any work. */
+static void a_host_name_not_allowed_should_get_403_naming_the_header_the_value_and_the_flag(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    long before = metric(&d, "pdesolid_solve_seconds_count");
+    assert_true(before >= 0);
+    char host[64], origin[128];
+    snprintf(host, sizeof host, "evil.example:%d", d.port);
+    snprintf(origin, sizeof origin, "Origin: http://%s\r\n", host);
+    static const struct {
+        const char *method, *target;
+    } routes[] = {
+        { "GET", "/" },         { "GET", "/app.js" },   { "GET", "/livez" },    { "GET", "/readyz" },
+        { "GET", "/metrics" },  { "GET", "/presets" },  { "POST", "/solve" },   { "OPTIONS", "/solve" },
+        { "GET", "/nowhere" },
+    };
+    for (size_t i = 0; i < sizeof routes / sizeof *routes; i++) {
+        int post = !strcmp(routes[i].method, "POST");
+        raw_reply r = ask_host(&d, host, routes[i].method, routes[i].target, origin,
+                               post ? "{\"preset\":\"fig4b\"}" : NULL, post ? 18 : 0, 5000);
+        expect_problem(&r, 403, NULL, host);
+        cJSON *p = cJSON_Parse(r.body);
+        const char *detail = cJSON_GetObjectItem(p, "detail")->valuestring;
+        if (!strstr(detail, "Host") || !strstr(detail, "--allow-host evil.example"))
+            fail_msg("%s %s: the detail \"%s\" does not name the Host header and --allow-host evil.example",
+                     routes[i].method, routes[i].target, detail);
+        cJSON_Delete(p);
+        raw_reply_free(&r);
+    }
+    assert_int_equal(metric(&d, "pdesolid_solve_seconds_count"), before);
+    /* Other spellings of names, and names that only start or end like an allowed one. */
+    static const char *const refused[] = {
+        "EVIL.Example.",  "x",        "localhost:80x", "127.0.0.1:80:80", "localhost.evil.example", "evillocalhost",
+        "localhost.example", "127.0.0.1.evil.example", "[evil.example]", "[::1", "[::1]x", "::1",
+    };
+    expect_hosts(&d, refused, sizeof refused / sizeof *refused, 403);
+    expect_livez(&d);   /* the daemon still answers */
+    stop(&d);
+}
+
+/* Rebinding needs a DNS name: an IP literal, or localhost (which browsers never ask DNS for), is this machine. */
+static void ip_literals_and_localhost_should_be_allowed_by_default(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    static const char *const allowed[] = {
+        "127.0.0.1:%d", "127.0.0.1",      "localhost", "localhost:%d", "LocalHost.", "foo.localhost",
+        "a.b.localhost:%d", "[::1]:%d",   "[::1]",     "192.0.2.7:80", "[2001:db8::1]", "localhost:",
+    };
+    expect_hosts(&d, allowed, sizeof allowed / sizeof *allowed, 200);
+    assert_int_equal(status_as(&d, "localhost:%d", "/"), 200);   /* the front-end */
+    /* HTTP/1.0 without Host (no browser sends that). */
+    const char *req = "GET /livez HTTP/1.0\r\n\r\n";
+    raw_reply r = raw_request(d.port, req, strlen(req), 5000);
+    assert_int_equal(r.status, 200);
+    raw_reply_free(&r);
+    stop(&d);
+}
+
+static void allow_host_should_allow_the_names_listed_and_subdomains_of_a_leading_dot(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--allow-host example.com,.example.org");
+    static const char *const allowed[] = {
+        "example.com", "EXAMPLE.com.", "example.com:8080", "example.org", "a.example.org", "b.a.Example.Org.:443",
+        "localhost",   "127.0.0.1:%d",
+    };
+    static const char *const refused[] = {
+        "evil.example", "a.example.com", "example.com.evil.example", "badexample.org", "example.co", "example.orgx",
+    };
+    expect_hosts(&d, allowed, sizeof allowed / sizeof *allowed, 200);
+    expect_hosts(&d, refused, sizeof refused / sizeof *refused, 403);
+    stop(&d);
+    start(&d, "--allow-host '*'");
+    static const char *const any[] = { "evil.example:8080", "x", "EVIL.example." };
+    expect_hosts(&d, any, sizeof any / sizeof *any, 200);
+    stop(&d);
+}
+
 static void the_openapi_document_should_be_served(void **state)
 {
     (void)state;
@@ -1213,6 +1327,9 @@ int main(void)
         T(server_timing_should_add_up_to_most_of_the_wall_time_of_a_new_solve),
         T(a_post_from_a_disallowed_origin_should_get_403_and_solve_nothing),
         T(the_openapi_document_should_be_served),
+        T(a_host_name_not_allowed_should_get_403_naming_the_header_the_value_and_the_flag),
+        T(ip_literals_and_localhost_should_be_allowed_by_default),
+        T(allow_host_should_allow_the_names_listed_and_subdomains_of_a_leading_dot),
     };
     test_filter_from_env();
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -801,7 +801,7 @@ static void two_content_lengths_and_stalled_clients_should_be_refused(void **sta
     start(&d, "--timeout 1");
     char buf[8192];
     int fd = dial(d.port);
-    const char *req = "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: 18\r\nContent-Length: 5\r\n\r\n"
+    const char *req = "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: 18\r\nContent-Length: 5\r\n\r\n"
                       "{\"preset\":\"fig4a\"}";
     send(fd, req, strlen(req), 0);
     long n = raw_read_to_close(fd, buf, sizeof buf, 10);
@@ -810,7 +810,7 @@ static void two_content_lengths_and_stalled_clients_should_be_refused(void **sta
     assert_true(strstr(buf, " 400 ") != NULL);
     /* Half the headers, then silence: closed after the one-second timeout. */
     fd = dial(d.port);
-    const char *half = "GET /livez HTTP/1.1\r\nHost: x\r\n";
+    const char *half = "GET /livez HTTP/1.1\r\nHost: localhost\r\n";
     send(fd, half, strlen(half), 0);
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
@@ -859,7 +859,7 @@ static void sigterm_should_let_a_request_in_flight_complete_and_answer_new_ones_
     free(late.body);
     /* A new request whose body is slow to come gets its 503 at once, not after the body (up to 5 s of draining
      * that held the exit back). */
-    static const char slow[] = "POST /solve HTTP/1.1\r\nHost: x\r\nContent-Length: 5\r\n\r\n";
+    static const char slow[] = "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: 5\r\n\r\n";
     raw_reply rr = raw_request(d.port, slow, sizeof slow - 1, 2000);
     assert_int_equal(rr.status, 503);
     assert_false(rr.timed_out);
