@@ -17,6 +17,9 @@
 #   CLUSTER_REPLICAS  how many replicas [3] (bench/bench_cluster.sh runs 1 and 3)
 #   PDESOLIDD         the daemon [build/pdesolidd]; the tests give build/san/pdesolidd
 #   CLUSTER_RATE      nginx's requests a second per address [1000]
+#   CLUSTER_ALLOW_HOST  the names clients reach nginx by, comma-separated, each replica's
+#                     --allow-host [none: 127.0.0.1:PORT and localhost:PORT only]; nginx passes
+#                     the client's Host on, and a replica answers another name 403 (DNS rebinding)
 #
 # start starts what is not running and leaves the rest alone, so after a replica or Redis dies,
 # `make cluster` again brings it back. stop stops every process that has a pid file here.
@@ -32,6 +35,7 @@ REDIS_PORT=$((PORT + 1))
 NGINX=${NGINX:-/usr/sbin/nginx}
 REDIS=${REDIS_SERVER:-/usr/bin/redis-server}
 PDESOLIDD=${PDESOLIDD:-build/pdesolidd}
+ALLOW_HOST=${CLUSTER_ALLOW_HOST:-}
 
 say() { echo "cluster: $*" >&2; }
 die() { say "$*"; exit 1; }
@@ -106,7 +110,7 @@ start_replica() {
     # In a session of its own, with nothing of this script's (stdin, the terminal, its process
     # group's signals): it outlives the script. Not a process group leader here, so setsid execs
     # the daemon itself and $! is its pid.
-    setsid "$PDESOLIDD" --port "$port" --store "redis://127.0.0.1:$REDIS_PORT" --log-format json \
+    setsid "$PDESOLIDD" --port "$port" --allow-host="$ALLOW_HOST" --store "redis://127.0.0.1:$REDIS_PORT" --log-format json \
         </dev/null >>"$DIR/pdesolidd-$k.log" 2>&1 &
     echo $! >"$DIR/pdesolidd-$k.pid"
 }

@@ -80,6 +80,7 @@ static const char *const shipped_directives[] = {
     "proxy_set_header X-Request-Id $pdesolid_request_id;",
     "proxy_set_header X-Forwarded-For $remote_addr;",
     "proxy_set_header X-Forwarded-Proto $scheme;",
+    "proxy_set_header Host $http_host;",
     "gzip on;",
     "gzip_types application/json application/problem+json",
     "error_page 400 494 /_problem/400;",
@@ -475,13 +476,18 @@ static int teardown(void **state)
     return tmpdir_remove(dir);
 }
 
-/* nginx in front of the daemon (static storage: stop_leftovers reaches them after a failure). */
-static void pair_start(daemon_t *d, front_t *f)
+/* nginx in front of the daemon started with args (static storage: stop_leftovers reaches them after a failure). */
+static void pair_start_with(daemon_t *d, front_t *f, const char *args)
 {
     need_nginx();
-    daemon_start(d, dir, "");
+    daemon_start(d, dir, args);
     live.daemon = d;
     front_start(f, d->port);
+}
+
+static void pair_start(daemon_t *d, front_t *f)
+{
+    pair_start_with(d, f, "");
 }
 
 static void pair_stop(daemon_t *d, front_t *f)
@@ -1032,6 +1038,26 @@ static void the_daemon_should_get_a_sane_request_id_and_forwarded_headers(void *
     recorded_stop(&up, &f);
 }
 
+/* nginx passes the client's Host on: the daemon, started as a deployment starts it (--allow-host with nginx's
+ * server_name), answers that name and refuses another with its own 403 problem, passed through (DNS rebinding). */
+static void the_daemon_should_answer_its_allowed_name_through_nginx_and_refuse_others(void **state)
+{
+    (void)state;
+    static daemon_t d;
+    static front_t f;
+    pair_start_with(&d, &f, "--allow-host solids.example.org");
+    http_reply r = http_request(NULL, f.base, "GET", "/", NULL, 0, "Host: Solids.Example.org", NULL);
+    assert_int_equal(r.status, 200);
+    free(r.body);
+    r = http_request(NULL, f.base, "POST", "/solve", FIG4A, strlen(FIG4A),
+                     "Host: evil.example\nOrigin: http://evil.example", NULL);
+    expect_problem(r.status, r.headers, r.body, 403);
+    if (!strstr(r.body, "--allow-host evil.example"))
+        fail_msg("the 403 does not say how to allow the name: %s", r.body);
+    free(r.body);
+    pair_stop_serving(&d, &f);   /* through 127.0.0.1:PORT, an address */
+}
+
 static void an_unreachable_daemon_should_give_a_502_problem(void **state)
 {
     (void)state;
@@ -1063,6 +1089,7 @@ int main(void)
         T(an_oversize_body_should_get_a_413_problem_that_the_client_can_read),
         T(a_burst_above_limit_req_should_get_429_problems_and_health_checks_none),
         T(the_daemon_should_get_a_sane_request_id_and_forwarded_headers),
+        T(the_daemon_should_answer_its_allowed_name_through_nginx_and_refuse_others),
         T(an_unreachable_daemon_should_give_a_502_problem),
     };
     test_filter_from_env();
