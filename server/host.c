@@ -16,13 +16,9 @@ static int label_char(char c)
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_';
 }
 
-/* An item of n bytes: [.]label(.label)*[.] */
+/* n bytes of s are labels of letters, digits, '-' and '_', separated by dots. */
 static int name_ok(const char *s, size_t n)
 {
-    if (n && *s == '.')
-        s++, n--;
-    if (n && s[n - 1] == '.')
-        n--;
     size_t label = 0;
     for (size_t i = 0; i < n; i++) {
         if (s[i] != '.' && !label_char(s[i]))
@@ -34,14 +30,30 @@ static int name_ok(const char *s, size_t n)
     return label > 0;
 }
 
+/* An item of n bytes of the list, *item moved past its leading dot (.NAME: NAME and the names under it, *under
+ * set); its length without that dot and a trailing one. */
+static size_t strip(const char **item, size_t n, int *under)
+{
+    *under = n && **item == '.';
+    if (*under)
+        ++*item, n--;
+    if (n && (*item)[n - 1] == '.')
+        n--;
+    return n;
+}
+
 int srv_host_list_check(const char *list)
 {
     if (!*list)
         return 0;
     const char *item;
+    int under;
     for (const char *p = list; p;) {
         size_t n = srv_config_item(p, &item, &p);
-        if (!(n == 1 && *item == '*') && !name_ok(item, n))
+        if (n == 1 && *item == '*')
+            continue;
+        n = strip(&item, n, &under);
+        if (!name_ok(item, n))
             return -1;
     }
     return 0;
@@ -51,16 +63,12 @@ int srv_host_list_check(const char *list)
 static int listed(const char *list, const char *name, size_t n)
 {
     const char *item;
+    int under;
     for (const char *p = list; p;) {
         size_t len = srv_config_item(p, &item, &p);
         if (len == 1 && *item == '*')
             return 1;
-        int under = len && *item == '.';   /* .NAME: NAME and the names under it */
-        if (under)
-            item++, len--;
-        if (len && item[len - 1] == '.')
-            len--;
-        if (!len)
+        if (!(len = strip(&item, len, &under)))
             continue;
         if (n == len && !strncasecmp(name, item, len))
             return 1;
@@ -73,7 +81,8 @@ static int listed(const char *list, const char *name, size_t n)
 enum { MALFORMED, ADDRESS, NAME };
 
 /* What host (a Host header's value) names: an IPv4 or bracketed IPv6 ADDRESS, or a NAME of *n bytes at its start
- * without its trailing dot; each with an optional :PORT. */
+ * without its trailing dot; each with an optional :PORT. Anything else, a name with a character DNS names do not
+ * hold among them, is MALFORMED. */
 static int split(const char *host, size_t *n)
 {
     char text[64];
@@ -99,11 +108,19 @@ static int split(const char *host, size_t *n)
         return ADDRESS;
     if (*n && host[*n - 1] == '.')
         --*n;
-    if (!*n || *n >= sizeof text)
-        return *n ? NAME : MALFORMED;
+    if (!name_ok(host, *n))
+        return MALFORMED;
+    if (*n >= sizeof text)
+        return NAME;   /* longer than any address */
     memcpy(text, host, *n);
     text[*n] = '\0';
     return inet_pton(AF_INET, text, addr) == 1 ? ADDRESS : NAME;
+}
+
+size_t srv_host_name(const char *host)
+{
+    size_t n;
+    return host && split(host, &n) == NAME ? n : 0;
 }
 
 int srv_host_allowed(const char *list, const char *host)

@@ -14,7 +14,7 @@
  *   if (srv_host_list_check(arg))            // at start-up: --allow-host's value
  *       ... refuse the flag ...
  *   if (!srv_host_allowed(cfg.allow_host, host_header_or_NULL))
- *       ... 403 ...
+ *       ... 403, suggesting --allow-host with the srv_host_name(host) bytes of host ...
  *
  * A list is names separated by commas (spaces around them ignored): NAME
  * allows NAME, .NAME allows NAME and every name under it, * allows every
@@ -25,13 +25,19 @@
 #ifndef SRV_HOST_H
 #define SRV_HOST_H
 
+#include <stddef.h>
+
 /* 0 if list is a valid --allow-host value (the empty list too), -1 if an item is not a host name (letters,
  * digits, '-' and '_' in dot-separated labels, an optional leading and trailing dot) nor "*". */
 int srv_host_list_check(const char *list);
 
 /* 1 if a request with this Host header value may be answered: none (NULL: HTTP/1.0), an IPv4 address, an IPv6
- * address in brackets, localhost or NAME.localhost, or a name list allows; each with an optional :PORT. A value
- * that is none of these, malformed ones included, is 0. */
+ * address in brackets, localhost or NAME.localhost, or a name list allows; each with an optional :PORT. A name is
+ * labels of letters, digits, '-' and '_' between dots; a value that is none of these is allowed by "*" only. */
 int srv_host_allowed(const char *list, const char *host);
+
+/* The length of the name at the start of host, without its port and trailing dot; 0 if host (or NULL) is not a
+ * name: an address, or malformed. For a message: "--allow-host %.*s". */
+size_t srv_host_name(const char *host);
 
 #endif

@@ -246,9 +246,11 @@ static int admit(srv_req *r, const char *method)
     const char *host = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
     if (!srv_host_allowed(s->cfg.allow_host, host)) {
         r->decided = 1;
+        int name = (int)srv_host_name(host);
         srv_problem(r, 403, NULL, "the Host header %.200s names neither an IP address, localhost nor a host allowed "
-                    "here (a guard against DNS rebinding); if it is this server's name, start pdesolidd with "
-                    "--allow-host %.*s", host, (int)strcspn(host, ":"), host);
+                    "here (a guard against DNS rebinding)%s%.*s", host,
+                    name ? "; if it is this server's name, start pdesolidd with --allow-host " : "; see --allow-host",
+                    name, host);
         return 0;
     }
     if (stopping) {   /* at once, body or not: waiting for a body would hold the exit back */

@@ -1236,7 +1236,8 @@ static void a_host_name_not_allowed_should_get_403_naming_the_header_the_value_a
     /* Other spellings of names, and names that only start or end like an allowed one. */
     static const char *const refused[] = {
         "EVIL.Example.",  "x",        "localhost:80x", "127.0.0.1:80:80", "localhost.evil.example", "evillocalhost",
-        "localhost.example", "127.0.0.1.evil.example", "[evil.example]", "[::1", "[::1]x", "::1",
+        "localhost.example", "127.0.0.1.evil.example", "[evil.example]", "[::1", "[::1]x", "::1", "",
+        "a..localhost", ".localhost", "evil.example/.localhost",
     };
     expect_hosts(&d, refused, sizeof refused / sizeof *refused, 403);
     expect_livez(&d);   /* the daemon still answers */
@@ -1279,7 +1280,7 @@ static void allow_host_should_allow_the_names_listed_and_subdomains_of_a_leading
     expect_hosts(&d, refused, sizeof refused / sizeof *refused, 403);
     stop(&d);
     start(&d, "--allow-host '*'");
-    static const char *const any[] = { "evil.example:8080", "x", "EVIL.example." };
+    static const char *const any[] = { "evil.example:8080", "x", "EVIL.example.", "[evil.example]" };
     expect_hosts(&d, any, sizeof any / sizeof *any, 200);
     stop(&d);
 }
