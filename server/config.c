@@ -3,6 +3,7 @@
  * usage text and srv_config_print all read the table, so that a new flag is
  * one row (and its field in srv_config).
  */
+#include <arpa/inet.h>
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -13,10 +14,13 @@
 
 #include "config.h"
 #include "host.h"
+#include "store.h"
 
 typedef enum {
     K_STR,       /* char array; lo is the least length */
-    K_HOSTS,     /* char array: host names, comma-separated, or * (host.h) */
+    K_HOSTS,     /* ... host names, comma-separated, or * (host.h) */
+    K_ADDR,      /* ... a numeric IP address */
+    K_STORE,     /* ... a store's spec (store.h) */
     K_UNSIGNED,  /* unsigned, a whole number in [lo, hi] */
     K_INT,       /* int, a whole number in [lo, hi] */
     K_COUNT,     /* size_t, a whole number in [lo, hi] */
@@ -47,8 +51,27 @@ typedef struct {
 #define AT(f) offsetof(srv_config, f), sizeof(((srv_config *)0)->f)
 #define NONE 0, 0
 
+/* --bind's address: numeric, as srv_start's getaddrinfo takes it (AI_NUMERICHOST). */
+static int address_check(const char *v)
+{
+    unsigned char a[16];
+    return inet_pton(AF_INET, v, a) == 1 || inet_pton(AF_INET6, v, a) == 1 ? 0 : -1;
+}
+
+/* The string kinds: what checks a value beyond its length (NULL: nothing), and what a valid one is. */
+#define IS_STR(k) ((k) <= K_STORE)
+static const struct {
+    int (*check)(const char *v);
+    const char *what;
+} str_kind[] = {
+    [K_STR] = { NULL, "" },
+    [K_HOSTS] = { srv_host_list_check, "host names separated by commas (.NAME: NAME and the names under it), or *; " },
+    [K_ADDR] = { address_check, "a numeric IPv4 or IPv6 address, such as 127.0.0.1, 0.0.0.0 or ::1; " },
+    [K_STORE] = { srv_store_spec_check, "DIR, lmdb:DIR, redis://HOST:PORT[/DB] or none; " },
+};
+
 static const flag flags[] = {
-    { "--bind", "ADDR", K_STR, AT(bind), 1, 0, "127.0.0.1", NULL, "address to listen on" },
+    { "--bind", "ADDR", K_ADDR, AT(bind), 1, 0, "127.0.0.1", NULL, "address to listen on" },
     { "--port", "N", K_UNSIGNED, AT(port), 0, 65535, "8080", NULL, "port; 0 picks a free one" },
     { "--threads", "N", K_INT, AT(threads), 1, 256, NULL, "one per core", "solver threads" },
     { "--http-threads", "N", K_INT, AT(http_threads), 1, 256, NULL, "one per core",
@@ -101,7 +124,7 @@ static const flag flags[] = {
       "the browser front-end's files; DIR/index.html\nmust be readable; installed: found in\nPREFIX/share/pdesolid/web" },
     { "--log-format", "F", K_LOGFMT, AT(log_format), 0, 0, "text", NULL,
       "access log lines: text, or json (one object\na line)" },
-    { "--store", "SPEC", K_STR, AT(store), 1, 0, "var/store", NULL,
+    { "--store", "SPEC", K_STORE, AT(store), 1, 0, "var/store", NULL,
       "durable ids: DIR or lmdb:DIR (LMDB),\nredis://HOST:PORT[/DB], or none; installed:\n/var/lib/pdesolid" },
     { "--store-mb", "N", K_COUNT, AT(store_mb), 1, 1 << 20, "256", NULL,
       "bound of the LMDB store, MiB: least recently used ids\ngo first" },
@@ -207,18 +230,15 @@ static int set(const flag *r, const char *v, srv_config *c)
     unsigned long long n;
     size_t z;
     double d;
-    if (r->k != K_STR && r->k != K_HOSTS && r->size != kind_size[r->k])
+    if (!IS_STR(r->k) && r->size != kind_size[r->k])
         return -1;   /* a row whose kind does not fit its field: the defaults test fails */
-    switch (r->k) {
-    case K_HOSTS:
-        if (srv_host_list_check(v))
-            return -1;
-        /* fall through */
-    case K_STR:
-        if (strlen(v) < (size_t)r->lo || strlen(v) >= r->size)
+    if (IS_STR(r->k)) {
+        if (strlen(v) < (size_t)r->lo || strlen(v) >= r->size || (str_kind[r->k].check && str_kind[r->k].check(v)))
             return -1;
         memcpy(p, v, strlen(v) + 1);
         return 0;
+    }
+    switch (r->k) {
     case K_UNSIGNED:
         if (parse_whole(v, r->lo, r->hi, &n))
             return -1;
@@ -254,6 +274,10 @@ static int set(const flag *r, const char *v, srv_config *c)
             return -1;
         *(srv_log_format *)p = strcmp(v, "json") ? SRV_LOG_TEXT : SRV_LOG_JSON;
         return 0;
+    case K_STR:   /* above */
+    case K_HOSTS:
+    case K_ADDR:
+    case K_STORE:
     case K_SWITCH:
     case K_HELP:
     case K_VERSION:
@@ -265,14 +289,11 @@ static int set(const flag *r, const char *v, srv_config *c)
 /* What a valid value of the row is, for the error message. */
 static void describe(const flag *r, char *out, size_t n)
 {
+    if (IS_STR(r->k)) {
+        snprintf(out, n, "%s%sat most %zu characters", str_kind[r->k].what, r->lo ? "not empty, " : "", r->size - 1);
+        return;
+    }
     switch (r->k) {
-    case K_STR:
-        snprintf(out, n, "%sat most %zu characters", r->lo ? "not empty, " : "", r->size - 1);
-        break;
-    case K_HOSTS:
-        snprintf(out, n, "host names separated by commas (.NAME: NAME and the names under it), or *; at most %zu "
-                 "characters", r->size - 1);
-        break;
     case K_UNSIGNED:
     case K_INT:
     case K_COUNT:
@@ -433,11 +454,11 @@ void srv_config_print(const srv_config *c, FILE *f)
     for (size_t i = 0; i < NFLAGS; i++) {
         const flag *r = &flags[i];
         const void *p = (const char *)c + r->off;
-        switch (r->k) {
-        case K_STR:
-        case K_HOSTS:
+        if (IS_STR(r->k)) {
             fprintf(f, *(const char *)p ? " %s %s" : " %s ''", r->name, (const char *)p);
-            break;
+            continue;
+        }
+        switch (r->k) {
         case K_UNSIGNED:
             fprintf(f, " %s %u", r->name, *(const unsigned *)p);
             break;
@@ -461,6 +482,10 @@ void srv_config_print(const srv_config *c, FILE *f)
             if (*(const int *)p)
                 fprintf(f, " %s", r->name);
             break;
+        case K_STR:   /* above */
+        case K_HOSTS:
+        case K_ADDR:
+        case K_STORE:
         case K_HELP:
         case K_VERSION:
             break;

@@ -180,21 +180,41 @@ static void answered(srv_store *s)
     pthread_mutex_unlock(&s->lock);
 }
 
+/* The backend of spec (LMDB for a directory without a scheme), *where what its open() gets; NULL for a
+ * spec that starts like a URL of no backend (ftp://x, REDIS://x, redis:/x), a mistake more likely than a
+ * directory of that name (./ftp:/x is one). */
+static const srv_store_backend *backend_of(const char *spec, const char **where)
+{
+    *where = spec;
+    for (size_t i = 0; i < sizeof backends / sizeof *backends; i++) {
+        size_t n = strlen(backends[i]->scheme);
+        if (!strncmp(spec, backends[i]->scheme, n)) {
+            *where = backends[i]->keep_scheme ? spec : spec + n;
+            return backends[i];
+        }
+    }
+    size_t k = strspn(spec, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789+.-");
+    return k && spec[k] == ':' && !(spec[0] >= '0' && spec[0] <= '9') ? NULL : &srv_store_lmdb;
+}
+
+int srv_store_spec_check(const char *spec)
+{
+    const char *where;
+    const srv_store_backend *b = strcmp(spec, "none") ? backend_of(spec, &where) : NULL;
+    return !strcmp(spec, "none") ? 0 : b ? b->check(where) : -1;
+}
+
 srv_store *srv_store_open(const srv_store_config *cfg, char *why, size_t whylen)
 {
     const char *spec = cfg->spec && *cfg->spec ? cfg->spec : "none";
     snprintf(why, whylen, "%s", "");
     if (!strcmp(spec, "none"))
         return NULL;
-    const srv_store_backend *b = &srv_store_lmdb;
-    const char *where = spec;
-    for (size_t i = 0; i < sizeof backends / sizeof *backends; i++) {
-        size_t n = strlen(backends[i]->scheme);
-        if (!strncmp(spec, backends[i]->scheme, n)) {
-            b = backends[i];
-            where = backends[i]->keep_scheme ? spec : spec + n;
-            break;
-        }
+    const char *where;
+    const srv_store_backend *b = backend_of(spec, &where);
+    if (!b || b->check(where)) {
+        snprintf(why, whylen, "--store %s: not a store; give DIR, lmdb:DIR, redis://HOST:PORT[/DB] or none", spec);
+        return NULL;
     }
     srv_store *s = calloc(1, sizeof *s);
     if (!s) {

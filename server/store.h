@@ -54,6 +54,9 @@ typedef struct {
     int up;                      /* 1 if the store answered its last call */
 } srv_store_stats;
 
+/* 0 if spec is a valid --store value by its syntax (a directory, lmdb:DIR, redis://HOST:PORT[/DB], none),
+ * else -1: what start-up checks before it opens anything. */
+int srv_store_spec_check(const char *spec);
 /* The store of cfg->spec, or NULL with why (why is "" for "none"). */
 srv_store *srv_store_open(const srv_store_config *cfg, char *why, size_t whylen);
 /* The canonical model document of id and the request it came from (both malloc'd, NUL-terminated;

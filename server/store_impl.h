@@ -12,6 +12,7 @@
 typedef struct {
     const char *scheme;   /* "lmdb:", "redis://": the spec's start that selects the backend */
     int keep_scheme;      /* 1: open() gets the whole spec; 0: the spec after the scheme */
+    int (*check)(const char *where);   /* 0 if where is a valid spec (its syntax alone: at start-up), else -1 */
     void *(*open)(const char *where, const srv_store_config *cfg, char *why, size_t whylen);
     srv_store_status (*get)(void *b, const char *id, char **model, char **request);
     srv_store_status (*put)(void *b, const char *id, const char *model, const char *request);

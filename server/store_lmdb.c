@@ -227,6 +227,12 @@ static srv_store_status status_of(int rc)
                                                                                           : SRV_STORE_ERROR;
 }
 
+/* A directory: any path but the empty one. */
+static int lmdb_check(const char *dir)
+{
+    return *dir ? 0 : -1;
+}
+
 static void *lmdb_open(const char *dir, const srv_store_config *cfg, char *why, size_t whylen)
 {
     lmdb_store *L = calloc(1, sizeof *L);
@@ -471,4 +477,4 @@ static void lmdb_close(void *b)
     free(L);
 }
 
-const srv_store_backend srv_store_lmdb = { "lmdb:", 0, lmdb_open, lmdb_get, lmdb_put, lmdb_stats, lmdb_ready, lmdb_close, lmdb_tick };
+const srv_store_backend srv_store_lmdb = { "lmdb:", 0, lmdb_check, lmdb_open, lmdb_get, lmdb_put, lmdb_stats, lmdb_ready, lmdb_close, lmdb_tick };

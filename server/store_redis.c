@@ -83,14 +83,9 @@ static redisContext *conn(redis_store *R)
     return R->c;
 }
 
-static void *redis_open(const char *url, const srv_store_config *cfg, char *why, size_t whylen)
+/* redis://HOST:PORT[/DB] into R's host, port and db; -1 if url is not one. */
+static int redis_parse(const char *url, redis_store *R)
 {
-    redis_store *R = calloc(1, sizeof *R);
-    if (!R) {
-        snprintf(why, whylen, "out of memory");
-        return NULL;
-    }
-    /* redis://HOST:PORT[/DB] */
     const char *h = url + strlen("redis://"), *colon = strrchr(h, ':');
     char *end = NULL;
     long port = colon ? strtol(colon + 1, &end, 10) : 0;
@@ -98,14 +93,33 @@ static void *redis_open(const char *url, const srv_store_config *cfg, char *why,
     if (end && *end == '/')
         db = strtol(end + 1, &end, 10);
     if (!colon || colon == h || (size_t)(colon - h) >= sizeof R->host || port < 1 || port > 65535 || !end || *end ||
-        db < 0 || db > 1000) {
+        db < 0 || db > 1000)
+        return -1;
+    memcpy(R->host, h, (size_t)(colon - h));
+    R->host[colon - h] = '\0';
+    R->port = (int)port;
+    R->db = (int)db;
+    return 0;
+}
+
+static int redis_check(const char *url)
+{
+    redis_store R;
+    return redis_parse(url, &R);
+}
+
+static void *redis_open(const char *url, const srv_store_config *cfg, char *why, size_t whylen)
+{
+    redis_store *R = calloc(1, sizeof *R);
+    if (!R) {
+        snprintf(why, whylen, "out of memory");
+        return NULL;
+    }
+    if (redis_parse(url, R)) {
         snprintf(why, whylen, "--store %s: give redis://HOST:PORT or redis://HOST:PORT/DB", url);
         free(R);
         return NULL;
     }
-    memcpy(R->host, h, (size_t)(colon - h));
-    R->port = (int)port;
-    R->db = (int)db;
     snprintf(R->prefix, sizeof R->prefix, "%s", cfg->prefix ? cfg->prefix : "pdesolid:");
     R->ttl = cfg->ttl_s;
     R->connect_tv = ms_tv(cfg->connect_timeout_ms ? cfg->connect_timeout_ms : 200);
@@ -264,5 +278,5 @@ static void redis_close(void *b)
     free(R);
 }
 
-const srv_store_backend srv_store_redis = { "redis://", 1, redis_open, redis_get, redis_put, redis_stats, redis_ready,
+const srv_store_backend srv_store_redis = { "redis://", 1, redis_check, redis_open, redis_get, redis_put, redis_stats, redis_ready,
                                             redis_close, NULL };

@@ -268,6 +268,15 @@ static void each_error_should_exit_2_naming_its_argument(void **state)
         { ARGS("--allow-host", "a.example:8080"), "--allow-host a.example:8080: not a valid value" },
         { ARGS("--allow-host", "a.example,,b.example"), "--allow-host a.example,,b.example: not a valid value" },
         { ARGS("--allow-host=*.example.com"), "--allow-host=*.example.com: not a valid value" },
+        { ARGS("--bind", "0.0.0.0x"), "--bind 0.0.0.0x: not a valid value; give a numeric IPv4 or IPv6 address" },
+        { ARGS("--bind=localhost"), "--bind=localhost: not a valid value; give a numeric" },
+        /* a scheme of no store: not a directory of that name (it was: ./ftp:/x/data.mdb) */
+        { ARGS("--store", "ftp://x"), "--store ftp://x: not a valid value; give DIR, lmdb:DIR, redis://HOST:PORT[/DB]" },
+        { ARGS("--store=REDIS://127.0.0.1:6379"), "--store=REDIS://127.0.0.1:6379: not a valid value" },
+        { ARGS("--store=redis:/x"), "--store=redis:/x: not a valid value" },
+        { ARGS("--store=lmdb:"), "--store=lmdb:: not a valid value" },
+        { ARGS("--store=redis://x:99999"), "--store=redis://x:99999: not a valid value" },
+        { ARGS("--store=redis://:6379"), "--store=redis://:6379: not a valid value" },
     };
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
         srv_config c;
@@ -276,6 +285,25 @@ static void each_error_should_exit_2_naming_its_argument(void **state)
             fail_msg("case %zu: rc %d, err \"%s\", want 2 and \"%s\"", i, r.rc, r.err, bad[i].says);
         if (i == 0 && strstr(r.err, "needs a value"))
             fail_msg("a stray argument is not a flag without its value: %s", r.err);
+    }
+}
+
+/* The forms --bind and --store take beyond every_flag's, kept as given. */
+static void store_and_bind_should_take_each_of_their_forms(void **state)
+{
+    (void)state;
+    static const char *const ok[][2] = {
+        { "--bind", "0.0.0.0" },   { "--bind", "127.0.0.1" },        { "--bind", "fe80::1" },
+        { "--store", "none" },     { "--store", "var/store" },       { "--store", "/var/lib/pdesolid" },
+        { "--store", "lmdb:/tmp/s" }, { "--store", "./ftp:x" },      /* a directory so named, written so */
+        { "--store", "redis://127.0.0.1:6379" }, { "--store", "redis://cache.internal:6380/3" },
+    };
+    for (size_t i = 0; i < sizeof ok / sizeof *ok; i++) {
+        srv_config c;
+        result r = parse(&c, ARGS(ok[i][0], ok[i][1]));
+        if (r.rc)
+            fail_msg("%s %s: rc %d, %s", ok[i][0], ok[i][1], r.rc, r.err);
+        assert_string_equal(!strcmp(ok[i][0], "--bind") ? c.bind : c.store, ok[i][1]);
     }
 }
 
@@ -382,6 +410,7 @@ int main(void)
         cmocka_unit_test(every_flag_should_take_its_value_in_both_forms),
         cmocka_unit_test(every_flag_in_the_usage_should_be_tested),
         cmocka_unit_test(each_error_should_exit_2_naming_its_argument),
+        cmocka_unit_test(store_and_bind_should_take_each_of_their_forms),
         cmocka_unit_test(web_given_without_an_index_should_refuse_to_start),
         cmocka_unit_test(help_and_version_should_print_and_return_1),
         cmocka_unit_test(print_should_read_back_as_the_same_config),
