@@ -145,12 +145,27 @@ int poly_detj(const poly3 x[3], poly3 *dj)
     return 1;
 }
 
+/* The strides of p's axes, and the number of lines along axis a with their starts' offsets into
+ * start[] (at most POLY_MAX / 2 + 1 of them: a line has >= 2 coefficients where it matters). */
+static int lines_along(const int n[3], int a, int *stride, int *start)
+{
+    const int st[3] = { n[1] * n[2], n[2], 1 };
+    int m[3] = { n[0], n[1], n[2] }, count = 0;
+    m[a] = 1;
+    for (int i = 0; i < m[0]; i++)
+        for (int j = 0; j < m[1]; j++)
+            for (int k = 0; k < m[2]; k++)
+                start[count++] = i * st[0] + j * st[1] + k;
+    *stride = st[a];
+    return count;
+}
+
 void poly_bernstein(poly3 *p)
 {
-    const int *n = p->n;
-    const int stride[3] = { n[1] * n[2], n[2], 1 };
+    double w[POLY_AXIS][POLY_AXIS];   /* C(i, j) / C(d, j) */
+    int start[POLY_MAX], st;
     for (int a = 0; a < 3; a++) {
-        const int d = n[a] - 1;
+        const int d = p->n[a] - 1;
         if (d < 1)
             continue;
         double binom[POLY_AXIS][POLY_AXIS];   /* C(i, j) */
@@ -159,21 +174,20 @@ void poly_bernstein(poly3 *p)
             for (int j = 1; j < i; j++)
                 binom[i][j] = binom[i - 1][j - 1] + binom[i - 1][j];
         }
-        for (int start = 0; start < ncoef(n); start++) {
-            const int idx[3] = { start / stride[0], start / stride[1] % n[1], start % n[2] };
-            if (idx[a] != 0)
-                continue;
-            double a_[POLY_AXIS], b[POLY_AXIS];
+        for (int i = 0; i <= d; i++)
+            for (int j = 0; j <= i; j++)
+                w[i][j] = binom[i][j] / binom[d][j];
+        const int nl = lines_along(p->n, a, &st, start);
+        for (int l = 0; l < nl; l++) {
+            double *c = p->c + start[l], a_[POLY_AXIS];
             for (int i = 0; i <= d; i++)
-                a_[i] = p->c[start + i * stride[a]];
+                a_[i] = c[i * st];
             for (int i = 0; i <= d; i++) {   /* b_i = sum_(j <= i) C(i, j) / C(d, j) a_j */
                 double sum = 0.0;
                 for (int j = 0; j <= i; j++)
-                    sum += binom[i][j] / binom[d][j] * a_[j];
-                b[i] = sum;
+                    sum += w[i][j] * a_[j];
+                c[i * st] = sum;
             }
-            for (int i = 0; i <= d; i++)
-                p->c[start + i * stride[a]] = b[i];
         }
     }
 }
@@ -257,6 +271,20 @@ static void slice(double *b, int n[3], int a, int keep)
  * (best); its bound is its least coefficient, exact when that is a corner's. Returns 1 when the
  * node still needs splitting.
  */
+/* The least and largest difference of neighbouring coefficients along axis a. */
+static void slopes(const double *b, const int n[3], int a, double *lo, double *hi)
+{
+    int start[POLY_MAX], st;
+    const int nl = lines_along(n, a, &st, start);
+    double l = INFINITY, h = -INFINITY;
+    for (int q = 0; q < nl; q++)
+        for (int i = 0; i + 1 < n[a]; i++) {
+            const double d = b[start[q] + (i + 1) * st] - b[start[q] + i * st];
+            l = d < l ? d : l, h = d > h ? d : h;
+        }
+    *lo = l, *hi = h;
+}
+
 static int settle(pnode *nd, double *b, double *best, double at[3], double *done)
 {
     for (int moved = 1; moved;) {
@@ -264,15 +292,9 @@ static int settle(pnode *nd, double *b, double *best, double at[3], double *done
         for (int a = 0; a < 3; a++) {
             if (nd->n[a] < 2)
                 continue;
-            const int st = a == 0 ? nd->n[1] * nd->n[2] : a == 1 ? nd->n[2] : 1;
-            int up = 1, down = 1;
-            for (int q = 0; q < ncoef(nd->n) && (up || down); q++) {
-                const int ia = a == 0 ? q / st : a == 1 ? q / st % nd->n[1] : q % nd->n[2];
-                if (ia + 1 >= nd->n[a])
-                    continue;
-                const double d = b[q + st] - b[q];
-                up &= d >= 0.0, down &= d <= 0.0;
-            }
+            double lo, hi;
+            slopes(b, nd->n, a, &lo, &hi);
+            const int up = lo >= 0.0, down = hi <= 0.0;
             if (up || down) {
                 slice(b, nd->n, a, up ? 0 : nd->n[a] - 1);
                 if (up)
@@ -318,15 +340,8 @@ static int split_axis_of(const pnode *nd, const double *b)
     for (int a = 0; a < 3; a++) {
         if (nd->n[a] < 2)
             continue;
-        const int st = a == 0 ? nd->n[1] * nd->n[2] : a == 1 ? nd->n[2] : 1;
-        double lo = INFINITY, hi = -INFINITY;
-        for (int q = 0; q < ncoef(nd->n); q++) {
-            const int ia = a == 0 ? q / st : a == 1 ? q / st % nd->n[1] : q % nd->n[2];
-            if (ia + 1 >= nd->n[a])
-                continue;
-            const double d = b[q + st] - b[q];
-            lo = fmin(lo, d), hi = fmax(hi, d);
-        }
+        double lo, hi;
+        slopes(b, nd->n, a, &lo, &hi);
         if (hi - lo > most)
             most = hi - lo, best = a;
     }
@@ -336,17 +351,16 @@ static int split_axis_of(const pnode *nd, const double *b)
 /* The halves of b along axis a (de Casteljau at 1/2): into l and r, sizes n. */
 static void halve(const double *b, const int n[3], int a, double *l, double *r)
 {
-    const int st = a == 0 ? n[1] * n[2] : a == 1 ? n[2] : 1, m = n[a];
-    for (int q = 0; q < ncoef(n); q++) {
-        const int ia = a == 0 ? q / st : a == 1 ? q / st % n[1] : q % n[2];
-        if (ia != 0)
-            continue;
+    int start[POLY_MAX], st;
+    const int nl = lines_along(n, a, &st, start), m = n[a];
+    for (int q = 0; q < nl; q++) {
         double t[POLY_AXIS];
+        const int s0 = start[q];
         for (int i = 0; i < m; i++)
-            t[i] = b[q + i * st];
+            t[i] = b[s0 + i * st];
         for (int lev = 0; lev < m; lev++) {
-            l[q + lev * st] = t[0];
-            r[q + (m - 1 - lev) * st] = t[m - 1 - lev];
+            l[s0 + lev * st] = t[0];
+            r[s0 + (m - 1 - lev) * st] = t[m - 1 - lev];
             for (int i = 0; i + 1 < m - lev; i++)
                 t[i] = 0.5 * (t[i] + t[i + 1]);
         }

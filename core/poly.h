@@ -5,10 +5,13 @@
  *
  * A poly3 is sum c[(i n1 + j) n2 + k] u^i v^j w^k, n = its degree + 1 along each axis. Over a box
  * mapped to [0, 1]^3, the same polynomial is sum b_ijk B_i(u) B_j(v) B_k(w) in the Bernstein
- * basis; the b lie between the polynomial's least and largest values' bounds (the basis is a
- * partition of unity, >= 0), the corner coefficients are its values at the corners, and halving a
+ * basis; the polynomial lies between its least and largest b there (the basis is >= 0 and sums to
+ * 1), the corner coefficients are its values at the corners, and halving a
  * box (de Casteljau) gives its halves' coefficients, which close on the range as the square of the
- * width. Nothing here allocates but poly_minimise; every function is reentrant.
+ * width. poly_detj, poly_face_element and poly_minimise allocate their scratch (and free it); every
+ * function is reentrant. A poly3 is 2 KB: the limits below are fig. 1's with room (at 1024
+ * coefficients the scratch's allocations, trimmed back to the system and faulted in again, cost fig.
+ * 1e 30 us a call).
  */
 #ifndef PDE_POLY_H
 #define PDE_POLY_H

@@ -238,12 +238,13 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
         const size_t nm = cs->nmodes;
         if (nm == 0 && cs->nfterms == 0)
             continue;
-        /* Per mode and sample: f_u, its fourth derivative, f_v, its fourth, h, its fourth. */
-        double *tab = malloc((6 * nm * n + 1) * sizeof *tab);
+        /* Per mode and sample: f_u, its fourth derivative, f_v, its fourth, h, its fourth; then per mode
+         * the products of the u- and v-factors of the three terms on the current (u, v). */
+        double *tab = malloc((6 * nm * n + 3 * nm + 1) * sizeof *tab);
         if (!tab)
             return PDE_ERR_NOMEM;
         double *fu = tab, *fu4 = fu + nm * n, *fv = fu4 + nm * n, *fv4 = fv + nm * n;
-        double *h = fv4 + nm * n, *h4 = h + nm * n;
+        double *h = fv4 + nm * n, *h4 = h + nm * n, *uv = h4 + nm * n;
         for (size_t m = 0; m < nm; m++) {
             const pde_mode *md = &cs->modes[m];
             if (poll_after(pl, n * (4 + md->nterms * 8))) {
@@ -269,24 +270,28 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
         }
         double err = 0.0, scale = 0.0;
         for (size_t i = 0; i < n; i++)
-            for (size_t j = 0; j < n; j++)
+            for (size_t j = 0; j < n; j++) {
+                if (poll_after(pl, n * (nm + cs->nfterms))) {
+                    free(tab);
+                    return PDE_ERR_CANCELLED;
+                }
+                for (size_t m = 0; m < nm; m++) {
+                    const double a = fu[m * n + i], b = fv[m * n + j];
+                    uv[3 * m] = fu4[m * n + i] * b, uv[3 * m + 1] = a * fv4[m * n + j], uv[3 * m + 2] = a * b;
+                }
                 for (size_t k = 0; k < n; k++) {
-                    if (poll_after(pl, nm + cs->nfterms)) {
-                        free(tab);
-                        return PDE_ERR_CANCELLED;
-                    }
                     double tu = 0.0, tv = 0.0, tw = 0.0;
                     for (size_t m = 0; m < nm; m++) {
-                        double a = fu[m * n + i], b = fv[m * n + j];
-                        tu += fu4[m * n + i] * b * h[m * n + k];
-                        tv += a * fv4[m * n + j] * h[m * n + k];
-                        tw += a * b * h4[m * n + k];
+                        tu += uv[3 * m] * h[m * n + k];
+                        tv += uv[3 * m + 1] * h[m * n + k];
+                        tw += uv[3 * m + 2] * h4[m * n + k];
                     }
                     tu *= cs->a, tv *= cs->b, tw *= cs->c;
                     double p = cs->nfterms ? pde_force(s, c, (i + 0.5) / res, (j + 0.5) / res, (k + 0.5) / res) : 0.0;
                     err = max2(err, fabs(tu + tv + tw - p));
                     scale = max2(scale, max2(max2(fabs(tu), fabs(tv)), max2(fabs(tw), fabs(p))));
                 }
+            }
         free(tab);
         worst = fmax(worst, scale > 0.0 ? err / scale : err);
     }
@@ -699,7 +704,8 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
         bb_result b;
         if (po) {
-            if ((st = poly_minimise(&po->b[what], sign, tol,
+            /* det J to 1e-11 of its scale, not 1e-9: its halvings are cheap, and close as their square */
+            if ((st = poly_minimise(&po->b[what], sign, what < 3 ? tol : 1e-2 * tol,
                                     what < 3 ? PDE_PROPS_BOXES : jbudget, &b)) != PDE_OK)
                 break;
         } else if (what < 3 && s->comp[what].nmodes == 1 && !(o & 1)) {

@@ -1354,6 +1354,16 @@ static void poly_bounds_should_match_the_closed_form_and_contain_a_dense_samplin
                     assert_rel(sign * r.best, k ? 1.5 : 0.0, 1e-13, 1.0);
             }
         }
+        if (f == 4) {   /* its faces curve along both parameters: the area by poly's rules, against the reference */
+            ref_props_out ref;
+            pde_props pp;
+            assert_int_equal(ref_props(sol, &ref), 0);
+            assert_int_equal(pde_properties(sol, NULL, &pp), PDE_OK);
+            assert_rel(pp.surface_area, ref.surface_area, 1e-9, 0);
+            assert_rel(pp.volume, ref.volume, 1e-9, 0);
+            assert_rel(pp.signed_volume, ref.signed_volume, 1e-9, 0);
+            assert_true(pp.integral_error <= 1e-11);
+        }
         pde_solution_free(sol);
     }
     free(p);
