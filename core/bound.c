@@ -523,52 +523,63 @@ double obj_lower(const pde_solution *s, int what, double sign, pbox *b, double *
 /* ---- branch and bound ---- */
 
 typedef struct {
+    double lb;  /* first: bb_heap's key */
     pbox b;
-    double lb;
     int axis;   /* split_axis of b's model, -1 for a point */
 } bb_node;
 
-typedef struct {
-    bb_node *a;
-    size_t n, cap;
-} heap;
+static double heap_key(const bb_heap *h, size_t i)
+{
+    double k;
+    memcpy(&k, h->a + i * h->size, sizeof k);
+    return k;
+}
 
-static int heap_push(heap *h, const bb_node *x)
+double bb_heap_min(const bb_heap *h)
+{
+    return heap_key(h, 0);
+}
+
+int bb_heap_push(bb_heap *h, const void *x)
 {
     if (h->n == h->cap) {
         size_t cap = h->cap ? 2 * h->cap : 64;
-        bb_node *a = realloc(h->a, cap * sizeof *a);
+        unsigned char *a = realloc(h->a, cap * h->size);
         if (!a)
             return -1;
         h->a = a, h->cap = cap;
     }
+    double k;
+    memcpy(&k, x, sizeof k);
     size_t i = h->n++;
-    while (i > 0 && h->a[(i - 1) / 2].lb > x->lb) {
-        h->a[i] = h->a[(i - 1) / 2];
+    while (i > 0 && heap_key(h, (i - 1) / 2) > k) {
+        memcpy(h->a + i * h->size, h->a + (i - 1) / 2 * h->size, h->size);
         i = (i - 1) / 2;
     }
-    h->a[i] = *x;
+    memcpy(h->a + i * h->size, x, h->size);
     return 0;
 }
 
-static bb_node heap_pop(heap *h)
+void bb_heap_pop(bb_heap *h, void *top)
 {
-    bb_node top = h->a[0], last = h->a[--h->n];
+    unsigned char *last = h->a + --h->n * h->size;
+    memcpy(top, h->a, h->size);
+    double k;
+    memcpy(&k, last, sizeof k);
     size_t i = 0;
     for (;;) {
         size_t c = 2 * i + 1;
         if (c >= h->n)
             break;
-        if (c + 1 < h->n && h->a[c + 1].lb < h->a[c].lb)
+        if (c + 1 < h->n && heap_key(h, c + 1) < heap_key(h, c))
             c++;
-        if (h->a[c].lb >= last.lb)
+        if (heap_key(h, c) >= k)
             break;
-        h->a[i] = h->a[c];
+        memcpy(h->a + i * h->size, h->a + c * h->size, h->size);
         i = c;
     }
     if (h->n)
-        h->a[i] = last;
-    return top;
+        memmove(h->a + i * h->size, last, h->size);
 }
 
 /* The axis along which b's half-width contributes most to its model m's bound, or -1 for a point. */
@@ -684,12 +695,12 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
         r.at[k] = start[k];
 
     /* A box per slab of a loft: a box's Taylor model holds within one slab, where h is analytic. */
-    heap h = { 0 };
+    bb_heap h = { .size = sizeof(bb_node) };
     size_t nslabs;
     const double *br = solution_breaks(s, &nslabs);
     double val, at[3];
     for (size_t k = 0; k < nslabs; k++) {
-        bb_node n = { { { 0, 0, br[k] }, { 1, 1, br[k + 1] } }, 0, -1 };
+        bb_node n = { 0, { { 0, 0, br[k] }, { 1, 1, br[k + 1] } }, -1 };
         if (within) {
             for (int a = 0; a < 3; a++)
                 n.b.lo[a] = fmax(n.b.lo[a], within->lo[a]), n.b.hi[a] = fmin(n.b.hi[a], within->hi[a]);
@@ -702,7 +713,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
         r.boxes++;
         if (val < r.best)
             r.best = val, r.at[0] = at[0], r.at[1] = at[1], r.at[2] = at[2];
-        if (heap_push(&h, &n)) {
+        if (bb_heap_push(&h, &n)) {
             free(h.a);
             free(jc);
             return PDE_ERR_NOMEM;
@@ -711,13 +722,14 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
     pde_status st = PDE_OK;
     unsigned iterations = 0;
     while (h.n) {
-        if (h.a[0].lb >= r.best - tol || r.boxes >= budget)
+        if (bb_heap_min(&h) >= r.best - tol || r.boxes >= budget)
             break;
         if ((++iterations & 7) == 0 && pde_stopped(cancel)) {   /* every 16 boxes */
             st = PDE_ERR_CANCELLED;
             break;
         }
-        bb_node top = heap_pop(&h);
+        bb_node top;
+        bb_heap_pop(&h, &top);
         const int k = top.axis;
         if (k < 0) {   /* a point: its bound is its value */
             r.lower = fmin(r.lower, top.lb);
@@ -754,7 +766,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
             c.axis = split_axis(&m, &c.b);
             c.lb = fmax(c.lb, top.lb);   /* a child's minimum is at least its parent's bound */
             if (c.lb < r.best - tol) {
-                if (heap_push(&h, &c)) {
+                if (bb_heap_push(&h, &c)) {
                     st = PDE_ERR_NOMEM;
                     break;
                 }
@@ -765,7 +777,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
             break;
     }
     if (h.n)
-        r.lower = fmin(r.lower, h.a[0].lb);
+        r.lower = fmin(r.lower, bb_heap_min(&h));
     r.lower = fmin(r.lower, r.best);
     free(h.a);
     free(jc);

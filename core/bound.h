@@ -57,6 +57,17 @@ typedef struct {
     size_t boxes;     /* boxes bounded */
 } bb_result;
 
+/* A binary min-heap of a branch and bound's open boxes: elements of `size` bytes, each beginning with
+ * the double it is ordered by. Zeroed but for size, it is empty; free(a) frees it. */
+typedef struct {
+    unsigned char *a;
+    size_t n, cap, size;
+} bb_heap;
+
+int bb_heap_push(bb_heap *h, const void *x);   /* -1 (h unchanged) where memory ran out */
+void bb_heap_pop(bb_heap *h, void *top);       /* the least into *top; h not empty */
+double bb_heap_min(const bb_heap *h);          /* the least key; h not empty */
+
 /*
  * Minimises sign * f over the box within (NULL: the unit cube; it may be flat, a face) by branch and
  * bound, from a known point start in it, until the gap best - lower is at most tol or `budget` boxes

@@ -5,7 +5,8 @@
  * 1. Extremes: a uniform sample, then branch and bound (bound.h) from its
  *    best points, until the certified bound is
  *    within 1e-9 of the solid's size of the best value (or a box budget ends:
- *    the gap says how far it got).
+ *    the gap says how far it got). A polynomial solid (fig. 1) instead takes
+ *    a branch and bound over Bernstein coefficients (poly.h), without sample.
  * 2. Integrals over the solid weighted by |det J| (quad.h): volume, signed
  *    volume, first and second moments about the box's centre, hence the
  *    centroid, the inertia tensor about it and its principal axes (Jacobi).
@@ -21,6 +22,7 @@
 #include <string.h>
 
 #include "bound.h"
+#include "poly.h"
 #include "quad.h"
 
 #define SIGN_BOXES 200         /* boxes to certify det J's sign where it touches 0 */
@@ -236,12 +238,13 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
         const size_t nm = cs->nmodes;
         if (nm == 0 && cs->nfterms == 0)
             continue;
-        /* Per mode and sample: f_u, its fourth derivative, f_v, its fourth, h, its fourth. */
-        double *tab = malloc((6 * nm * n + 1) * sizeof *tab);
+        /* Per mode and sample: f_u, its fourth derivative, f_v, its fourth, h, its fourth; then per mode
+         * the products of the u- and v-factors of the three terms on the current (u, v). */
+        double *tab = malloc((6 * nm * n + 3 * nm + 1) * sizeof *tab);
         if (!tab)
             return PDE_ERR_NOMEM;
         double *fu = tab, *fu4 = fu + nm * n, *fv = fu4 + nm * n, *fv4 = fv + nm * n;
-        double *h = fv4 + nm * n, *h4 = h + nm * n;
+        double *h = fv4 + nm * n, *h4 = h + nm * n, *uv = h4 + nm * n;
         for (size_t m = 0; m < nm; m++) {
             const pde_mode *md = &cs->modes[m];
             if (poll_after(pl, n * (4 + md->nterms * 8))) {
@@ -267,24 +270,28 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
         }
         double err = 0.0, scale = 0.0;
         for (size_t i = 0; i < n; i++)
-            for (size_t j = 0; j < n; j++)
+            for (size_t j = 0; j < n; j++) {
+                if (poll_after(pl, n * (nm + cs->nfterms))) {
+                    free(tab);
+                    return PDE_ERR_CANCELLED;
+                }
+                for (size_t m = 0; m < nm; m++) {
+                    const double a = fu[m * n + i], b = fv[m * n + j];
+                    uv[3 * m] = fu4[m * n + i] * b, uv[3 * m + 1] = a * fv4[m * n + j], uv[3 * m + 2] = a * b;
+                }
                 for (size_t k = 0; k < n; k++) {
-                    if (poll_after(pl, nm + cs->nfterms)) {
-                        free(tab);
-                        return PDE_ERR_CANCELLED;
-                    }
                     double tu = 0.0, tv = 0.0, tw = 0.0;
                     for (size_t m = 0; m < nm; m++) {
-                        double a = fu[m * n + i], b = fv[m * n + j];
-                        tu += fu4[m * n + i] * b * h[m * n + k];
-                        tv += a * fv4[m * n + j] * h[m * n + k];
-                        tw += a * b * h4[m * n + k];
+                        tu += uv[3 * m] * h[m * n + k];
+                        tv += uv[3 * m + 1] * h[m * n + k];
+                        tw += uv[3 * m + 2] * h4[m * n + k];
                     }
                     tu *= cs->a, tv *= cs->b, tw *= cs->c;
                     double p = cs->nfterms ? pde_force(s, c, (i + 0.5) / res, (j + 0.5) / res, (k + 0.5) / res) : 0.0;
                     err = max2(err, fabs(tu + tv + tw - p));
                     scale = max2(scale, max2(max2(fabs(tu), fabs(tv)), max2(fabs(tw), fabs(p))));
                 }
+            }
         free(tab);
         worst = fmax(worst, scale > 0.0 ? err / scale : err);
     }
@@ -593,6 +600,44 @@ static pde_status what_detj(const pde_solution *s, const quad_sep *sp, double si
     return bb_minimise(s, OBJ_DETJ, sign, start, NULL, tol, budget, cancel, out);
 }
 
+/*
+ * A polynomial solid's objectives (poly.h): x, y, z and det J by their Bernstein coefficients over
+ * the cube, and the sums of the magnitudes of their terms (the rounding's scale). NULL where the
+ * solid is not a polynomial within poly.h's limits (or memory ran out: the general path then).
+ */
+typedef struct {
+    poly3 x[3], b[4];   /* x: power basis; b: Bernstein, of x, y, z, det J */
+} poly_objs;
+
+static poly_objs *poly_objs_new(const pde_solution *s)
+{
+    poly_objs *p = malloc(sizeof *p);
+    if (!p || !poly_solution(s, p->x) || !poly_detj(p->x, &p->b[3])) {
+        free(p);
+        return NULL;
+    }
+    for (int c = 0; c < 3; c++) {
+        const int n = p->x[c].n[0] * p->x[c].n[1] * p->x[c].n[2];
+        memcpy(p->b[c].n, p->x[c].n, sizeof p->b[c].n);
+        memcpy(p->b[c].c, p->x[c].c, (size_t)n * sizeof p->b[c].c[0]);
+    }
+    return p;
+}
+
+/* The objectives at the corners and the centre, noted as a sample's would be; then the Bernstein forms. */
+static void poly_sample(poly_objs *p, extremes *e)
+{
+    for (int i = 0; i < 9; i++) {
+        const double at[3] = { i < 8 ? i & 1 : 0.5, i < 8 ? i >> 1 & 1 : 0.5, i < 8 ? i >> 2 : 0.5 };
+        double x[3];
+        for (int c = 0; c < 3; c++)
+            x[c] = poly_eval(&p->x[c], at);
+        note_point(e, at, x, poly_eval(&p->b[3], at));
+    }
+    for (int o = 0; o < 4; o++)
+        poly_bernstein(&p->b[o]);
+}
+
 pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde_props *out)
 {
     if (!s || !out)
@@ -623,7 +668,13 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     }
     e.jmin = DBL_MAX;
     e.jmax = -DBL_MAX;
-    pde_status st = sweep(s, uni, res, uni, res, uni, res, &pl, &e);
+    /* A polynomial solid: its extremes from Bernstein coefficients, where a sample is of no help. */
+    poly_objs *po = poly_objs_new(s);
+    pde_status st = PDE_OK;
+    if (po)
+        poly_sample(po, &e);
+    else
+        st = sweep(s, uni, res, uni, res, uni, res, &pl, &e);
     free(uni);
     if (st != PDE_OK)
         return st;
@@ -652,7 +703,12 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         const int what = o < 6 ? o / 2 : 3;
         const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
         bb_result b;
-        if (what < 3 && s->comp[what].nmodes == 1 && !(o & 1)) {
+        if (po) {
+            /* det J to 1e-11 of its scale, not 1e-9: its halvings are cheap, and close as their square */
+            if ((st = poly_minimise(&po->b[what], sign, what < 3 ? tol : 1e-2 * tol,
+                                    what < 3 ? PDE_PROPS_BOXES : jbudget, &b)) != PDE_OK)
+                break;
+        } else if (what < 3 && s->comp[what].nmodes == 1 && !(o & 1)) {
             /* Both extremes of a component of one mode at once. */
             double bd[2], bs[2], ba[2][3];
             if ((st = single_mode_extremes(s, what, tol, cancel, bd, bs, ba)) == PDE_OK) {
@@ -664,7 +720,9 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             } else if (st != PDE_ERR_INVALID)
                 return st;
         }
-        if (what < 3 && single[what])
+        if (po)
+            (void)0;
+        else if (what < 3 && single[what])
             b = sb[what][o & 1];
         else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, jbudget, cancel, &b)
                        : sp.axis >= 0 ? separable_extreme(s, &sp, what, sign, at[o], tol, PDE_PROPS_BOXES, cancel, &b)
@@ -686,6 +744,10 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             r.detj_gap = fmax(r.detj_gap, gap);
         }
     }
+    if (st != PDE_OK) {   /* poly_minimise's (the other paths return) */
+        free(po);
+        return st;
+    }
     /* The scales from the extremes found, which the branch and bound only improved. */
     scales(best, &size, &jscale);
     /* det J keeps its sign over the whole solid, up to what the integrals count as zero (1e-13 of its
@@ -698,14 +760,18 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         const double sign = k ? -1.0 : 1.0;
         if (jlow[k] < -jtol && fabs(best[6 + k]) <= 1e-9 * jscale) {
             bb_result b;
-            st = what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, &b);
-            if (st != PDE_OK)
+            st = po ? poly_minimise(&po->b[3], sign, 0.5 * jtol, SIGN_BOXES, &b)
+                    : what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, &b);
+            if (st != PDE_OK) {
+                free(po);
                 return st;
+            }
             jlow[k] = fmax(jlow[k], b.lower);
         }
         if (jlow[k] >= -jtol)
             jsign = k ? -1 : 1;
     }
+    free(po);
     /* Folds are witnessed by attained values of both signs. */
     double tol = 1e-9 * jscale;
     r.folds = best[6] < -tol && best[7] > tol;

@@ -19,6 +19,7 @@
 #include "mesh.h"
 #include "internal.h"   /* to perturb a solution's closed form, which the public API keeps immutable */
 #include "quad.h"       /* the separable integrals against the cube's */
+#include "poly.h"       /* polynomial solids' Bernstein bounds */
 #include "model.h"
 #include "support.h"
 #include "template.h"
@@ -1292,6 +1293,82 @@ static void det_j_gap_should_close_to_1e_9_of_its_scale_on_every_paper_figure(vo
     }
 }
 
+/*
+ * poly.c: a polynomial solid's power form and det J against the closed form's values and partials
+ * (pde_eval_d) at random points, and the Bernstein branch and bound's extremes of x, y, z and det J
+ * against a dense sampling: the bound below every sample, the value found attained where it says,
+ * the gap within its tolerance; fig. 1a's det J is 6 w (1 - w) by hand: range [0, 3/2].
+ */
+static void poly_bounds_should_match_the_closed_form_and_contain_a_dense_sampling_of_figure_1(void **state)
+{
+    (void)state;
+    /* And a twisted solid, where every entry of J (so every cofactor of det J) is nonzero. */
+    const char *figs[] = { "fig1a", "fig1c", "fig1e", "fig1g", "twisted" };
+    pde_bterm bx[2] = { { F_pow(1), F_pow(0), 1, 0, 1, 0.5 }, { F_pow(0), F_pow(1), 0.3, 0.2, -0.2, 0 } };
+    pde_bterm by[2] = { { F_pow(0), F_pow(1), 1, 0, 1.2, 0 }, { F_pow(1), F_pow(1), 0.4, 0, -0.3, 0.2 } };
+    pde_bterm bz[3] = { { F_pow(0), F_pow(0), 0, 1, 1, 1 }, { F_pow(1), F_pow(0), 0.2, 0, -0.1, 0.3 },
+                        { F_pow(0), F_pow(1), 0, -0.1, 0.2, 0 } };
+    pde_model twisted = { { { 1, 1, -1, bx, 2, NULL, 0 }, { 1, 1, -1, by, 2, NULL, 0 }, { 1, 1, -1, bz, 3, NULL, 0 } } };
+    poly3 *p = malloc(5 * sizeof *p);   /* x, y, z, det J, a Bernstein form */
+    assert_non_null(p);
+    uint64_t seed = 88172645463325252u;
+    for (size_t f = 0; f < sizeof figs / sizeof *figs; f++) {
+        pde_solution *sol = NULL;
+        if (f < 4)
+            sol = preset_solution(figs[f]);
+        else
+            assert_int_equal(pde_solve(&twisted, &sol, NULL), PDE_OK);
+        assert_true(poly_solution(sol, p));
+        assert_true(poly_detj(p, &p[3]));
+        for (int k = 0; k < 300; k++) {
+            double at[3], x[3], d[3][3];
+            for (int a = 0; a < 3; a++) {
+                seed ^= seed << 13, seed ^= seed >> 7, seed ^= seed << 17;
+                at[a] = (double)(seed >> 11) / 9007199254740992.0;
+            }
+            pde_eval_d(sol, at[0], at[1], at[2], x, d[0], d[1], d[2]);
+            for (int c = 0; c < 3; c++)
+                assert_rel(poly_eval(&p[c], at), x[c], 1e-13, 1.0);
+            assert_rel(poly_eval(&p[3], at), det3(d[0], d[1], d[2]), 1e-12, 1.0);
+        }
+        for (int o = 0; o < 4; o++) {
+            p[4] = p[o];
+            poly_bernstein(&p[4]);
+            enum { N = 33 };
+            double lo = INFINITY, hi = -INFINITY;
+            for (int i = 0; i < N * N * N; i++) {
+                const double at[3] = { (i / (N * N)) / (N - 1.0), (i / N % N) / (N - 1.0), (i % N) / (N - 1.0) };
+                const double v = poly_eval(&p[o], at);
+                lo = fmin(lo, v), hi = fmax(hi, v);
+            }
+            const double scale = fmax(1.0, fmax(fabs(lo), fabs(hi))), tol = 1e-11 * scale;
+            for (int k = 0; k < 2; k++) {
+                const double sign = k ? -1.0 : 1.0;
+                bb_result r;
+                assert_int_equal(poly_minimise(&p[4], sign, tol, 100000, &r), PDE_OK);
+                if (!(r.lower <= sign * (k ? hi : lo) + 1e-14 * scale) || !(r.best - r.lower <= tol))
+                    fail_msg("%s objective %d sign %g: bound %.17g, found %.17g, sampled %.17g", figs[f], o, sign,
+                             r.lower, r.best, sign * (k ? hi : lo));
+                assert_rel(sign * poly_eval(&p[o], r.at), r.best, 1e-13, scale);
+                if (f == 0 && o == 3)   /* fig. 1a: det J = 6 w (1 - w) */
+                    assert_rel(sign * r.best, k ? 1.5 : 0.0, 1e-13, 1.0);
+            }
+        }
+        if (f == 4) {   /* its faces curve along both parameters: the area by poly's rules, against the reference */
+            ref_props_out ref;
+            pde_props pp;
+            assert_int_equal(ref_props(sol, &ref), 0);
+            assert_int_equal(pde_properties(sol, NULL, &pp), PDE_OK);
+            assert_rel(pp.surface_area, ref.surface_area, 1e-9, 0);
+            assert_rel(pp.volume, ref.volume, 1e-9, 0);
+            assert_rel(pp.signed_volume, ref.signed_volume, 1e-9, 0);
+            assert_true(pp.integral_error <= 1e-11);
+        }
+        pde_solution_free(sol);
+    }
+    free(p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1323,6 +1400,7 @@ int main(void)
         cmocka_unit_test(bounds_should_stay_certified_when_a_factor_bound_overflows),
         cmocka_unit_test(a_lofts_properties_should_match_the_reference_and_its_certificate_be_near_rounding),
         cmocka_unit_test(det_j_gap_should_close_to_1e_9_of_its_scale_on_every_paper_figure),
+        cmocka_unit_test(poly_bounds_should_match_the_closed_form_and_contain_a_dense_sampling_of_figure_1),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
