@@ -19,6 +19,7 @@
  * the client, which is still writing, can read the answer.
  */
 #include <arpa/inet.h>
+#include <stdarg.h>
 #include <netdb.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -408,8 +409,10 @@ static enum MHD_Result take_body(srv_req *r, const char *upload, size_t n)
         r->drained += n;
         return r->drained <= DRAIN_BYTES && age <= DRAIN_SECONDS ? MHD_YES : MHD_NO;
     }
-    if (age > s->cfg.request_timeout)
+    if (age > s->cfg.request_timeout) {
+        r->status = 408;   /* logged so; closed without an answer */
         return MHD_NO;   /* the whole request, headers and body, has a deadline (--request-timeout) */
+    }
     if (!(srv_routes[r->route].flags & SRV_RT_BODY) || strcmp(r->method, srv_routes[r->route].method)) {
         r->drained += n;
         return r->drained <= DRAIN_BYTES ? MHD_YES : MHD_NO;
@@ -499,7 +502,12 @@ static void completed(void *cls, struct MHD_Connection *conn, void **con_cls, en
         return;
     *con_cls = NULL;
     double dt = srv_now() - r->t0;
-    int status = r->status ? r->status : 500;
+    /* No answer: the client went away (499, as nginx logs it), or its request ran past --timeout or
+     * --request-timeout (408); a request that completed without one would be a bug (500). */
+    int status = r->status                                    ? r->status
+                 : toe == MHD_REQUEST_TERMINATED_TIMEOUT_REACHED ? 408
+                 : toe != MHD_REQUEST_TERMINATED_COMPLETED_OK    ? 499
+                                                                 : 500;
     srv_metrics_request(s->metrics, r->route, status, dt);
     if (s->log) {
         char ip[INET6_ADDRSTRLEN] = "-";
@@ -568,6 +576,33 @@ static enum MHD_Result accept_policy(void *cls, const struct sockaddr *addr, soc
 
 /* ---- start and stop ---- */
 
+static void say(srv_log *log, const char *source, const char *fmt, va_list ap)
+{
+    char msg[1024];
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    if (log)
+        srv_log_note(log, source, msg);
+    else
+        fprintf(stderr, "pdesolidd: %s%s%s%s", strcmp(source, "pdesolidd") ? source : "",
+                strcmp(source, "pdesolidd") ? ": " : "", msg, strchr(msg, '\n') ? "" : "\n");
+}
+
+void srv_say(srv_server *s, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    say(s->log, "pdesolidd", fmt, ap);
+    va_end(ap);
+}
+
+/* libmicrohttpd's own messages (a request it refused itself, a client gone mid-body) into the log, in its
+ * format: with --log-format json, every line on stderr is JSON. */
+static void mhd_logger(void *cls, const char *fmt, va_list ap)
+{
+    srv_server *s = cls;
+    say(s->log, "libmicrohttpd", fmt, ap);
+}
+
 static void free_server(srv_server *s)
 {
     srv_pool_destroy(s->pool);
@@ -635,7 +670,9 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
     struct MHD_OptionItem pool[] = { { MHD_OPTION_THREAD_POOL_SIZE, workers, NULL }, { MHD_OPTION_END, 0, NULL } };
     if (workers == 1)
         pool[0] = pool[1];
-    s->d = MHD_start_daemon(flags, (uint16_t)c->port, accept_policy, s, handler, s, MHD_OPTION_SOCK_ADDR, ai->ai_addr,
+    s->d = MHD_start_daemon(flags, (uint16_t)c->port, accept_policy, s, handler, s,
+                            MHD_OPTION_EXTERNAL_LOGGER, mhd_logger, s,   /* first: it takes the other options' messages */
+                            MHD_OPTION_SOCK_ADDR, ai->ai_addr,
                             MHD_OPTION_ARRAY, pool,
                             MHD_OPTION_CONNECTION_TIMEOUT, c->timeout, MHD_OPTION_PER_IP_CONNECTION_LIMIT, c->per_ip,
                             MHD_OPTION_CONNECTION_LIMIT, (c->max_conns + SPARE_CONNS + 1) * workers,
@@ -696,5 +733,6 @@ void srv_stop(srv_server *s)
     }
     srv_pool_stop(s->pool);
     MHD_stop_daemon(s->d);
+    srv_say(s, "stopped");
     free_server(s);
 }

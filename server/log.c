@@ -270,6 +270,26 @@ static char *format_json(char *o, const srv_log_rec *r)
     return o;
 }
 
+static char *format_note(char *o, srv_log_format fmt, const char *source, const char *msg)
+{
+    if (fmt == SRV_LOG_JSON) {
+        o = put_str(o, "{\"time\":\"");
+        o = put_time(o);
+        o = put_str(o, "\",\"source\":");
+        o = esc_json(o, source);
+        o = put_str(o, ",\"message\":");
+        o = esc_json(o, msg);
+        return put_str(o, "}\n");
+    }
+    o = put_time(o);
+    *o++ = ' ';
+    o = esc_text(o, source, 1);
+    o = put_str(o, ": ");
+    o = esc_text(o, msg, 0);
+    *o++ = '\n';
+    return o;
+}
+
 /* ---- the buffer ---- */
 
 static void write_all(int fd, const char *p, size_t n)
@@ -342,6 +362,23 @@ void srv_log_request(srv_log *l, const srv_log_rec *r)
     append(l, b, (size_t)(end - b));
     if (b != stack)
         free(b);
+}
+
+void srv_log_note(srv_log *l, const char *source, const char *msg)
+{
+    if (!l || !source || !msg)
+        return;
+    size_t n = strlen(msg);
+    char *m = malloc(n + 1), *b = malloc(128 + 6 * (strlen(source) + n));
+    if (m && b) {
+        memcpy(m, msg, n + 1);
+        while (n && (m[n - 1] == '\n' || m[n - 1] == '\r'))
+            m[--n] = '\0';
+        char *end = format_note(b, l->fmt, source, m);
+        append(l, b, (size_t)(end - b));
+    }
+    free(m);
+    free(b);
 }
 
 static void *flusher(void *arg)

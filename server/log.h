@@ -34,6 +34,9 @@
  *   {"time":"2026-11-22T04:37:00.123Z","ip":"127.0.0.1","method":"GET","path":"/path",
  *    "query":"a=1","status":200,"bytes":1234,"ms":0.520,"solid_id":null,"request_id":"...",
  *    "aborted":false}
+ * Other lines (srv_log_note) are in the same format, with the same escaping:
+ *   2026-11-22T04:37:00.123Z pdesolidd: listening on http://127.0.0.1:8080/
+ *   {"time":"2026-11-22T04:37:00.123Z","source":"libmicrohttpd","message":"..."}
  *
  * query, solid_id and request_id are null when NULL (solid_id also when "").
  * Controls (and U+007F..U+009F) are written \u00XX, and every byte that is not
@@ -71,6 +74,10 @@ typedef struct {
 /* Thread-safe; one line, "\n"-terminated. A NULL ip, method or path is written as "-". Cannot fail
  * (a line that finds no memory is dropped). */
 void srv_log_request(srv_log *l, const srv_log_rec *r);
+/* A line that is not a request (the daemon starting and stopping, libmicrohttpd's own messages), in the
+ * log's format: TEXT "TIME SOURCE: MESSAGE", JSON {"time":...,"source":...,"message":...}; both escaped as
+ * a request's fields, a trailing newline of msg left out. Thread-safe; a line that finds no memory is dropped. */
+void srv_log_note(srv_log *l, const char *source, const char *msg);
 /* Writes out what is buffered, now. Thread-safe. */
 void srv_log_flush(srv_log *l);
 

@@ -5,6 +5,7 @@
  */
 #include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "config.h"
@@ -29,13 +30,21 @@ int main(int argc, char **argv)
         fprintf(stderr, "pdesolidd: %s\n", err);
         return 1;
     }
-    srv_config_print(&c, stderr);
-    fprintf(stderr, "pdesolidd: listening on http://%s%s%s:%u/\n", strchr(c.bind, ':') ? "[" : "", c.bind,
-            strchr(c.bind, ':') ? "]" : "", srv_port(s));
+    /* Into the log, in its format (--log-format json: every line on stderr is JSON). */
+    char *flags = NULL;
+    size_t n = 0;
+    FILE *m = open_memstream(&flags, &n);
+    if (m) {
+        srv_config_print(&c, m);
+        fclose(m);
+        srv_say(s, "%s", strncmp(flags, "pdesolidd ", 10) ? flags : flags + 10);   /* "0.4.0: --bind ..." */
+        free(flags);
+    }
+    srv_say(s, "listening on http://%s%s%s:%u/", strchr(c.bind, ':') ? "[" : "", c.bind, strchr(c.bind, ':') ? "]" : "",
+            srv_port(s));
     int sig;
     sigwait(&set, &sig);
-    fprintf(stderr, "pdesolidd: %s: finishing the requests in flight\n", sig == SIGTERM ? "SIGTERM" : "SIGINT");
+    srv_say(s, "%s: finishing the requests in flight", sig == SIGTERM ? "SIGTERM" : "SIGINT");
     srv_stop(s);
-    fprintf(stderr, "pdesolidd: stopped\n");
     return 0;
 }

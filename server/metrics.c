@@ -10,7 +10,7 @@
 #include "metrics.h"
 #include "sbuf.h"
 
-static const int statuses[] = { 200, 204, 304, 400, 403, 404, 405, 413, 422, 500, 501, 503 };
+static const int statuses[] = { 200, 204, 304, 400, 403, 404, 405, 408, 413, 422, 499, 500, 501, 503 };
 #define NSTATUS (int)(sizeof statuses / sizeof *statuses)
 static const double buckets[] = { 0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1, 2.5, 5, 10 };
 #define NBUCKET (int)(sizeof buckets / sizeof *buckets)

@@ -267,6 +267,54 @@ static void text_should_leave_out_what_is_absent_and_escape_spaces_outside_quote
     free(b);
 }
 
+/* A note (srv_log_note), read back as the one line it must be. */
+static char *note_one(srv_log_format fmt, const char *source, const char *msg, size_t *n)
+{
+    FILE *f = tmpfile();
+    assert_non_null(f);
+    srv_log *l = srv_log_create(fileno(f), fmt);
+    assert_non_null(l);
+    srv_log_note(l, source, msg);
+    srv_log_destroy(l);
+    char *b = read_fd(fileno(f), n);
+    fclose(f);
+    check_plain_line(b, *n);
+    return b;
+}
+
+/* The daemon's own lines and libmicrohttpd's share the log's format: with json, every line is JSON (a
+ * libmicrohttpd message went raw to stderr, breaking a JSON log: QA), escaped as requests' fields are. */
+static void notes_should_be_lines_of_the_logs_format_escaped_as_requests(void **state)
+{
+    (void)state;
+    static const char msg[] = "Error \"processing\" \\ request\x1b[31m, \xff\r\n";
+    size_t n;
+    char *b = note_one(SRV_LOG_JSON, "libmicrohttpd", msg, &n);
+    cJSON *j = cJSON_Parse(b);
+    if (!j)
+        fail_msg("not JSON: %s", b);
+    assert_int_equal(cJSON_GetArraySize(j), 3);
+    assert_string_equal(cJSON_GetObjectItem(j, "source")->valuestring, "libmicrohttpd");
+    assert_string_equal(cJSON_GetObjectItem(j, "message")->valuestring,
+                        "Error \"processing\" \\ request\x1b[31m, " FFFD);   /* the line's end dropped */
+    assert_int_equal(strlen(cJSON_GetObjectItem(j, "time")->valuestring), 24);
+    cJSON_Delete(j);
+    free(b);
+    b = note_one(SRV_LOG_TEXT, "pdesolidd", "listening on http://127.0.0.1:8080/\n", &n);
+    assert_string_equal(strchr(b, ' '), " pdesolidd: listening on http://127.0.0.1:8080/\n");
+    free(b);
+    b = note_one(SRV_LOG_TEXT, "libmicrohttpd", msg, &n);
+    char out[128];
+    size_t m;
+    const char *text = strstr(b, "libmicrohttpd: ");
+    assert_non_null(text);
+    text += strlen("libmicrohttpd: ");
+    assert_int_equal(unescape(text, strlen(text) - 1, out, &m), 0);
+    assert_string_equal(out, "Error \"processing\" \\ request\x1b[31m, \xff");
+    free(b);
+    srv_log_note(NULL, "pdesolidd", "nothing");   /* no log: nothing, no crash */
+}
+
 /* ---- timestamps ---- */
 
 static void check_time(const char *stamp, time_t before, time_t after)
@@ -480,6 +528,7 @@ int main(void)
         cmocka_unit_test(hostile_paths_should_stay_on_one_line_and_unescape_back_in_text),
         cmocka_unit_test(hostile_paths_should_give_valid_json_in_valid_utf8),
         cmocka_unit_test(text_should_leave_out_what_is_absent_and_escape_spaces_outside_quotes),
+        cmocka_unit_test(notes_should_be_lines_of_the_logs_format_escaped_as_requests),
         cmocka_unit_test(timestamps_should_be_rfc3339_utc_at_the_time_of_writing),
         cmocka_unit_test(flusher_should_write_a_line_without_an_explicit_flush),
         cmocka_unit_test(concurrent_writers_should_lose_and_interleave_nothing),

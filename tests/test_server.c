@@ -876,6 +876,54 @@ static void sigterm_should_let_a_request_in_flight_complete_and_answer_new_ones_
     free(log);
 }
 
+/* With --log-format json every line of stderr is JSON: the daemon's start and stop, libmicrohttpd's own
+ * messages (a 505 it sent itself, a client gone mid-body: raw text before, QA); and a request whose client went
+ * away before its body ended is logged and counted as 499, not 500 (any client could raise the error rate). */
+static void a_json_log_should_be_all_json_and_a_client_gone_mid_body_499(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--log-format json");
+    static const char v2[] = "GET /livez HTTP/2.0\r\nHost: localhost\r\n\r\n";
+    raw_reply rr = raw_request(d.port, v2, sizeof v2 - 1, 2000);
+    assert_int_equal(rr.status, 505);
+    raw_reply_free(&rr);
+    int fd = raw_dial(d.port);
+    static const char part[] = "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: 100\r\n\r\n{\"pre";
+    raw_send_all(fd, part, sizeof part - 1);
+    usleep(200 * 1000);
+    close(fd);
+    usleep(200 * 1000);
+    reply r = http(&d, "GET", "/metrics", NULL, 0, NULL);
+    assert_int_equal(r.status, 200);
+    assert_non_null(strstr(r.body, "pdesolid_requests_total{route=\"solve\",status=\"499\"} 1"));
+    if (strstr(r.body, "status=\"500\"") || strstr(r.body, "status=\"other\""))
+        fail_msg("a client that went away counted as an error of the server:\n%s", r.body);
+    free(r.body);
+    stop(&d);
+    char *log = read_file(d.log, NULL);
+    assert_non_null(log);
+    int lines = 0, mhd = 0, aborted = 0, said = 0;
+    for (char *line = log, *end; *line; line = end + 1) {
+        end = strchr(line, '\n');
+        assert_non_null(end);
+        *end = '\0';
+        if (!json_strict_valid(line, strlen(line)))
+            fail_msg("a line of the json log is not JSON: %s", line);
+        lines++;
+        mhd += strstr(line, "\"source\":\"libmicrohttpd\"") != NULL;
+        said += strstr(line, "\"source\":\"pdesolidd\",\"message\":\"listening on http://127.0.0.1:") != NULL ||
+                strstr(line, "\"message\":\"stopped\"") != NULL;
+        aborted += strstr(line, "\"path\":\"/solve\"") && strstr(line, "\"status\":499") &&
+                   strstr(line, "\"aborted\":true");
+    }
+    assert_true(mhd >= 1);
+    assert_int_equal(said, 2);
+    assert_int_equal(aborted, 1);
+    assert_true(lines >= 6);
+    free(log);
+}
+
 /* One polling thread starts without libmicrohttpd's "Warning: ... thread pool size, is ignored" (a pool size of
  * 0 was passed for it). */
 static void one_polling_thread_should_start_without_warnings(void **state)
@@ -1241,6 +1289,7 @@ int main(void)
         cmocka_unit_test(two_content_lengths_and_stalled_clients_should_be_refused),
         cmocka_unit_test(sigterm_should_let_a_request_in_flight_complete_and_answer_new_ones_503),
         cmocka_unit_test(one_polling_thread_should_start_without_warnings),
+        cmocka_unit_test(a_json_log_should_be_all_json_and_a_client_gone_mid_body_499),
         cmocka_unit_test(presets_version_health_metrics_and_cors_should_answer),
         cmocka_unit_test(formats_should_list_the_table_and_each_row_should_hold),
         cmocka_unit_test(compress_should_be_checked_like_every_query_parameter),
