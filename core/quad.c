@@ -24,7 +24,11 @@
  * Where det J separates along u or v (quad_separate: det J = n t^p G), all of
  * this runs on the face t = 1 alone, the flat axis (n 0: one point, weight 1),
  * and the integrals over t are exact (separable_moments); so do the skin's
- * faces whose element separates too (face_separates).
+ * faces whose element separates too (face_separates). Where det J may change
+ * sign there and depends on both of the face's parameters, the face goes by
+ * rows of w instead of 2-D panels: whole lines of the other parameter, refined
+ * along w alone (face_rows), over one period where the solid turns about an
+ * axis along it (param_rotation).
  *
  * The skin's faces run on lines the same way, with |x_a x x_b| for |det J|: cut at the roots of its
  * component along its direction (a cuspidal edge), and where a fold is rounded (the element dips
@@ -70,13 +74,9 @@
 #define OFF_WORK MAX_WORK   /* points off the tables times (modes + 1), at most */
 #define REFINE_WORK (2 * MAX_WORK)   /* points times modes after which no panel is refined */
 #define REFINE_PANELS 96      /* panels refined, at most: fig. 4's 24 to 72, not fig. 3's 1024 */
-/* The same where det J separates (quad_separate): a face's quadrants cost a quarter of a box's
- * octants, so every panel is refined, deeper: fig. 3b's volume came within 1e-11 of the reference
- * at four halvings (7e-7 at two, within 96 panels). */
-#define FLAT_DEPTH 4
-#define FLAT_PANELS ((size_t)-1)
-/* The same where every line runs along a polynomial axis (qctx's along): its boxes are halved in the
- * two other axes only, each line exact (poly_line). */
+/* Where det J separates (quad_separate) and may change sign, the face goes by rows (face_rows), not
+ * by these boxes. Where every line runs along a polynomial axis (qctx's along), every box is refined,
+ * deeper: its boxes are halved in the two other axes only, each line exact (poly_line). */
 #define ALONG_DEPTH 5
 #define ALONG_PANELS ((size_t)-1)
 #define SEG_MEMO 128          /* segments of w remembered by free_panel */
@@ -122,8 +122,8 @@ typedef struct {
     double seg_lo[SEG_MEMO], seg_hi[SEG_MEMO];
     unsigned char seg_def[SEG_MEMO];
     int nseg;
-    int max_depth;               /* OUTER_DEPTH, or FLAT_DEPTH with a flat axis */
-    size_t max_panels;           /* REFINE_PANELS, or FLAT_PANELS */
+    int max_depth;               /* OUTER_DEPTH, or ALONG_DEPTH along a polynomial axis */
+    size_t max_panels;           /* REFINE_PANELS, or ALONG_PANELS */
     size_t off[3], mt;           /* modes of the components before c; modes in all */
     axis_tab tab[3];             /* the current panel's factors */
     pbox tab_box;                /* the box of the tables when tab_ok (tabs_for) */
@@ -723,10 +723,10 @@ static void panel_lines(qctx *q, const pbox *b, int k, int definite, double acc[
  * set tangentially. So the box's result is checked against the sum over its eight octants, each
  * with lines along its own best axis (in a small box the zero set is nearly flat, and the lines
  * cross it rather than touch it) and a rule sized to it; octants are refined the same way where
- * the two differ by more than 1e-12 of the solid's volume, down to OUTER_DEPTH halvings (FLAT_DEPTH). Lines
+ * the two differ by more than 1e-12 of the solid's volume, down to OUTER_DEPTH halvings. Lines
  * that all cross the zero set the same number of times do not show that nothing was missed: a
  * narrow lobe of det J near tangency can lie between samples (fig. 4b), so every such panel is
- * refined, within REFINE_PANELS (FLAT_PANELS). Lines along a polynomial axis (q->along) miss no lobe
+ * refined, within REFINE_PANELS. Lines along a polynomial axis (q->along) miss no lobe
  * (poly_line): their boxes are quarters, not octants, down to ALONG_DEPTH halvings, and a box whose
  * lines all agree in det J's signs at their ends and number of roots is not refined further.
  */
@@ -1574,8 +1574,6 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     }
     if (sp.axis >= 0) {   /* the face t = 1 alone: one panel along the flat axis, no rule */
         q->flat = sp.axis;
-        q->max_depth = FLAT_DEPTH;
-        q->max_panels = FLAT_PANELS;
         p.np[sp.axis] = 1, p.n[sp.axis] = 0;
         p.edge[sp.axis][0] = p.edge[sp.axis][1] = 1.0;
     } else
