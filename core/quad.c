@@ -25,10 +25,11 @@
  * this runs on the face t = 1 alone, the flat axis (n 0: one point, weight 1),
  * and the integrals over t are exact (separable_moments); so do the skin's
  * faces whose element separates too (face_separates). Where det J may change
- * sign there and depends on both of the face's parameters, the face goes by
- * rows of w instead of 2-D panels: whole lines of the other parameter, refined
- * along w alone (face_rows), over one period where the solid turns about an
- * axis along it (param_rotation).
+ * sign there, depends on both of the face's parameters, and the solid repeats
+ * itself along the other one (param_symmetry, or turned about an axis:
+ * param_rotation), one period of the face goes by rows of w instead of 2-D
+ * panels: whole lines of the other parameter, refined along w alone
+ * (face_rows).
  *
  * The skin's faces run on lines the same way, with |x_a x x_b| for |det J|: cut at the roots of its
  * component along its direction (a cuspidal edge), and where a fold is rounded (the element dips
@@ -74,9 +75,14 @@
 #define OFF_WORK MAX_WORK   /* points off the tables times (modes + 1), at most */
 #define REFINE_WORK (2 * MAX_WORK)   /* points times modes after which no panel is refined */
 #define REFINE_PANELS 96      /* panels refined, at most: fig. 4's 24 to 72, not fig. 3's 1024 */
-/* Where det J separates (quad_separate) and may change sign, the face goes by rows (face_rows), not
- * by these boxes. Where every line runs along a polynomial axis (qctx's along), every box is refined,
- * deeper: its boxes are halved in the two other axes only, each line exact (poly_line). */
+/* The same where det J separates (quad_separate) and the face has no period (face_rows' lines would
+ * take more than OFF_WORK on fig. 3a at an odd n_xy >= 25): a face's quadrants cost a quarter of a
+ * box's octants, so every panel is refined, deeper: fig. 3b's volume came within 1e-11 of the
+ * reference at four halvings (7e-7 at two, within 96 panels). */
+#define FLAT_DEPTH 4
+#define FLAT_PANELS ((size_t)-1)
+/* The same where every line runs along a polynomial axis (qctx's along): its boxes are halved in the
+ * two other axes only, each line exact (poly_line). */
 #define ALONG_DEPTH 5
 #define ALONG_PANELS ((size_t)-1)
 #define SEG_MEMO 128          /* segments of w remembered by free_panel */
@@ -122,8 +128,8 @@ typedef struct {
     double seg_lo[SEG_MEMO], seg_hi[SEG_MEMO];
     unsigned char seg_def[SEG_MEMO];
     int nseg;
-    int max_depth;               /* OUTER_DEPTH, or ALONG_DEPTH along a polynomial axis */
-    size_t max_panels;           /* REFINE_PANELS, or ALONG_PANELS */
+    int max_depth;               /* OUTER_DEPTH, or FLAT_DEPTH with a flat axis */
+    size_t max_panels;           /* REFINE_PANELS, or FLAT_PANELS */
     size_t off[3], mt;           /* modes of the components before c; modes in all */
     axis_tab tab[3];             /* the current panel's factors */
     pbox tab_box;                /* the box of the tables when tab_ok (tabs_for) */
@@ -135,6 +141,7 @@ typedef struct {
     double *P, *Pi, *Pj;         /* mt each */
     int line_roots, line_lo;     /* the roots line_integrate located on its last line, and whether det J is
                                   * above jtol at its start */
+    int count_only;              /* line_integrate only counts the roots (row_sig_at), adding nothing */
     int node_sig[GMAX + 2];      /* panel_lines: the lines' signatures through each index of w, summed over
                                   * panels: twice their roots, plus 1 where det J is above jtol at s = 0 */
     quad_result r;
@@ -597,20 +604,26 @@ static void line_integrate(qctx *q, double a, double b, double wt)
     q->line_roots = 0, q->line_lo = f[0] > q->jtol;
     for (int i = 1; i <= m && off_budget(q); i++) {
         if (sign_changes(f[last], f[i], q->jtol))
-            cut[ncut++] = line_root(q, t[last], t[i], f[last], f[i]);
+            cut[ncut++] = q->count_only ? t[i] : line_root(q, t[last], t[i], f[last], f[i]);
         else if (i < m && fabs(f[i]) <= fabs(f[i - 1]) && fabs(f[i]) < fabs(f[i + 1]) &&
                  fabs(f[i]) > q->jtol && !sign_changes(f[i], f[i + 1], q->jtol)) {
             double at, fat, sign = f[i] > 0 ? 1.0 : -1.0;
             if (line_dip(q, t[i - 1], t[i + 1], sign, &at, &fat)) {
                 int l = at > t[i] ? i : i - 1, r = at < t[i] ? i : i + 1;
-                cut[ncut++] = line_root(q, t[l], at, f[l], fat);
-                cut[ncut++] = line_root(q, at, t[r], fat, f[r]);
+                if (q->count_only)
+                    ncut += 2;
+                else {
+                    cut[ncut++] = line_root(q, t[l], at, f[l], fat);
+                    cut[ncut++] = line_root(q, at, t[r], fat, f[r]);
+                }
             }
         }
         if (fabs(f[i]) > q->jtol || fabs(f[last]) <= q->jtol)
             last = i;
     }
     q->line_roots = ncut;
+    if (q->count_only)
+        return;
     if (!ncut) {
         for (int i = 0; i < n; i++)
             add_value(q, x[i + 1], f[i + 1], wt * (b - a) * q->gw[n][i]);
@@ -723,10 +736,10 @@ static void panel_lines(qctx *q, const pbox *b, int k, int definite, double acc[
  * set tangentially. So the box's result is checked against the sum over its eight octants, each
  * with lines along its own best axis (in a small box the zero set is nearly flat, and the lines
  * cross it rather than touch it) and a rule sized to it; octants are refined the same way where
- * the two differ by more than 1e-12 of the solid's volume, down to OUTER_DEPTH halvings. Lines
+ * the two differ by more than 1e-12 of the solid's volume, down to OUTER_DEPTH halvings (FLAT_DEPTH). Lines
  * that all cross the zero set the same number of times do not show that nothing was missed: a
  * narrow lobe of det J near tangency can lie between samples (fig. 4b), so every such panel is
- * refined, within REFINE_PANELS. Lines along a polynomial axis (q->along) miss no lobe
+ * refined, within REFINE_PANELS (FLAT_PANELS). Lines along a polynomial axis (q->along) miss no lobe
  * (poly_line): their boxes are quarters, not octants, down to ALONG_DEPTH halvings, and a box whose
  * lines all agree in det J's signs at their ends and number of roots is not refined further.
  */
@@ -812,11 +825,13 @@ static void row_lines(qctx *q, const qplan *p, int sa, double lo, double hi, int
     q->n[2] = saved;
 }
 
-/* The signature of the whole line of s at w (row_lines). */
+/* The signature of the whole line of s at w (row_lines), its roots counted, not located. */
 static int row_sig_at(qctx *q, const qplan *p, int sa, double w)
 {
     double acc[Q_N];
+    q->count_only = 1;
     row_lines(q, p, sa, w, w, 0, acc);
+    q->count_only = 0;
     return q->node_sig[0];
 }
 
@@ -1574,6 +1589,8 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     }
     if (sp.axis >= 0) {   /* the face t = 1 alone: one panel along the flat axis, no rule */
         q->flat = sp.axis;
+        q->max_depth = FLAT_DEPTH;
+        q->max_panels = FLAT_PANELS;
         p.np[sp.axis] = 1, p.n[sp.axis] = 0;
         p.edge[sp.axis][0] = p.edge[sp.axis][1] = 1.0;
     } else
@@ -1586,7 +1603,7 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
      * or half-turn (param_symmetry) where the period is a whole number of panels; else, where the face
      * is integrated by rows (face_rows), a rotation (param_rotation), with the period's own panels. */
     qsym sy = { .k = 0 };
-    const int rows = sp.axis >= 0 && q->free < 0 && !jsign;
+    const int folds = sp.axis >= 0 && q->free < 0 && !jsign;   /* on the face, G depending on both */
     for (int t = 0; t < 2 && sp.axis >= 0 && separate != 3 && !sy.k; t++) {
         int sd[3], sm[3], per;
         if (t != sp.axis && (per = param_symmetry(s, t, sd, sm)) > 1 && p.np[t] % per == 0) {
@@ -1596,7 +1613,7 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
             p.np[t] /= per * sy.half;
         }
     }
-    if (rows && !sy.k && separate != 3 && param_rotation(s, 1 - sp.axis, &sy)) {   /* its own panels */
+    if (folds && !sy.k && separate != 3 && param_rotation(s, 1 - sp.axis, &sy)) {   /* its own panels */
         const int t = sy.t, per = sy.k * sy.half;
         p.np[t] = (p.np[t] + per - 1) / per;
         for (int i = 0; i <= p.np[t]; i++)
@@ -1604,7 +1621,10 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     }
     if (sy.k)   /* the tolerances of the part integrated: its copies multiply its error */
         q->vscale /= sy.k * sy.half;
-    if (rows)
+    /* By rows over a period; without one (an odd n_xy of fig. 3a), by the face's boxes: whole lines
+     * of its other parameter exhaust OFF_WORK where it is fast (fig. 3a at n_xy = 25: 2.1 M points off
+     * the tables, 0.01 reported), except in the tests (separate 2, 3). */
+    if (folds && (sy.k || separate >= 2))
         face_rows(q, &p, 1 - sp.axis);
     else
         for (int i = 0; i < p.np[0]; i++)
