@@ -12,6 +12,7 @@
  *   bench_cost            the table for docs/BENCHMARKS.md
  *   bench_cost --quick    one run per case, presets fig1a and fig4a only
  *   bench_cost --heavy    the synthetic models only
+ *   bench_cost --example3 the properties of fig. 3a's solid (example3) at n_xy = 10, 15, .., 100
  */
 #include <malloc.h>
 #include <stdio.h>
@@ -330,8 +331,42 @@ static void cases(const char *name, const pde_model *m, const unsigned *res_grid
     pde_solution_free(sol);
 }
 
+/* The properties of example3 (fig. 3a) at n_xy = 10 .. 100: separable and folding, with a rotation
+ * along v at even n_xy (core/quad.c's face_rows). */
+static void example3_sweep(void)
+{
+    const api_preset *ps = api_preset_find("fig3a");
+    for (int n = 10; n <= 100; n += 5) {
+        api_params prm;
+        api_error err;
+        api_preset_params(ps, &prm);
+        const double nxy = n;
+        if (api_params_set(api_preset_template(ps), &prm, "n_xy", &nxy, 1, &err))
+            return;
+        api_model *m = api_template_expand(api_preset_template(ps), &prm, &err);
+        pde_solution *sol;
+        if (!m || pde_solve(api_model_get(m), &sol, NULL) != PDE_OK) {
+            api_model_free(m);
+            return;
+        }
+        char label[64];
+        snprintf(label, sizeof label, "example3 n_xy %d props", n);
+        job j = { .kind = JOB_PROPS, .sol = sol };
+        report(label, &j);
+        pde_solution_free(sol);
+        api_model_free(m);
+    }
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 1 && !strcmp(argv[1], "--example3")) {
+        printf("| case | estimate ms | measured ms | ratio | est. MB | heap peak MB |\n");
+        printf("|---|---:|---:|---:|---:|---:|\n");
+        example3_sweep();
+        printf("\nratio estimate/measured: %.2f to %.2f\n", worst_lo, worst_hi);
+        return 0;
+    }
     int quick = argc > 1 && !strcmp(argv[1], "--quick"), heavy_only = argc > 1 && !strcmp(argv[1], "--heavy");
     if (quick)
         runs = 1;

@@ -54,9 +54,12 @@ void quad_separate(const pde_solution *s, quad_sep *sep);
  * bound), so that every panel takes its tensor rule, else 0; vscale: the size of the
  * volume (jscale will do), for the refinement's tolerance. separate: where det J separates
  * (quad_separate), integrate over the face t = 1 only, and along w alone where det J does not
- * depend on the face's other parameter (pde_properties), and where it does not separate, along a
- * polynomial axis (quad.c's poly_line); 2: the face without the former (tests); 0: over the cube,
- * lines along the axis that crosses det J's zero set most often, in 3-D (tests). */
+ * depend on the face's other parameter (pde_properties), else by rows of w refined along w over one
+ * period of the face where the solid repeats itself along it (quad.c's face_rows, param_rotation), and
+ * by the face's 2-D panels where it does not; where it does not separate, along a polynomial axis
+ * (quad.c's poly_line); 2: the face by rows, even where det J does not depend on its other parameter
+ * or the face has no period (tests); 3: the same over the whole face, no period used (tests); 0: over
+ * the cube, lines along the axis that crosses det J's zero set most often, in 3-D (tests). */
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
                       int jsign, const pde_cancel *cancel, quad_result *out);
 
