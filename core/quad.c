@@ -1371,21 +1371,6 @@ static int param_symmetry(const pde_solution *s, int t, int d[3], int m[3])
 }
 
 /*
- * A face repeats itself where the solid does (param_symmetry): x_a x x_b -> det D D (x_a x x_b), so
- * the element |x_a x x_b| is the same and the flux x . (x_a x x_b) det D times the same; mirrored,
- * the same with the tangent reversed: the flux -det M times it, and half a period is enough.
- * Returns k (0: none), with det D in *det and -det M in *rdet (0: no mirror).
- */
-static int face_period(const pde_solution *s, int t, double *det, double *rdet)
-{
-    int d[3], m[3];
-    const int k = param_symmetry(s, t, d, m);
-    *det = d[0] * d[1] * d[2];
-    *rdet = m[0] ? -m[0] * m[1] * m[2] : 0.0;
-    return k;
-}
-
-/*
  * A symmetry of the solid along t (u or v): t -> t + 1/k maps x to R x, and where half = 2,
  * t -> 1/k - t maps x to H x (R, H orthogonal). Then one period of t, or half of one, is integrated
  * (moments about the origin), and the copies' integrals follow (sym_moments).
@@ -2212,14 +2197,55 @@ static int face_poly(const poly3 *px, int axis, int side, double tol, double *ar
 }
 
 /*
+ * A face repeats itself along its parameter t (u or v) where the solid does: where t -> t + 1/k maps
+ * x to A x (A orthogonal), x_a x x_b goes to det A A (x_a x x_b), so the element |x_a x x_b| is the
+ * same and the flux x . (x_a x x_b) det A times the same; mirrored, t -> 1/k - t mapping x to H x
+ * with the tangent along t reversed, -det H times. So one period, or half of one mirrored, is
+ * integrated, times its copies. A reflection or half-turn A = diag(+-1) (param_symmetry: fig. 2 and
+ * 4) where the period is a whole number of the face's *np panels, which stay; else a rotation about
+ * an axis (param_rotation: fig. 3a, 3b, det A = 1), the period with panels of its own, as wide as
+ * the face's or narrower: *div per unit of t, so that every panel edge falls on a multiple of
+ * 1/(k half) and the fold's handling (face_line_integral) sees each of the period's dips whole.
+ * With period 0 (tests), no period is used: the whole face, with the same panels. Returns the
+ * copies k (1: none) and sets *np (panels integrated), *div (0: the plan's edges), *half (2:
+ * mirrored), det A into *det and -det H into *rdet (0: no mirror).
+ */
+static int face_period(const pde_solution *s, int t, int period, int *np, int *div, int *half, double *det,
+                       double *rdet)
+{
+    int d[3], m[3], k = param_symmetry(s, t, d, m);
+    qsym sy;
+    if (k >= 2 && *np % k == 0) {
+        *det = d[0] * d[1] * d[2];
+        *rdet = m[0] ? -m[0] * m[1] * m[2] : 0.0;
+        *half = *rdet != 0.0 && *np % (2 * k) == 0 ? 2 : 1;
+        if (*half == 1)
+            *rdet = 0.0;
+        *div = 0;
+        *np /= period ? k * *half : 1;
+    } else if (param_rotation(s, t, &sy)) {
+        k = sy.k, *half = sy.half;
+        *det = det33(sy.R);
+        *rdet = sy.half == 2 ? -det33(sy.H) : 0.0;
+        const int n = (*np + k * *half - 1) / (k * *half);   /* panels per period */
+        *div = n * k * *half;
+        *np = period ? n : *div;
+    } else
+        return 1;
+    if (!period)
+        *half = 1, *det = 1.0, *rdet = 0.0, k = 1;
+    return k;
+}
+
+/*
  * The skin's area: each face's panels (sized to the element's frequencies, counted like the
  * solid's integrals as five factors') along lines that locate the cuspidal edges of a folded
  * face. Each panel is checked against its quarters and refined where they differ by more than
  * 1e-13 of the solid's size squared, down to FACE_DEPTH halvings (in a small panel the lines
  * cross an edge rather than touch it), for the first FACE_REFINE panels.
  */
-pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area,
-                     quad_result *info)
+pde_status quad_area_period(const pde_solution *s, double size, int period, const pde_cancel *cancel, double *area,
+                            quad_result *info)
 {
     face_ctx *c = calloc(1, sizeof *c);
     qctx *q = qctx_new(s, cancel);
@@ -2272,24 +2298,23 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
             }
             c->line = (face_line){ .q = q, .axis = axis, .side = side, .o = { o[0], o[1] } };
             c->flat = face_separates(s, &sp, axis, &ascale, &fscale);
-            int npa = c->flat == 0 ? 1 : p.np[o[0]], npb = c->flat == 1 ? 1 : p.np[o[1]];
-            /* One period (half a period, mirrored) of a parameter along which the face repeats itself,
-             * reflected (face_period): per parts of the face alike. */
-            double fdet = 1.0, rdet = 0.0;
+            /* np[k] panels along the face's parameter k: p's edges, or [i, i + 1] / div[k] where div[k] > 0
+             * (the panels of a period, face_period) */
+            int np[2] = { c->flat == 0 ? 1 : p.np[o[0]], c->flat == 1 ? 1 : p.np[o[1]] }, div[2] = { 0, 0 };
             int per = 1, half = 1;
-            for (int k = 0; k < 2 && per == 1; k++) {
-                int *np = k ? &npb : &npa;
-                if (o[k] > 1 || (per = face_period(s, o[k], &fdet, &rdet)) < 2 || *np % per) {
-                    per = 1, fdet = 1.0, rdet = 0.0;
-                    continue;
-                }
-                half = rdet != 0.0 && *np % (2 * per) == 0 ? 2 : 1;
-                *np /= per * half;
-            }
-            for (int pa = 0; pa < npa && !c->stopped; pa++)
-                for (int pb = 0; pb < npb && !c->stopped; pb++) {
-                    const double *ea = p.edge[o[0]], *eb = p.edge[o[1]];
-                    double lo[2] = { ea[pa], eb[pb] }, h[2] = { ea[pa + 1] - ea[pa], eb[pb + 1] - eb[pb] };
+            double fdet = 1.0, rdet = 0.0;
+            for (int k = 0; k < 2 && per == 1; k++)
+                if (o[k] <= 1 && k != c->flat)
+                    per = face_period(s, o[k], period, &np[k], &div[k], &half, &fdet, &rdet);
+            for (int pa = 0; pa < np[0] && !c->stopped; pa++)
+                for (int pb = 0; pb < np[1] && !c->stopped; pb++) {
+                    const int i[2] = { pa, pb };
+                    double lo[2], h[2];
+                    for (int k = 0; k < 2; k++) {
+                        const double *e = p.edge[o[k]];
+                        lo[k] = div[k] ? (double)i[k] / div[k] : e[i[k]];
+                        h[k] = div[k] ? 1.0 / div[k] : e[i[k] + 1] - e[i[k]];
+                    }
                     if (c->flat >= 0)   /* the line t = 1 of the face */
                         lo[c->flat] = 1.0, h[c->flat] = 0.0;
                     if (pde_stopped(cancel))   /* a panel of a face */
@@ -2300,9 +2325,9 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
                                 ? a : face_refine(c, lo, h, a, est, 0);
                 }
             /* Outward: side 1 along +axis; (o0, o1, axis) is odd for axis 1. */
-            double fsum = 0.0;   /* the periods' fluxes: det D^j times the first's, and its mirror's */
-            for (int j = 0; j < per; j++)
-                fsum += j & 1 ? fdet : 1.0;
+            double fsum = 0.0, sig = 1.0;   /* the periods' fluxes: det R^j times the first's, and its mirror's */
+            for (int j = 0; j < per; j++, sig *= fdet)
+                fsum += sig;
             if (half == 2)
                 fsum *= 1.0 + rdet;
             flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fscale * fsum * fflux;
@@ -2320,4 +2345,9 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
     }
     qctx_free(q);
     return st;
+}
+
+pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area, quad_result *info)
+{
+    return quad_area_period(s, size, 1, cancel, area, info);
 }

@@ -68,6 +68,10 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
  * another way, from the faces: (1/3) of the flux of x through them (divergence theorem). */
 pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area,
                      quad_result *info);
+/* The same with period 0: each face whole, its periods' panels kept but no period used (tests; quad.c's
+ * face_period); 1: quad_area. */
+pde_status quad_area_period(const pde_solution *s, double size, int period, const pde_cancel *cancel, double *area,
+                            quad_result *info);
 
 /* Panels per axis and Gauss-Legendre points per panel on each axis (also for api/cost.h). */
 void quad_panels(const pde_solution *s, int np[3], int n[3]);
