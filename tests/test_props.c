@@ -660,7 +660,9 @@ static void separable_integrals_should_equal_the_adaptive_integrals_over_the_cub
         quad_result face;
         assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 2, 0, NULL, &face), PDE_OK);
         double scale[Q_N];   /* each integral against its size: |det J| times |r|^k */
-        const double size = cbrt(p.volume) + 1.0;
+        double size = 0.0;   /* pde_properties': the box's largest side (from the extremes found) */
+        for (int c = 0; c < 3; c++)
+            size = fmax(size, p.bbox_max[c] - p.bbox_min[c]);
         for (int e = 0; e < Q_N; e++)
             scale[e] = p.volume * (e == Q_VOL || e == Q_SIGNED ? 1.0 : e < Q_M2 ? size : size * size);
         for (int e = 0; e < Q_N; e++) {
@@ -1438,6 +1440,60 @@ static void face_rows_should_match_the_reference_and_the_whole_face_on_folding_s
     }
 }
 
+/*
+ * core/quad.c's face_period on a face turned about an axis: the skin of fig. 3a (x + i y turned by
+ * 2 pi / 9 as v -> v + 1/9, mirrored by v -> 1/9 - v) and of its template at n_xy = 10, r1 = 0.3
+ * (another N, mirrored), the face u = 1 over half a period of v times its 2 N copies against the whole
+ * face with the same panels (quad_area_period 0): the area and the flux's signed volume to 1e-12, the
+ * period taking at most a third of the points; and pde_properties' area against the reference to 1e-9.
+ * A wrong period (N, the mirror, the panels' edges) or a wrong sign of a copy's flux differs by far more.
+ */
+static void area_over_one_period_should_match_the_whole_face_and_the_reference_on_solids_turned_about_z(void **state)
+{
+    (void)state;
+    static const struct {
+        double nxy, r1;
+        const char *name;
+    } cases[] = { { 20, 0.1, "fig3a" }, { 10, 0.3, "fig3a at n_xy = 10, r1 = 0.3" } };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        api_model *m;
+        pde_solution *sol = example3(cases[k].nxy, cases[k].r1, &m);
+        const char *name = cases[k].name;
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        assert_true(p.folds);
+        ref_props_out own;
+        const ref_props_out *r = &own;
+        if (k == 0)
+            r = preset_ref(preset_index("fig3a"), sol);
+        else
+            assert_int_equal(ref_props(sol, &own), 0);
+        assert_true(r->converged);
+        print_message("%s: surface_area %.3g off the reference\n", name,
+                      fabs(p.surface_area - r->surface_area) / r->surface_area);
+        assert_rel(p.surface_area, r->surface_area, 1e-9, 0);
+        double size = 0.0;   /* pde_properties': the box's largest side (from the extremes found) */
+        for (int c = 0; c < 3; c++)
+            size = fmax(size, p.bbox_max[c] - p.bbox_min[c]);
+        double period, whole;
+        quad_result qp, qw;
+        assert_int_equal(quad_area_period(sol, size, 1, NULL, &period, &qp), PDE_OK);
+        assert_int_equal(quad_area_period(sol, size, 0, NULL, &whole, &qw), PDE_OK);
+        assert_rel(period, p.surface_area, 1e-12, 0);
+        print_message("%s: area over a period %.17g, the whole face %.17g; %zu and %zu points\n", name, period, whole,
+                      qp.evals, qw.evals);
+        if (!(fabs(period - whole) <= 1e-12 * whole))
+            fail_msg("%s: area %.17g over a period, %.17g over the whole face", name, period, whole);
+        if (!(fabs(qp.acc[Q_SIGNED] - qw.acc[Q_SIGNED]) <= 1e-12 * p.volume))
+            fail_msg("%s: signed volume %.17g from the faces over a period, %.17g over the whole", name,
+                     qp.acc[Q_SIGNED], qw.acc[Q_SIGNED]);
+        assert_rel(qp.acc[Q_SIGNED], r->signed_volume, 1e-9, r->volume);
+        assert_true(3 * qp.evals <= qw.evals);   /* the period is used */
+        pde_solution_free(sol);
+        api_model_free(m);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1471,6 +1527,7 @@ int main(void)
         cmocka_unit_test(det_j_gap_should_close_to_1e_9_of_its_scale_on_every_paper_figure),
         cmocka_unit_test(poly_bounds_should_match_the_closed_form_and_contain_a_dense_sampling_of_figure_1),
         cmocka_unit_test(face_rows_should_match_the_reference_and_the_whole_face_on_folding_separable_solids),
+        cmocka_unit_test(area_over_one_period_should_match_the_whole_face_and_the_reference_on_solids_turned_about_z),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
