@@ -454,6 +454,16 @@ static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, i
     at[sp->axis] = 1.0;
     if (what == 3 && sp->free >= 0)   /* det J is constant along it: a segment of w, a 1-D problem */
         face.lo[sp->free] = face.hi[sp->free] = at[sp->free];
+    /* det J repeats itself along the face's other parameter t where the solid turns about an axis
+     * (the box of x, y does not): its extremes over one period, the start folded into it */
+    const int t = 1 - sp->axis;
+    int mirror;
+    double len;
+    if (what == 3 && sp->axis < 2 && sp->free != t && (len = quad_detj_period(s, t, &mirror)) < 1.0) {
+        const double per = mirror ? 2.0 * len : len, a = fmod(at[t], per);
+        face.hi[t] = len;
+        at[t] = a > len ? per - a : a;
+    }
     bb_result b;
     pde_status st = bb_minimise(s, what, sign, at, &face, tol, budget, cancel, &b);
     if (st != PDE_OK)

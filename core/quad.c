@@ -1534,6 +1534,17 @@ static int param_rotation(const pde_solution *s, int t, qsym *sy)
     return 0;
 }
 
+double quad_detj_period(const pde_solution *s, int t, int *mirror)
+{
+    qsym sy;
+    *mirror = 0;
+    if (!param_rotation(s, t, &sy))
+        return 1.0;
+    /* det J(1/N - t) = -det H det J(t): the mirrored half repeats it where det H = -1 */
+    *mirror = sy.half == 2 && det33(sy.H) < 0.0;
+    return (*mirror ? 0.5 : 1.0) / sy.k;
+}
+
 /* The polynomial axis of lowest degree (the fewest pieces per line) along which poly_line applies with
  * its exact rule, or -1. */
 static int along_axis(const qctx *q)
@@ -2196,6 +2207,12 @@ static int face_poly(const poly3 *px, int axis, int side, double tol, double *ar
     return f.ok;
 }
 
+/* param_rotation along u and v, found once (known) for all the faces. */
+typedef struct {
+    int known[2], has[2];
+    qsym sy[2];
+} face_rot;
+
 /*
  * A face repeats itself along its parameter t (u or v) where the solid does: where t -> t + 1/k maps
  * x to A x (A orthogonal), x_a x x_b goes to det A A (x_a x x_b), so the element |x_a x x_b| is the
@@ -2210,11 +2227,15 @@ static int face_poly(const poly3 *px, int axis, int side, double tol, double *ar
  * copies k (1: none) and sets *np (panels integrated), *div (0: the plan's edges), *half (2:
  * mirrored), det A into *det and -det H into *rdet (0: no mirror).
  */
-static int face_period(const pde_solution *s, int t, int period, int *np, int *div, int *half, double *det,
-                       double *rdet)
+static int face_period(const pde_solution *s, int t, int period, face_rot *rot, int *np, int *div, int *half,
+                       double *det, double *rdet)
 {
     int d[3], m[3], k = param_symmetry(s, t, d, m);
-    qsym sy;
+    if (k < 2 || *np % k) {
+        if (!rot->known[t])   /* its 16 points' checks once per parameter, not per face */
+            rot->has[t] = param_rotation(s, t, &rot->sy[t]), rot->known[t] = 1;
+    }
+    const qsym sy = rot->sy[t];
     if (k >= 2 && *np % k == 0) {
         *det = d[0] * d[1] * d[2];
         *rdet = m[0] ? -m[0] * m[1] * m[2] : 0.0;
@@ -2223,7 +2244,7 @@ static int face_period(const pde_solution *s, int t, int period, int *np, int *d
             *rdet = 0.0;
         *div = 0;
         *np /= period ? k * *half : 1;
-    } else if (param_rotation(s, t, &sy)) {
+    } else if (rot->has[t]) {
         k = sy.k, *half = sy.half;
         *det = det33(sy.R);
         *rdet = sy.half == 2 ? -det33(sy.H) : 0.0;
@@ -2275,6 +2296,7 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
      * goes to the rest (fig. 3b's area 1.1e-5 -> 1.6e-8 of the reference quadrature's). */
     c->max_refined = sp.axis >= 0 ? INT_MAX : FACE_REFINE;
     double total = 0.0, flux = 0.0;
+    face_rot rot = { .known = { 0, 0 } };
     for (int axis = 0; axis < 3 && !c->stopped; axis++) {
         if (faces_coincide(s, px, axis, size))
             continue;   /* both lie inside the solid, as api/mesh.c drops them */
@@ -2305,7 +2327,7 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
             double fdet = 1.0, rdet = 0.0;
             for (int k = 0; k < 2 && per == 1; k++)
                 if (o[k] <= 1 && k != c->flat)
-                    per = face_period(s, o[k], period, &np[k], &div[k], &half, &fdet, &rdet);
+                    per = face_period(s, o[k], period, &rot, &np[k], &div[k], &half, &fdet, &rdet);
             for (int pa = 0; pa < np[0] && !c->stopped; pa++)
                 for (int pb = 0; pb < np[1] && !c->stopped; pb++) {
                     const int i[2] = { pa, pb };

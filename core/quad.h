@@ -73,6 +73,11 @@ pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cance
 pde_status quad_area_period(const pde_solution *s, double size, int period, const pde_cancel *cancel, double *area,
                             quad_result *info);
 
+/* The part [0, len] of t (u or v) over which det J repeats itself, returned: where t -> t + 1/N turns
+ * the solid about an axis (quad.c's param_rotation; det R = 1), 1/N, and 1/(2N) with *mirror = 1
+ * where the mirror t -> 1/N - t keeps det J too (fig. 3a, 3b); else 1. */
+double quad_detj_period(const pde_solution *s, int t, int *mirror);
+
 /* Panels per axis and Gauss-Legendre points per panel on each axis (also for api/cost.h). */
 void quad_panels(const pde_solution *s, int np[3], int n[3]);
 

@@ -1494,6 +1494,48 @@ static void area_over_one_period_should_match_the_whole_face_and_the_reference_o
     }
 }
 
+/*
+ * det J's branch and bound over one period of v where the solid turns about z (core/props.c's
+ * separable_extreme, quad_detj_period: fig. 3a [0, 1/18], n_xy = 10 [0, 1/8]): its certified range
+ * holds det J on a 1801 x 41 grid of the face u = 1 over all of v (det J = u G(v, w): the face
+ * holds its extremes), and det J takes the extremes found, to 1e-12 of its scale, at every copy of
+ * their places, v + j/N and j/N - v (N = 9 and 4): the values the search over one period stands for.
+ */
+static void det_j_bounds_over_one_period_should_hold_the_whole_face_on_solids_turned_about_z(void **state)
+{
+    (void)state;
+    static const double nxy[2] = { 20, 10 }, r1[2] = { 0.1, 0.3 };
+    static const int copies[2] = { 9, 4 };
+    for (int k = 0; k < 2; k++) {
+        api_model *m;
+        pde_solution *sol = example3(nxy[k], r1[k], &m);
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        const double scale = fmax(fabs(p.detj_min_found), fabs(p.detj_max_found));
+        double lo = INFINITY, hi = -INFINITY;
+        for (int i = 0; i <= 1800; i++)
+            for (int j = 0; j <= 40; j++) {
+                const double d = pde_eval_detj(sol, 1.0, i / 1800.0, j / 40.0);
+                lo = fmin(lo, d), hi = fmax(hi, d);
+            }
+        print_message("n_xy = %g: det J on the grid [%.12g, %.12g], found [%.12g, %.12g], bounds [%.12g, %.12g]\n",
+                      nxy[k], lo, hi, p.detj_min_found, p.detj_max_found, p.detj_min, p.detj_max);
+        assert_true(p.detj_min <= lo && hi <= p.detj_max);
+        for (int e = 0; e < 2; e++) {
+            const double *at = e ? p.detj_max_at : p.detj_min_at, want = e ? p.detj_max_found : p.detj_min_found;
+            for (int j = 0; j < 2 * copies[k]; j++) {
+                const double v = fmod((j >> 1) / (double)copies[k] + (j & 1 ? -at[1] : at[1]) + 1.0, 1.0);
+                const double d = pde_eval_detj(sol, at[0], v, at[2]);
+                if (!(fabs(d - want) <= 1e-12 * scale))
+                    fail_msg("n_xy = %g: det J %.17g at v = %.17g, %.17g at the extreme found (v = %.17g)", nxy[k],
+                             d, v, want, at[1]);
+            }
+        }
+        pde_solution_free(sol);
+        api_model_free(m);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1528,6 +1570,7 @@ int main(void)
         cmocka_unit_test(poly_bounds_should_match_the_closed_form_and_contain_a_dense_sampling_of_figure_1),
         cmocka_unit_test(face_rows_should_match_the_reference_and_the_whole_face_on_folding_separable_solids),
         cmocka_unit_test(area_over_one_period_should_match_the_whole_face_and_the_reference_on_solids_turned_about_z),
+        cmocka_unit_test(det_j_bounds_over_one_period_should_hold_the_whole_face_on_solids_turned_about_z),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
