@@ -64,7 +64,9 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
                       int jsign, const pde_cancel *cancel, quad_result *out);
 
 /* The area of the skin; size: the solid's extent, for deciding that two faces coincide. Its panels
- * are the solid's, and so is its rules' error. info->acc[Q_SIGNED] is the signed volume computed
+ * are the solid's, and so is its rules' error; a face that repeats itself along u or v, reflected or
+ * turned about an axis, over one period (or half of one, mirrored) times its copies (quad.c's
+ * face_period). info->acc[Q_SIGNED] is the signed volume computed
  * another way, from the faces: (1/3) of the flux of x through them (divergence theorem). */
 pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area,
                      quad_result *info);
