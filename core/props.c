@@ -7,6 +7,9 @@
  *    within 1e-9 of the solid's size of the best value (or a box budget ends:
  *    the gap says how far it got). A polynomial solid (fig. 1) instead takes
  *    a branch and bound over Bernstein coefficients (poly.h), without sample.
+ *    A solid whose properties cannot be finite is refused from these first
+ *    values (a polynomial solid's at its corners and centre), before any
+ *    branch and bound (beyond_double).
  * 2. Integrals over the solid weighted by |det J| (quad.h): volume, signed
  *    volume, first and second moments about the box's centre, hence the
  *    centroid, the inertia tensor about it and its principal axes (Jacobi).
@@ -660,16 +663,16 @@ static void poly_sample(poly_objs *p, extremes *e)
  *
  * - a coordinate or det J that overflows at a sample (e->overflow): the bounds, which hold it, cannot
  *   be finite, and nor can the integrals evaluated from the same partials;
- * - the volume or a moment of inertia beyond RANGE_MARGIN times DBL_MAX by the trapezoid rule over the
- *   sample's grid, about its own centroid. The margin is for what a grid of 9 points an axis makes of
- *   an integrand concentrated near a face (|det J| r^2 of exp(700 u) factors: 131 times its integral
- *   an axis), so that no solid whose properties are finite is refused; those within it are computed
- *   and refused at the end as before.
+ * - a moment of inertia beyond RANGE_MARGIN times DBL_MAX by the trapezoid rule over the sample's grid,
+ *   about its own centroid. The margin is for what a grid of 9 points an axis makes of an integrand
+ *   concentrated near a face (|det J| r^2 of exp(700 u) factors: 131 times its integral an axis), so
+ *   that no solid whose properties are finite is refused; those within it are computed and refused at
+ *   the end as before. (The volume needs no test: over the unit cube it is below the largest |det J|.)
  *
- * The volume is below the largest |det J| and the second moments below it times the largest extent
- * squared: only a sample past these needs the grid's sums (a polynomial solid's is 9 points, the
- * grid's own sweep then). The sums are scaled by them and Welford's updates keep the moments about the
- * running centroid, so that nothing overflows or cancels.
+ * The second moments are below the largest |det J| times the largest extent squared: only a sample
+ * past that needs the grid's sums (a polynomial solid's is 9 points, the grid's own sweep then). The
+ * sums are scaled by both, and Welford's updates keep the moments about the running centroid, so that
+ * nothing overflows or cancels.
  */
 #define RANGE_MARGIN 1e20
 
@@ -678,10 +681,10 @@ static pde_status beyond_double(const pde_solution *s, const double *uni, int re
     if (e->overflow)
         return PDE_ERR_RANGE;
     const double limit = log2(DBL_MAX) + log2(RANGE_MARGIN);
-    double J = fmax(fabs(e->jmin), fabs(e->jmax)), E = 0.0;
+    double J = fmax(fabs(e->jmin), fabs(e->jmax)), E = 0.0;   /* E: half the largest extent (no overflow) */
     for (int c = 0; c < 3; c++)
-        E = fmax(E, e->hi[c] - e->lo[c]);
-    if (!(J > 0.0) || (log2(J) <= limit && log2(J) + 2.0 * log2(fmax(E, 1.0)) <= limit))
+        E = fmax(E, 0.5 * e->hi[c] - 0.5 * e->lo[c]);
+    if (!(J > 0.0 && E > 0.0) || log2(J) + 2.0 * log2(2.0 * E) <= limit)
         return PDE_OK;
     extremes g;
     extremes_init(&g);
@@ -693,10 +696,9 @@ static pde_status beyond_double(const pde_solution *s, const double *uni, int re
     J = fmax(fabs(g.jmin), fabs(g.jmax)), E = 0.0;
     double mid[3];
     for (int c = 0; c < 3; c++)
-        E = fmax(E, g.hi[c] - g.lo[c]), mid[c] = 0.5 * (g.lo[c] + g.hi[c]);
-    if (!(J > 0.0))
+        E = fmax(E, 0.5 * g.hi[c] - 0.5 * g.lo[c]), mid[c] = 0.5 * g.lo[c] + 0.5 * g.hi[c];
+    if (!(J > 0.0 && E > 0.0))
         return PDE_OK;
-    E = E > 0.0 ? E : 1.0;
     pde_grid *gr;
     if ((st = pde_grid_create(s, uni, (size_t)res, uni, (size_t)res, &gr)) != PDE_OK)
         return st;
@@ -736,9 +738,7 @@ static pde_status beyond_double(const pde_solution *s, const double *uni, int re
         return st;
     /* A moment of inertia about an axis holds the second moments along the two others. */
     const double m2 = fmax(S[0] + S[1], fmax(S[1] + S[2], S[0] + S[2]));
-    if (log2(W) + log2(J) > limit || (m2 > 0.0 && log2(m2) + log2(J) + 2.0 * log2(E) > limit))
-        return PDE_ERR_RANGE;
-    return PDE_OK;
+    return m2 > 0.0 && log2(m2) + log2(J) + 2.0 * log2(E) > limit ? PDE_ERR_RANGE : PDE_OK;
 }
 
 pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde_props *out)
