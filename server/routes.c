@@ -225,7 +225,17 @@ static void answer_heavy(srv_req *r, srv_entry *e)
     const pde_solution *sol = srv_entry_solution(e);
     const int with_props = api_format_info_of(f)->props;
     const pde_props *props = NULL;
+    api_error err;
+    /* The output's own refusals first (float32's range: a glb of a solid beyond it), which cost nothing,
+     * where the properties of the same solid would take their whole budget. */
     double t0 = srv_now();
+    if (api_output_check(sol, f, &opts, &err)) {
+        r->tm.output = srv_now() - t0;
+        srv_cache_release(s->cache, e);
+        failed(r, &err);
+        return;
+    }
+    t0 = srv_now();
     int cancelled = 0;
     if (with_props)
         props = srv_entry_props(e, &r->cancel, &cancelled);
@@ -235,7 +245,6 @@ static void answer_heavy(srv_req *r, srv_entry *e)
         stopped(r);
         return;
     }
-    api_error err;
     t0 = srv_now();
     api_output *o = api_output_open_ex(sol, r->id, props, f, res, &opts, &r->cancel, &err);
     r->tm.output = srv_now() - t0;

@@ -891,6 +891,27 @@ static void help_should_describe_the_command_s_own_files(void **state)
     free(err);
 }
 
+/* A solid whose properties overflow a double (fig. 4a with p0 = 1e100): offline, solve printed "properties:
+ * value out of range" and exited 1 where --format json and --server say it is too large and exit 2 (QA). */
+static void a_solid_too_large_for_its_properties_should_be_refused_alike_in_every_mode(void **state)
+{
+    (void)state;
+    static const char words[] = "the solid is too large: its properties (volume, inertia) exceed the range of a double";
+    daemon_t d;
+    daemon_start(&d, dir, "--quiet");
+    const char *const p0[] = { "1e100", "1e300" };
+    for (size_t i = 0; i < sizeof p0 / sizeof *p0; i++) {
+        char args[256];
+        snprintf(args, sizeof args, "solve --preset fig4a --param p0=%s", p0[i]);
+        expect(1, args, 2, words);
+        snprintf(args, sizeof args, "solve --preset fig4a --param p0=%s --format json", p0[i]);
+        expect(1, args, 2, words);
+        snprintf(args, sizeof args, "solve --preset fig4a --param p0=%s --server %s", p0[i], d.base);
+        expect(1, args, 2, words);
+    }
+    daemon_stop(&d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -910,6 +931,7 @@ int main(void)
         cmocka_unit_test(params_that_overflow_a_double_should_be_named),
         cmocka_unit_test(long_server_urls_should_not_be_cut_short),
         cmocka_unit_test(help_should_describe_the_command_s_own_files),
+        cmocka_unit_test(a_solid_too_large_for_its_properties_should_be_refused_alike_in_every_mode),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);
