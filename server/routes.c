@@ -665,6 +665,8 @@ int srv_query_arg(const srv_route *rt, srv_query *q, const char *key, size_t kle
                   char *msg, size_t n)
 {
     size_t i = 0;
+    if (!klen && (!value || !vlen))
+        return 0;   /* an empty item, as "?&format=glb" or "?format=glb&" hold: nothing asked */
     if (rt->flags & SRV_RT_PAGE) {
         if (bad_text(key, klen) || (value && (bad_text(value, vlen) || strlen(value) != vlen))) {
             snprintf(msg, n, "the query holds a control character or a NUL");
@@ -682,7 +684,14 @@ int srv_query_arg(const srv_route *rt, srv_query *q, const char *key, size_t kle
         char known[64] = "none";
         for (size_t k = 0, used = 0; (rt->flags & SRV_RT_OUTPUT) && k < NPARAMS; k++)   /* from the table */
             used += (size_t)snprintf(known + used, sizeof known - used, "%s%s", k ? ", " : "", params[k].name);
-        snprintf(msg, n, "unknown query parameter \"%s\"; %s takes %s", shown, rt->path, known);
+        char path[64];   /* the route's {} named, for the message */
+        const char *brace = strstr(rt->path, "{}");
+        if (brace)
+            snprintf(path, sizeof path, "%.*s{%s}%s", (int)(brace - rt->path), rt->path,
+                     strcmp(rt->name, "preset") ? "id" : "name", brace + 2);
+        else
+            snprintf(path, sizeof path, "%s", rt->path);
+        snprintf(msg, n, "unknown query parameter \"%s\"; %s takes %s", shown, path, known);
         return -1;
     }
     if (q->seen & params[i].bit) {
