@@ -171,6 +171,7 @@ static void bad_input_should_exit_2_and_name_the_field(void **state)
         { "solve --preset fig4a --param p0", "--param p0: write NAME=VALUE" },
         { "solve --preset fig4a --param p0=lots", "\"lots\" is not a number" },
         { "solve --preset fig4a --param q=1", "/params/q: example4 has no parameter \"q\"" },
+        { "solve --preset fig4a --param p0=1 --param p0=2", "--param p0 is given twice; give it once" },
         { "solve --preset fig4a --param c=-1,-1,0", "/params/c/2: c of component z is 0" },
         { "solve --preset fig4a --format dae -o x", "\"dae\" is not a format" },
         { "solve --preset fig4a --format grid --res 9999", "limit of 4096" },

@@ -204,6 +204,12 @@ static char *request_text(const options *o, size_t *len)
             return NULL;
         }
         char *name = strndup(o->params[i], (size_t)(eq - o->params[i]));
+        if (name && cJSON_GetObjectItemCaseSensitive(params, name)) {
+            fprintf(stderr, "pdesolid: --param %s is given twice; give it once\n", name);
+            free(name);
+            cJSON_Delete(req);
+            return NULL;
+        }
         cJSON *v = name ? param_value(name, eq + 1) : NULL;
         if (!v || !cJSON_AddItemToObject(params, name, v)) {
             cJSON_Delete(v);
