@@ -108,8 +108,8 @@ int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *er
     unsigned max = mesh ? API_RES_MESH_MAX : API_RES_GRID_MAX;
     const char *what = mesh ? "samples per face edge" : "samples per axis";
     res[0] = res[1] = res[2] = dflt;
-    if (!text || !*text)
-        return 0;
+    if (!text || !*text || formats[f]->unsampled)
+        return 0;   /* json: res=2 (the front-end's) and res=512 are one answer, one ETag */
     unsigned long long v[3];
     int n = 0;
     const char *s = text;

@@ -82,6 +82,7 @@ typedef struct api_format_info {
     int props;             /* carries the properties: api_output_open() computes them when not given */
     int binary;            /* bytes that are not text: not written to a terminal */
     int compress;          /* takes compress=meshopt */
+    int unsampled;         /* writes no samples: res is taken and ignored (api_res_parse gives the default) */
     api_range range;       /* what must fit float32 */
     /* The stream (api/fmt.h says what each does). */
     int (*open)(api_output *o, const pde_cancel *cancel, api_error *err);
