@@ -446,8 +446,8 @@ static void expect(int sanitised, const char *args, int st, const char *words)
     free(err);
 }
 
-/* --res is checked offline as the server checks it, with --format or without: --res 0 exited 0 offline and 2
- * (a 422) with --server. */
+/* --res is checked offline as the server checks it: --res 0 exited 0 offline and 2 (a 422) with --server. (Without
+ * --format, json's, it is taken and ignored, as the server does.) */
 static void res_should_be_checked_offline_as_the_server_does(void **state)
 {
     (void)state;
@@ -456,9 +456,9 @@ static void res_should_be_checked_offline_as_the_server_does(void **state)
     const char *bad[] = { "0", "abc", "1,2", "99999" };
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
         char args[256];
-        snprintf(args, sizeof args, "solve --preset fig4a --res %s", bad[i]);
+        snprintf(args, sizeof args, "solve --preset fig4a --format grid --res %s", bad[i]);
         expect(1, args, 2, "--res");
-        snprintf(args, sizeof args, "solve --preset fig4a --res %s --server %s", bad[i], d.base);
+        snprintf(args, sizeof args, "solve --preset fig4a --format grid --res %s --server %s", bad[i], d.base);
         expect(1, args, 2, "res");
     }
     expect(1, "solve --preset fig4a --res 5", 0, NULL);

@@ -894,7 +894,7 @@ static void invalid_utf8_anywhere_should_give_a_problem_in_valid_json_and_utf8(v
         { "POST", "/solve?format=\xff\xfe", "{\"preset\":\"fig4a\"}" },
         { "POST", "/solve?format=%ff%fe", "{\"preset\":\"fig4a\"}" },
         { "POST", "/solve?%c3%28=1", "{\"preset\":\"fig4a\"}" },
-        { "POST", "/solve?res=%e2%82", "{\"preset\":\"fig4a\"}" },
+        { "POST", "/solve?format=grid&res=%e2%82", "{\"preset\":\"fig4a\"}" },
         { "GET", "/presets/fig%ff", NULL },
         { "GET", "/presets/fig\xc3\x28", NULL },
         { "GET", "/solids/%ed%a0%80", NULL },
