@@ -236,11 +236,14 @@ static void answer_heavy(srv_req *r, srv_entry *e)
         return;
     }
     t0 = srv_now();
-    int cancelled = 0;
-    if (with_props)
-        props = srv_entry_props(e, &r->cancel, &cancelled);
+    if (with_props && !(props = srv_entry_props(e, &r->cancel, &err))) {
+        r->tm.props = srv_now() - t0;
+        srv_cache_release(s->cache, e);
+        failed(r, &err);   /* cancelled: stopped(); the solid's own failure, kept with it */
+        return;
+    }
     r->tm.props = srv_now() - t0;
-    if (cancelled || srv_job_stop(r)) {
+    if (srv_job_stop(r)) {
         srv_cache_release(s->cache, e);
         stopped(r);
         return;

@@ -1322,6 +1322,19 @@ static void a_solid_beyond_a_double_should_be_refused_422_without_its_properties
     if (!strstr(st, "props;dur=0.000"))
         fail_msg("the glb refused for float32 computed the properties first: %s", st);
     raw_reply_free(&r);
+    /* A solid near the limit does its properties' work before their refusal: once. The failure is kept with
+     * the cached solid, so a repeat (and a glb, which computed them again after their NULL) costs nothing. */
+    static const char near[] = "{\"preset\":\"fig4a\",\"params\":{\"p0\":1e85}}";
+    static const char *const again[] = { "/solve", "/solve?format=vts&res=4" };
+    for (int k = 0; k < 3; k++) {
+        r = post(&d, k ? again[k - 1] : "/solve", near);
+        expect_problem(&r, 422, ANY_POINTER, "too large");
+        if (!raw_header(&r, "Server-Timing", st, sizeof st))
+            fail_msg("no Server-Timing");
+        if (!k == !!strstr(st, "props;dur=0.000"))
+            fail_msg("request %d of a solid whose properties fail: %s", k, st);
+        raw_reply_free(&r);
+    }
     stop(&d);
 }
 
