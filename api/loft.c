@@ -422,7 +422,7 @@ static int parse_section(const cJSON *j, const char *ptr, int k, double tol, api
         return -1;
     if (!!f[1] + !!f[4] + !!f[5] != 1)
         return api_fail(err, API_ERR_DOCUMENT, ptr, "a section %s one of \"profile\" (points of a curve), \"grid\" (a sampled surface) "
-                        "or \"terms\" (closed form)", !!f[1] + !!f[4] + !!f[5] ? "takes only" : "needs");
+                        "or \"terms\" (closed form)", (!!f[1] + !!f[4] + !!f[5]) ? "takes only" : "needs");
     if (f[6] && !f[5])
         return api_fail(err, API_ERR_DOCUMENT, ptr, "\"periodic\" goes with \"grid\"");
     if (f[5]) {
