@@ -81,17 +81,8 @@ int api_out_cancelled(api_error *err)
 
 const pde_props *api_out_props(api_output *o, const pde_cancel *cancel, api_error *err)
 {
-    pde_props_opts opts = { .cancel = cancel };
-    if (!o->have_props) {
-        pde_status st = pde_properties(o->sol, &opts, &o->props);
-        if (st == PDE_ERR_CANCELLED)
-            api_out_cancelled(err);
-        else if (st == PDE_ERR_RANGE)
-            api_fail(err, API_ERR_DOCUMENT, "", "the solid is too large: its properties (volume, inertia) exceed "
-                     "the range of a double; scale the model's data or forces down");
-        if (st != PDE_OK)
-            return NULL;
-    }
+    if (!o->have_props && api_properties(o->sol, cancel, &o->props, err) != PDE_OK)
+        return NULL;
     o->have_props = 1;
     return &o->props;
 }

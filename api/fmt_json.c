@@ -102,6 +102,6 @@ static int json_fill(api_output *o)
 }
 
 const api_format_info api_format_json = {
-    .name = "json", .mime = "application/json", .ext = ".json", .props = 1, .range = API_RANGE_DOUBLES,
+    .name = "json", .mime = "application/json", .ext = ".json", .props = 1, .unsampled = 1, .range = API_RANGE_DOUBLES,
     .open = json_open, .fill = json_fill, .cost = api_cost_json,
 };

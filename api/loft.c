@@ -285,7 +285,7 @@ static int get_points(const cJSON *j, const char *ptr, int want, double (**out)[
         return api_fail(err, API_ERR_DOCUMENT, ptr, "must be an array of points [x, y, z], not %s", api_json_type(j));
     int k = cJSON_GetArraySize(j);
     if (want && k != want)
-        return api_fail(err, API_ERR_DOCUMENT, ptr, "has %d vectors; it needs one for each of the profile's %d points", k, want);
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "has %d vector%s; it needs one for each of the profile's %d points", k, k == 1 ? "" : "s", want);
     if (k < 3)
         return api_fail(err, API_ERR_DOCUMENT, ptr, "has %d points; a closed curve needs at least 3", k);
     if (k > API_LOFT_MAX_POINTS) {
@@ -421,8 +421,8 @@ static int parse_section(const cJSON *j, const char *ptr, int k, double tol, api
     if (api_json_number(f[0], q, &l->sec[k].w, err))
         return -1;
     if (!!f[1] + !!f[4] + !!f[5] != 1)
-        return api_fail(err, API_ERR_DOCUMENT, ptr, "a section needs one of \"profile\" (points of a curve), \"grid\" (a sampled surface) "
-                        "or \"terms\" (closed form)");
+        return api_fail(err, API_ERR_DOCUMENT, ptr, "a section %s one of \"profile\" (points of a curve), \"grid\" (a sampled surface) "
+                        "or \"terms\" (closed form)", (!!f[1] + !!f[4] + !!f[5]) ? "takes only" : "needs");
     if (f[6] && !f[5])
         return api_fail(err, API_ERR_DOCUMENT, ptr, "\"periodic\" goes with \"grid\"");
     if (f[5]) {

@@ -108,8 +108,8 @@ int api_res_parse(const char *text, api_format f, unsigned res[3], api_error *er
     unsigned max = mesh ? API_RES_MESH_MAX : API_RES_GRID_MAX;
     const char *what = mesh ? "samples per face edge" : "samples per axis";
     res[0] = res[1] = res[2] = dflt;
-    if (!text || !*text)
-        return 0;
+    if (!text || !*text || formats[f]->unsampled)
+        return 0;   /* json: res=2 (the front-end's) and res=512 are one answer, one ETag */
     unsigned long long v[3];
     int n = 0;
     const char *s = text;
@@ -401,6 +401,40 @@ static int range_check(const pde_solution *sol, const api_format_info *fi, api_e
 
 /* ---- the stream ---- */
 
+/* ---- the properties ---- */
+
+pde_status api_properties(const pde_solution *sol, const pde_cancel *cancel, pde_props *out, api_error *err)
+{
+    api_error local;
+    if (!err)
+        err = &local;
+    const pde_props_opts opts = { .cancel = cancel };
+    pde_status st = pde_properties(sol, &opts, out);
+    if (st == PDE_ERR_CANCELLED)
+        api_fail_cancelled(err);
+    else if (st == PDE_ERR_RANGE)
+        api_fail(err, API_ERR_DOCUMENT, "", "the solid is too large: its properties (volume, inertia) exceed "
+                 "the range of a double; scale the model's data or forces down");
+    else if (st != PDE_OK)
+        api_fail_nomem(err);   /* the one failure left for a solution (PDE_ERR_INVALID: no solution) */
+    return st;
+}
+
+int api_output_check(const pde_solution *sol, api_format f, const api_output_opts *opts, api_error *err)
+{
+    api_error local;
+    if (!err)
+        err = &local;
+    const api_format_info *fi = api_format_info_of(f);
+    if (!fi)
+        return api_fail(err, API_ERR_DOCUMENT, "", "format: %d is not a format", (int)f);
+    if (opts && opts->compress != API_COMPRESS_NONE && !fi->compress) {
+        api_compress_parse(api_compress_name(opts->compress), f, &(api_compress){ 0 }, err);
+        return -1;
+    }
+    return range_check(sol, fi, err);
+}
+
 api_output *api_output_open_ex(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
                                const unsigned res[3], const api_output_opts *opts, const pde_cancel *cancel,
                                api_error *err)
@@ -408,17 +442,9 @@ api_output *api_output_open_ex(const pde_solution *sol, const char *id, const pd
     api_error local;
     if (!err)
         err = &local;
+    if (api_output_check(sol, f, opts, err))
+        return NULL;
     const api_format_info *fi = api_format_info_of(f);
-    if (!fi) {
-        api_fail(err, API_ERR_DOCUMENT, "", "format: %d is not a format", (int)f);
-        return NULL;
-    }
-    if (opts && opts->compress != API_COMPRESS_NONE && !fi->compress) {
-        api_compress_parse(api_compress_name(opts->compress), f, &(api_compress){ 0 }, err);
-        return NULL;
-    }
-    if (range_check(sol, fi, err))
-        return NULL;
     api_output *o = calloc(1, sizeof *o);
     if (!o) {
         api_fail_nomem(err);

@@ -82,6 +82,7 @@ typedef struct api_format_info {
     int props;             /* carries the properties: api_output_open() computes them when not given */
     int binary;            /* bytes that are not text: not written to a terminal */
     int compress;          /* takes compress=meshopt */
+    int unsampled;         /* writes no samples: res is taken and ignored (api_res_parse gives the default) */
     api_range range;       /* what must fit float32 */
     /* The stream (api/fmt.h says what each does). */
     int (*open)(api_output *o, const pde_cancel *cancel, api_error *err);
@@ -128,6 +129,15 @@ api_output *api_output_open(const pde_solution *sol, const char *id, const pde_p
 api_output *api_output_open_ex(const pde_solution *sol, const char *id, const pde_props *props, api_format f,
                                const unsigned res[3], const api_output_opts *opts, const pde_cancel *cancel,
                                api_error *err);
+/* pde_properties() (cancel: NULL never stops) with its failure as err: a solid whose properties overflow a
+ * double a document error (the client scales it down), a cancelled call API_ERR_CANCELLED, else out of
+ * memory. Returns the
+ * status; *out as pde_properties() leaves it. The formats that carry the properties compute them so. */
+pde_status api_properties(const pde_solution *sol, const pde_cancel *cancel, pde_props *out, api_error *err);
+/* The refusals of api_output_open_ex() that take no work (a format that is none, a compression it does not
+ * take, a solid beyond its float32 range): 0, or -1 with err as api_output_open_ex() would set it. For a
+ * caller that computes the properties first (server/routes.c), so that it refuses before that work. */
+int api_output_check(const pde_solution *sol, api_format f, const api_output_opts *opts, api_error *err);
 /* The total size in bytes, or -1 when it is known only at the end (grid, obj, msh, vtu). */
 long long api_output_size(const api_output *o);
 /*

@@ -57,7 +57,7 @@ static const api_param_info ex3_params[] = {
     { "r2", 1, "radius at w = 1" },
     { "h0", 1, "z at w = 0" }, { "h1", 1, "amplitude of u sin n_z pi v in z at w = 0" },
     { "h2", 1, "z at w = 1" }, { "h3", 1, "amplitude of u sin n_z pi v in z at w = 1" },
-    { "n_xy", 1, "frequency of the second x, y term" }, { "n_z", 1, "frequency of the z term (0: planar)" },
+    { "n_xy", 1, "frequency of the second x, y term (even closes the seam v = 0, 1; odd or fractional leaves two faces there that overlap in the plane x = 0)" }, { "n_z", 1, "frequency of the z term (0: planar)" },
     { "r0p", 1, "r'0" }, { "r1p", 1, "r'1" }, { "r2p", 1, "r'2" },
     { "h0p", 1, "h'0" }, { "h1p", 1, "h'1" }, { "h2p", 1, "h'2" }, { "h3p", 1, "h'3" },
 };

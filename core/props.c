@@ -7,6 +7,9 @@
  *    within 1e-9 of the solid's size of the best value (or a box budget ends:
  *    the gap says how far it got). A polynomial solid (fig. 1) instead takes
  *    a branch and bound over Bernstein coefficients (poly.h), without sample.
+ *    A solid whose properties cannot be finite is refused from these first
+ *    values (a polynomial solid's at its corners and centre), before any
+ *    branch and bound (beyond_double).
  * 2. Integrals over the solid weighted by |det J| (quad.h): volume, signed
  *    volume, first and second moments about the box's centre, hence the
  *    centroid, the inertia tensor about it and its principal axes (Jacobi).
@@ -58,10 +61,25 @@ static int poll_after(poller *p, size_t units)
 typedef struct {
     double lo[3], hi[3], lo_at[3][3], hi_at[3][3];
     double jmin, jmax, jmin_at[3], jmax_at[3];
+    int overflow;   /* a coordinate or det J was inf or NaN (which no comparison notes) */
 } extremes;
+
+static void extremes_init(extremes *e)
+{
+    for (int c = 0; c < 3; c++) {
+        e->lo[c] = DBL_MAX, e->hi[c] = -DBL_MAX;
+        for (int a = 0; a < 3; a++)
+            e->lo_at[c][a] = e->hi_at[c][a] = e->jmin_at[a] = e->jmax_at[a] = 0.5;
+    }
+    e->jmin = DBL_MAX;
+    e->jmax = -DBL_MAX;
+    e->overflow = 0;
+}
 
 static void note_point(extremes *e, const double p[3], const double x[3], double dj)
 {
+    if (!(isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]) && isfinite(dj)))
+        e->overflow = 1;
     for (int c = 0; c < 3; c++) {
         if (x[c] < e->lo[c])
             e->lo[c] = x[c], e->lo_at[c][0] = p[0], e->lo_at[c][1] = p[1], e->lo_at[c][2] = p[2];
@@ -648,6 +666,91 @@ static void poly_sample(poly_objs *p, extremes *e)
         poly_bernstein(&p->b[o]);
 }
 
+/*
+ * Refuses (PDE_ERR_RANGE) at once a solid whose properties cannot be finite, before the branch and
+ * bound and the quadrature, which would otherwise spend their whole budget on it (NaN stops no
+ * refinement: a 1e300 solid took a second to end as inf):
+ *
+ * - a coordinate or det J that overflows at a sample (e->overflow): the bounds, which hold it, cannot
+ *   be finite, and nor can the integrals evaluated from the same partials;
+ * - a moment of inertia beyond RANGE_MARGIN times DBL_MAX by the trapezoid rule over the sample's grid,
+ *   about its own centroid. The margin is for what a grid of 9 points an axis makes of an integrand
+ *   concentrated near a face (|det J| r^2 of exp(700 u) factors: 131 times its integral an axis), so
+ *   that no solid whose properties are finite is refused; those within it are computed and refused at
+ *   the end as before. (The volume needs no test: over the unit cube it is below the largest |det J|.)
+ *
+ * The second moments are below the largest |det J| times the largest extent squared: only a sample
+ * past that needs the grid's sums (a polynomial solid's is 9 points, the grid's own sweep then). The
+ * sums are scaled by both, and Welford's updates keep the moments about the running centroid, so that
+ * nothing overflows or cancels.
+ */
+#define RANGE_MARGIN 1e20
+
+static pde_status beyond_double(const pde_solution *s, const double *uni, int res, poller *pl, const extremes *e)
+{
+    if (e->overflow)
+        return PDE_ERR_RANGE;
+    const double limit = log2(DBL_MAX) + log2(RANGE_MARGIN);
+    double J = fmax(fabs(e->jmin), fabs(e->jmax)), E = 0.0;   /* E: half the largest extent (no overflow) */
+    for (int c = 0; c < 3; c++)
+        E = fmax(E, 0.5 * e->hi[c] - 0.5 * e->lo[c]);
+    if (!(J > 0.0 && E > 0.0) || log2(J) + 2.0 * log2(2.0 * E) <= limit)
+        return PDE_OK;
+    extremes g;
+    extremes_init(&g);
+    pde_status st = sweep(s, uni, res, uni, res, uni, res, pl, &g);
+    if (st != PDE_OK)
+        return st;
+    if (g.overflow)
+        return PDE_ERR_RANGE;
+    J = fmax(fabs(g.jmin), fabs(g.jmax)), E = 0.0;
+    double mid[3];
+    for (int c = 0; c < 3; c++)
+        E = fmax(E, 0.5 * g.hi[c] - 0.5 * g.lo[c]), mid[c] = 0.5 * g.lo[c] + 0.5 * g.hi[c];
+    if (!(J > 0.0 && E > 0.0))
+        return PDE_OK;
+    pde_grid *gr;
+    if ((st = pde_grid_create(s, uni, (size_t)res, uni, (size_t)res, &gr)) != PDE_OK)
+        return st;
+    const size_t n = (size_t)res;
+    double W = 0.0, mean[3] = { 0, 0, 0 }, S[3] = { 0, 0, 0 };
+    for (size_t k = 0; k < n && st == PDE_OK; k++) {
+        grid_set_w(gr, uni[k]);
+        const double wk = (k == 0 || k == n - 1 ? 0.5 : 1.0) / (double)(n - 1);
+        for (size_t j = 0; j < n; j++) {
+            if (poll_after(pl, (j ? 0 : pl->point) + pl->modes * (4 + n) / 16)) {
+                st = PDE_ERR_CANCELLED;
+                break;
+            }
+            grid_row(gr, j, GRID_X | GRID_XU | GRID_XV | GRID_XW);
+            const double wjk = wk * (j == 0 || j == n - 1 ? 0.5 : 1.0) / (double)(n - 1);
+            for (size_t i = 0; i < n; i++) {
+                double a[3], b[3], c[3];
+                for (int q = 0; q < 3; q++) {
+                    a[q] = gr->row[(3 + q) * n + i];
+                    b[q] = gr->row[(6 + q) * n + i];
+                    c[q] = gr->row[(9 + q) * n + i];
+                }
+                const double wt = wjk * (i == 0 || i == n - 1 ? 0.5 : 1.0) / (double)(n - 1) * fabs(det3(a, b, c)) / J;
+                if (!(wt > 0.0))
+                    continue;
+                W += wt;
+                for (int q = 0; q < 3; q++) {
+                    const double y = (gr->row[q * n + i] - mid[q]) / E, d = y - mean[q];
+                    mean[q] += d * wt / W;
+                    S[q] += wt * d * (y - mean[q]);
+                }
+            }
+        }
+    }
+    pde_grid_free(gr);
+    if (st != PDE_OK)
+        return st;
+    /* A moment of inertia about an axis holds the second moments along the two others. */
+    const double m2 = fmax(S[0] + S[1], fmax(S[1] + S[2], S[0] + S[2]));
+    return m2 > 0.0 && log2(m2) + log2(J) + 2.0 * log2(E) > limit ? PDE_ERR_RANGE : PDE_OK;
+}
+
 pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde_props *out)
 {
     if (!s || !out)
@@ -671,13 +774,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     for (int i = 0; i < res; i++)
         uni[i] = (double)i / (res - 1);
     extremes e;
-    for (int c = 0; c < 3; c++) {
-        e.lo[c] = DBL_MAX, e.hi[c] = -DBL_MAX;
-        for (int a = 0; a < 3; a++)
-            e.lo_at[c][a] = e.hi_at[c][a] = e.jmin_at[a] = e.jmax_at[a] = 0.5;
-    }
-    e.jmin = DBL_MAX;
-    e.jmax = -DBL_MAX;
+    extremes_init(&e);
     /* A polynomial solid: its extremes from Bernstein coefficients, where a sample is of no help. */
     poly_objs *po = poly_objs_new(s);
     pde_status st = PDE_OK;
@@ -685,9 +782,13 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         poly_sample(po, &e);
     else
         st = sweep(s, uni, res, uni, res, uni, res, &pl, &e);
+    if (st == PDE_OK)
+        st = beyond_double(s, uni, res, &pl, &e);
     free(uni);
-    if (st != PDE_OK)
+    if (st != PDE_OK) {
+        free(po);
         return st;
+    }
 
     /* Into a local result, so that a cancelled call leaves *out untouched. */
     pde_props r = { 0 };
@@ -806,12 +907,15 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         const pde_factor v = s->comp[cc].modes[cm].v;
         r.condition_harmonic = v.kind == PDE_SIN || v.kind == PDE_COS ? 0.5 * v.p : 0.0;
     }
-    /* Integrals beyond a double: say so rather than hand back inf and NaN. */
-    double sum = r.volume + r.signed_volume + r.surface_area + r.centroid[0] + r.centroid[1] + r.centroid[2];
-    for (int i = 0; i < 3; i++)
+    /* Integrals beyond a double: say so rather than hand back inf and NaN. Each on its own: a sum of
+     * finite ones may overflow. */
+    int finite = isfinite(r.volume) && isfinite(r.signed_volume) && isfinite(r.surface_area);
+    for (int i = 0; i < 3; i++) {
+        finite &= isfinite(r.centroid[i]) && isfinite(r.principal_moments[i]);
         for (int k = 0; k < 3; k++)
-            sum += r.inertia[i][k] + r.principal_axes[i][k];
-    if (!isfinite(sum))
+            finite &= isfinite(r.inertia[i][k]) && isfinite(r.principal_axes[i][k]);
+    }
+    if (!finite)
         return PDE_ERR_RANGE;
 
     double own[3];   /* the solution's size: attained values, not bounds (which may be loose) */

@@ -2002,7 +2002,7 @@ static double face_refine(face_ctx *c, const double lo[2], const double h[2], do
 {
     if (!c->stopped && pde_stopped(c->cancel))
         c->stopped = 1;
-    if (est <= FACE_EST * c->tol)
+    if (!(est > FACE_EST * c->tol))   /* NaN too: values beyond a double refine to nothing better */
         return coarse;
     double q[4] = { 0, 0, 0, 0 }, ql[4][2], qe[4] = { 0, 0, 0, 0 }, fine = 0.0;
     const double hh[2] = { c->flat == 0 ? h[0] : 0.5 * h[0], c->flat == 1 ? h[1] : 0.5 * h[1] };
@@ -2014,8 +2014,8 @@ static double face_refine(face_ctx *c, const double lo[2], const double h[2], do
         fine += q[k] = face_panel(c, ql[k], hh, &fl, &qe[k]);
     }
     const double diff = fabs(fine - coarse);
-    if (c->stopped || c->line.q->r.evals * c->line.q->modes >= REFINE_WORK || diff <= c->tol ||
-        depth + 1 >= FACE_DEPTH_MAX || (depth + 1 >= FACE_DEPTH && diff <= FACE_DEEP * c->tol))
+    if (c->stopped || c->line.q->r.evals * c->line.q->modes >= REFINE_WORK || !(diff > c->tol) ||
+        depth + 1 >= FACE_DEPTH_MAX || (depth + 1 >= FACE_DEPTH && !(diff > FACE_DEEP * c->tol)))
         return fine;
     double sum = 0.0;
     for (int k = 0; k < 4; k++)
@@ -2146,7 +2146,7 @@ static double poly_face_rule(const poly_face *f, const double lo[2], const doubl
 static double poly_face_adapt(poly_face *f, const double lo[2], const double h[2], double coarse, int depth)
 {
     const double fine = poly_face_rule(f, lo, h, 2 * POLY_RULE);
-    if (fabs(fine - coarse) <= f->tol * h[0] * h[1])
+    if (!(fabs(fine - coarse) > f->tol * h[0] * h[1]))   /* or NaN: no refinement mends it */
         return fine;
     if (depth == POLY_DEPTH) {
         f->ok = 0;

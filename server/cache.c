@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "cache.h"
+#include "output.h"
 
 enum { SOLVING, READY, FAILED };
 
@@ -27,7 +28,8 @@ struct srv_entry {
     srv_entry *hnext, *prev, *next;
     pthread_mutex_t props_lock;   /* one computes the properties; the others wait for them */
     pde_props props;
-    int props_ok;
+    int props_ok;                 /* 1: props; -1: they failed (props_err), which every later call answers */
+    api_error props_err;
     _Atomic unsigned long long shown[8];   /* representations opened once (srv_entry_shown), a ring */
     atomic_uint shown_next;
 };
@@ -254,18 +256,21 @@ const char *srv_entry_id(const srv_entry *e)
     return e->id;
 }
 
-const pde_props *srv_entry_props(srv_entry *e, const pde_cancel *cancel, int *cancelled)
+const pde_props *srv_entry_props(srv_entry *e, const pde_cancel *cancel, api_error *err)
 {
     pthread_mutex_lock(&e->props_lock);
-    pde_status st = PDE_OK;
     if (!e->props_ok) {
-        pde_props_opts o = { .cancel = cancel };
-        st = pde_properties(e->sol, &o, &e->props);
-        e->props_ok = st == PDE_OK;   /* a cancelled computation leaves them for the next request */
+        pde_status st = api_properties(e->sol, cancel, &e->props, &e->props_err);
+        /* A cancelled computation leaves them for the next request; any other failure is the solid's. */
+        e->props_ok = st == PDE_OK ? 1 : st == PDE_ERR_CANCELLED ? 0 : -1;
+        if (st == PDE_ERR_CANCELLED)
+            *err = e->props_err;
     }
+    if (e->props_ok < 0)
+        *err = e->props_err;
+    const pde_props *p = e->props_ok > 0 ? &e->props : NULL;
     pthread_mutex_unlock(&e->props_lock);
-    *cancelled = st == PDE_ERR_CANCELLED;
-    return e->props_ok ? &e->props : NULL;
+    return p;
 }
 
 int srv_entry_shown(srv_entry *e, const char *rep, int mark)
@@ -280,11 +285,11 @@ int srv_entry_shown(srv_entry *e, const char *rep, int mark)
     return 0;
 }
 
-/* Whether the properties are there already (then they cost nothing). */
+/* Whether the properties are there already, or failed for good (then they cost nothing). */
 int srv_entry_has_props(srv_entry *e)
 {
     pthread_mutex_lock(&e->props_lock);
-    int ok = e->props_ok;
+    int ok = e->props_ok != 0;
     pthread_mutex_unlock(&e->props_lock);
     return ok;
 }

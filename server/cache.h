@@ -42,11 +42,12 @@ const pde_solution *srv_entry_solution(const srv_entry *e);
 const char *srv_entry_id(const srv_entry *e);
 /*
  * The properties, computed on first use, once: concurrent callers wait for
- * the first. NULL if out of memory, or cancelled (then *cancelled is 1, and
- * the next call computes them again).
+ * the first. NULL with *err when they failed: cancelled (API_ERR_CANCELLED;
+ * the next call computes them again), or a failure of the solid's own (too
+ * large for a double), which is kept: every later call gets it at once.
  */
-const pde_props *srv_entry_props(srv_entry *e, const pde_cancel *cancel, int *cancelled);
-/* 1 if the properties are computed already. */
+const pde_props *srv_entry_props(srv_entry *e, const pde_cancel *cancel, api_error *err);
+/* 1 if the properties are computed already, or failed for good: they cost nothing now. */
 int srv_entry_has_props(srv_entry *e);
 /* 1 if the representation rep (its ETag) of the entry was opened before: the last 8 are kept, by a 64-bit
  * hash. With mark, a rep not seen is recorded. So a revalidation (If-None-Match) of an output known to open

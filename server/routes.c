@@ -225,17 +225,29 @@ static void answer_heavy(srv_req *r, srv_entry *e)
     const pde_solution *sol = srv_entry_solution(e);
     const int with_props = api_format_info_of(f)->props;
     const pde_props *props = NULL;
+    api_error err;
+    /* The output's own refusals first (float32's range: a glb of a solid beyond it), which cost nothing,
+     * where the properties of the same solid would take their whole budget. */
     double t0 = srv_now();
-    int cancelled = 0;
-    if (with_props)
-        props = srv_entry_props(e, &r->cancel, &cancelled);
+    if (api_output_check(sol, f, &opts, &err)) {
+        r->tm.output = srv_now() - t0;
+        srv_cache_release(s->cache, e);
+        failed(r, &err);
+        return;
+    }
+    t0 = srv_now();
+    if (with_props && !(props = srv_entry_props(e, &r->cancel, &err))) {
+        r->tm.props = srv_now() - t0;
+        srv_cache_release(s->cache, e);
+        failed(r, &err);   /* cancelled: stopped(); the solid's own failure, kept with it */
+        return;
+    }
     r->tm.props = srv_now() - t0;
-    if (cancelled || srv_job_stop(r)) {
+    if (srv_job_stop(r)) {
         srv_cache_release(s->cache, e);
         stopped(r);
         return;
     }
-    api_error err;
     t0 = srv_now();
     api_output *o = api_output_open_ex(sol, r->id, props, f, res, &opts, &r->cancel, &err);
     r->tm.output = srv_now() - t0;
@@ -656,6 +668,8 @@ int srv_query_arg(const srv_route *rt, srv_query *q, const char *key, size_t kle
                   char *msg, size_t n)
 {
     size_t i = 0;
+    if (!klen && (!value || !vlen))
+        return 0;   /* an empty item, as "?&format=glb" or "?format=glb&" hold: nothing asked */
     if (rt->flags & SRV_RT_PAGE) {
         if (bad_text(key, klen) || (value && (bad_text(value, vlen) || strlen(value) != vlen))) {
             snprintf(msg, n, "the query holds a control character or a NUL");
@@ -673,7 +687,14 @@ int srv_query_arg(const srv_route *rt, srv_query *q, const char *key, size_t kle
         char known[64] = "none";
         for (size_t k = 0, used = 0; (rt->flags & SRV_RT_OUTPUT) && k < NPARAMS; k++)   /* from the table */
             used += (size_t)snprintf(known + used, sizeof known - used, "%s%s", k ? ", " : "", params[k].name);
-        snprintf(msg, n, "unknown query parameter \"%s\"; %s takes %s", shown, rt->path, known);
+        char path[64];   /* the route's {} named, for the message */
+        const char *brace = strstr(rt->path, "{}");
+        if (brace)
+            snprintf(path, sizeof path, "%.*s{%s}%s", (int)(brace - rt->path), rt->path,
+                     strcmp(rt->name, "preset") ? "id" : "name", brace + 2);
+        else
+            snprintf(path, sizeof path, "%s", rt->path);
+        snprintf(msg, n, "unknown query parameter \"%s\"; %s takes %s", shown, path, known);
         return -1;
     }
     if (q->seen & params[i].bit) {

@@ -171,6 +171,7 @@ static void bad_input_should_exit_2_and_name_the_field(void **state)
         { "solve --preset fig4a --param p0", "--param p0: write NAME=VALUE" },
         { "solve --preset fig4a --param p0=lots", "\"lots\" is not a number" },
         { "solve --preset fig4a --param q=1", "/params/q: example4 has no parameter \"q\"" },
+        { "solve --preset fig4a --param p0=1 --param p0=2", "--param p0 is given twice; give it once" },
         { "solve --preset fig4a --param c=-1,-1,0", "/params/c/2: c of component z is 0" },
         { "solve --preset fig4a --format dae -o x", "\"dae\" is not a format" },
         { "solve --preset fig4a --format grid --res 9999", "limit of 4096" },
@@ -445,8 +446,8 @@ static void expect(int sanitised, const char *args, int st, const char *words)
     free(err);
 }
 
-/* --res is checked offline as the server checks it, with --format or without: --res 0 exited 0 offline and 2
- * (a 422) with --server. */
+/* --res is checked offline as the server checks it: --res 0 exited 0 offline and 2 (a 422) with --server. (Without
+ * --format, json's, it is taken and ignored, as the server does.) */
 static void res_should_be_checked_offline_as_the_server_does(void **state)
 {
     (void)state;
@@ -455,9 +456,9 @@ static void res_should_be_checked_offline_as_the_server_does(void **state)
     const char *bad[] = { "0", "abc", "1,2", "99999" };
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
         char args[256];
-        snprintf(args, sizeof args, "solve --preset fig4a --res %s", bad[i]);
+        snprintf(args, sizeof args, "solve --preset fig4a --format grid --res %s", bad[i]);
         expect(1, args, 2, "--res");
-        snprintf(args, sizeof args, "solve --preset fig4a --res %s --server %s", bad[i], d.base);
+        snprintf(args, sizeof args, "solve --preset fig4a --format grid --res %s --server %s", bad[i], d.base);
         expect(1, args, 2, "res");
     }
     expect(1, "solve --preset fig4a --res 5", 0, NULL);
@@ -891,6 +892,27 @@ static void help_should_describe_the_command_s_own_files(void **state)
     free(err);
 }
 
+/* A solid whose properties overflow a double (fig. 4a with p0 = 1e100): offline, solve printed "properties:
+ * value out of range" and exited 1 where --format json and --server say it is too large and exit 2 (QA). */
+static void a_solid_too_large_for_its_properties_should_be_refused_alike_in_every_mode(void **state)
+{
+    (void)state;
+    static const char words[] = "the solid is too large: its properties (volume, inertia) exceed the range of a double";
+    daemon_t d;
+    daemon_start(&d, dir, "--quiet");
+    const char *const p0[] = { "1e100", "1e300" };
+    for (size_t i = 0; i < sizeof p0 / sizeof *p0; i++) {
+        char args[256];
+        snprintf(args, sizeof args, "solve --preset fig4a --param p0=%s", p0[i]);
+        expect(1, args, 2, words);
+        snprintf(args, sizeof args, "solve --preset fig4a --param p0=%s --format json", p0[i]);
+        expect(1, args, 2, words);
+        snprintf(args, sizeof args, "solve --preset fig4a --param p0=%s --server %s", p0[i], d.base);
+        expect(1, args, 2, words);
+    }
+    daemon_stop(&d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -910,6 +932,7 @@ int main(void)
         cmocka_unit_test(params_that_overflow_a_double_should_be_named),
         cmocka_unit_test(long_server_urls_should_not_be_cut_short),
         cmocka_unit_test(help_should_describe_the_command_s_own_files),
+        cmocka_unit_test(a_solid_too_large_for_its_properties_should_be_refused_alike_in_every_mode),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("cli", tests, setup, teardown);

@@ -432,6 +432,32 @@ static void a_loft_of_zero_sections_should_be_the_zero_solid(void **state)
     }
 }
 
+/* Messages say what is wrong with what was given: a section with two kinds "takes only one of" them (it said
+ * "needs one of"), one tangent is "1 vector" (it said "1 vectors"; QA). */
+static void loft_messages_should_fit_what_was_given(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *doc, *says;
+    } cases[] = {
+        { "{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": " TRI(0) ", \"terms\": {}}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
+          "a section takes only one of \"profile\"" },
+        { "{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0}, {\"w\": 1, \"profile\": " TRI(1) "}]}}", "a section needs one of \"profile\"" },
+        { "{\"loft\": {" PDE3 ", \"sections\": [{\"w\": 0, \"profile\": " TRI(0) ", \"tangent\": [[0, 0, 1]]}, {\"w\": 1, \"profile\": " TRI(1) "}]}}",
+          "has 1 vector; it needs one for each of the profile's 3 points" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        api_error err;
+        api_model *m = api_model_parse(cases[i].doc, strlen(cases[i].doc), &err);
+        if (m) {
+            api_model_free(m);
+            fail_msg("accepted: %s", cases[i].doc);
+        }
+        if (!strstr(err.message, cases[i].says))
+            fail_msg("\"%s\" lacks \"%s\"", err.message, cases[i].says);
+    }
+}
+
 static void every_bad_loft_should_name_its_field(void **state)
 {
     (void)state;
@@ -497,6 +523,7 @@ int main(void)
         cmocka_unit_test(the_tolerance_should_drop_the_harmonics_of_noise),
         cmocka_unit_test(equal_lofts_should_share_an_id_and_a_changed_one_should_not),
         cmocka_unit_test(every_bad_loft_should_name_its_field),
+        cmocka_unit_test(loft_messages_should_fit_what_was_given),
         cmocka_unit_test(a_loft_of_zero_sections_should_be_the_zero_solid),
         cmocka_unit_test(every_loft_preset_should_solve_soundly_and_its_document_give_the_same_id),
         cmocka_unit_test(a_near_resonant_loft_should_report_its_harmonic_and_condition),

@@ -958,6 +958,15 @@ static void bad_formats_and_resolutions_should_name_the_limit(void **state)
     api_format f;
     api_error err;
     unsigned res[3];
+    /* json samples nothing: any res is one answer (res=512 was refused as too many points, and res=5 and 33
+     * gave one body under two ETags: QA), the default's. */
+    static const char *const any[] = { "2", "512", "5,6,7", "abc", "99999999999999999999" };
+    for (size_t i = 0; i < sizeof any / sizeof *any; i++) {
+        unsigned want[3];
+        assert_int_equal(api_res_parse(NULL, API_FMT_JSON, want, &err), 0);
+        assert_int_equal(api_res_parse(any[i], API_FMT_JSON, res, &err), 0);
+        assert_memory_equal(res, want, sizeof res);
+    }
     assert_int_equal(api_format_parse("dae", &f, &err), -1);
     assert_non_null(strstr(err.message, "json, grid, f32, gltf, glb, vts, stl, obj, ply, msh, vtu"));
     api_compress c;

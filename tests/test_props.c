@@ -6,11 +6,13 @@
  * and against the independent quadrature ref_props() of support.c; the
  * certified bounds against dense samplings.
  */
+#include <float.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -660,9 +662,7 @@ static void separable_integrals_should_equal_the_adaptive_integrals_over_the_cub
         quad_result face;
         assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 2, 0, NULL, &face), PDE_OK);
         double scale[Q_N];   /* each integral against its size: |det J| times |r|^k */
-        double size = 0.0;   /* pde_properties': the box's largest side (from the extremes found) */
-        for (int c = 0; c < 3; c++)
-            size = fmax(size, p.bbox_max[c] - p.bbox_min[c]);
+        const double size = cbrt(p.volume) + 1.0;
         for (int e = 0; e < Q_N; e++)
             scale[e] = p.volume * (e == Q_VOL || e == Q_SIGNED ? 1.0 : e < Q_M2 ? size : size * size);
         for (int e = 0; e < Q_N; e++) {
@@ -1440,6 +1440,133 @@ static void face_rows_should_match_the_reference_and_the_whole_face_on_folding_s
     }
 }
 
+/* ---- solids beyond a double ---- */
+
+static int count_polls(void *arg)
+{
+    ++*(long *)arg;
+    return 0;
+}
+
+static pde_solution *fig4a_with_p0(const char *p0)
+{
+    char doc[128];
+    snprintf(doc, sizeof doc, "{\"preset\":\"fig4a\",\"params\":{\"p0\":%s}}", p0);
+    api_error err;
+    api_model *m = api_model_parse(doc, strlen(doc), &err);
+    assert_non_null(m);
+    pde_solution *sol = NULL;
+    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
+    api_model_free(m);
+    return sol;
+}
+
+/* fig. 4a with p0 = 1e300 has x ~ 1e296 and det J beyond a double (NaN from its partials' products): its
+ * properties took a second of branch and bound and quadrature, 60701 polls of the caller's stop(), to end as
+ * inf; 1e100 (inertia ~ 1e384) 48 polls. The sample alone decides, before any of that. */
+static void props_of_a_solid_beyond_a_double_should_be_refused_after_its_sample(void **state)
+{
+    (void)state;
+    static const char *const p0[] = { "1e300", "3e299", "1e200", "1e150", "1e100" };
+    for (size_t i = 0; i < sizeof p0 / sizeof *p0; i++) {
+        pde_solution *sol = fig4a_with_p0(p0[i]);
+        long polls = 0;
+        const pde_cancel cancel = { count_polls, &polls };
+        const pde_props_opts opts = { .cancel = &cancel };
+        pde_props p;
+        assert_int_equal(pde_properties(sol, &opts, &p), PDE_ERR_RANGE);
+        if (polls > 2)
+            fail_msg("p0 = %s: %ld polls before the refusal", p0[i], polls);
+        pde_solution_free(sol);
+    }
+}
+
+/* The skin's refinement compared NaN estimates with <=, which never stops it: fig. 4a with p0 = 1e300 took
+ * quad_area 4.2 M points, 60139 polls, to its work's bound (its size as pde_properties gives it: the
+ * sample's largest extent). */
+static void area_of_a_solid_beyond_a_double_should_stop_at_its_first_panels(void **state)
+{
+    (void)state;
+    pde_solution *sol = fig4a_with_p0("1e300");
+    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY }, size = 0.0;
+    for (int k = 0; k < 125; k++) {
+        double x[3];
+        pde_eval(sol, k % 5 / 4.0, k / 5 % 5 / 4.0, k / 25 / 4.0, x);
+        for (int c = 0; c < 3; c++)
+            lo[c] = fmin(lo[c], x[c]), hi[c] = fmax(hi[c], x[c]), size = fmax(size, hi[c] - lo[c]);
+    }
+    assert_true(size > 1e295 && isfinite(size));
+    long polls = 0;
+    const pde_cancel cancel = { count_polls, &polls };
+    double area;
+    quad_result q;
+    assert_int_equal(quad_area(sol, size, &cancel, &area, &q), PDE_OK);
+    assert_false(isfinite(area));
+    if (polls > 1000 || q.evals > 100000)
+        fail_msg("%ld polls, %zu points", polls, q.evals);
+    pde_solution_free(sol);
+}
+
+/* fig. 1a with every coordinate times s: its volume s^3 times, its inertia s^5 times, up to a factor below
+ * the limit of a double (where the refusal must not reach), and down to 1e-60 (inertia 1e-300); 30 times
+ * past the limit the integrals are refused. */
+static void props_of_a_scaled_solid_should_scale_up_to_the_limit_of_a_double(void **state)
+{
+    (void)state;
+    size_t fig = 0;
+    while (strcmp(paper_figure_name(fig), "fig1a"))
+        fig++;
+    pde_model m;
+    pde_solution *sol = figure(fig, &m);
+    pde_props p0;
+    assert_int_equal(pde_properties(sol, NULL, &p0), PDE_OK);
+    pde_solution_free(sol);
+    double imax = 0.0;
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            imax = fmax(imax, fabs(p0.inertia[i][k]));
+    const double near = exp(0.2 * (log(DBL_MAX) - log(4.0 * imax))), scales[] = { 1e-60, 1e50, near, 30.0 * near };
+    for (size_t k = 0; k < sizeof scales / sizeof *scales; k++) {
+        const double s = scales[k];
+        pde_bterm b[3][64];
+        pde_fterm f[3][64];
+        pde_model ms = m;
+        for (int c = 0; c < 3; c++) {   /* the data and the forces times s: x times s */
+            const size_t nb = m.comp[c].nbterms, nf = m.comp[c].nfterms;
+            assert_true(nb <= 64 && nf <= 64);
+            if (nb)
+                memcpy(b[c], m.comp[c].bterms, nb * sizeof b[c][0]);
+            if (nf)   /* a NULL list of none: no memcpy of it */
+                memcpy(f[c], m.comp[c].fterms, nf * sizeof f[c][0]);
+            for (pde_bterm *t = b[c]; t < b[c] + nb; t++)
+                t->w0 *= s, t->dw0 *= s, t->w1 *= s, t->dw1 *= s;
+            for (pde_fterm *t = f[c]; t < f[c] + nf; t++)
+                t->coef *= s;
+            ms.comp[c].bterms = b[c], ms.comp[c].fterms = f[c];
+        }
+        pde_diag d;
+        if (pde_solve(&ms, &sol, &d) != PDE_OK)
+            fail_msg("scale %.3g: %s", s, d.message);
+        pde_props p;
+        const pde_status st = pde_properties(sol, NULL, &p);
+        pde_solution_free(sol);
+        if (k == 3) {
+            assert_int_equal(st, PDE_ERR_RANGE);
+            continue;
+        }
+        if (st != PDE_OK)
+            fail_msg("scale %.3g: %s", s, pde_strerror(st));
+        /* s^5 alone may overflow where the inertia does not: x s s s s s */
+        assert_rel(p.volume, p0.volume * s * s * s, 1e-12, 0);
+        for (int i = 0; i < 3; i++) {
+            assert_rel(p.centroid[i], s * p0.centroid[i], 1e-12, s);
+            for (int j = 0; j < 3; j++)
+                assert_rel(p.inertia[i][j], p0.inertia[i][j] * s * s * s * s * s, 1e-12, imax * s * s * s * s * s);
+        }
+        assert_rel(p.surface_area, s * s * p0.surface_area, 1e-12, 0);
+    }
+}
+
 /*
  * core/quad.c's face_period on a face turned about an axis: the skin of fig. 3a (x + i y turned by
  * 2 pi / 9 as v -> v + 1/9, mirrored by v -> 1/9 - v) and of its template at n_xy = 10, r1 = 0.3
@@ -1569,6 +1696,9 @@ int main(void)
         cmocka_unit_test(det_j_gap_should_close_to_1e_9_of_its_scale_on_every_paper_figure),
         cmocka_unit_test(poly_bounds_should_match_the_closed_form_and_contain_a_dense_sampling_of_figure_1),
         cmocka_unit_test(face_rows_should_match_the_reference_and_the_whole_face_on_folding_separable_solids),
+        cmocka_unit_test(props_of_a_solid_beyond_a_double_should_be_refused_after_its_sample),
+        cmocka_unit_test(area_of_a_solid_beyond_a_double_should_stop_at_its_first_panels),
+        cmocka_unit_test(props_of_a_scaled_solid_should_scale_up_to_the_limit_of_a_double),
         cmocka_unit_test(area_over_one_period_should_match_the_whole_face_and_the_reference_on_solids_turned_about_z),
         cmocka_unit_test(det_j_bounds_over_one_period_should_hold_the_whole_face_on_solids_turned_about_z),
     };

@@ -695,7 +695,7 @@ static void bad_requests_should_get_problems_and_the_daemon_should_keep_serving(
     r = post(&d, "/solve", "{\"preset\":\"fig4a\",\"params\":{\"c\":[-1,-1,0]}}");
     expect_problem(&r, 422, "/params/c/2", "not fourth order");
     free(r.body);
-    r = post(&d, "/solve?res=100000", "{\"preset\":\"fig4a\"}");
+    r = post(&d, "/solve?format=grid&res=100000", "{\"preset\":\"fig4a\"}");   /* json takes any res */
     expect_problem(&r, 422, NULL, "limit of 4096");
     free(r.body);
     r = post(&d, "/solve?format=dae", "{\"preset\":\"fig4a\"}");
@@ -985,6 +985,32 @@ static void formats_should_list_the_table_and_each_row_should_hold(void **state)
         free(s.body);
     }
     cJSON_Delete(j);
+    free(r.body);
+    stop(&d);
+}
+
+/* An unknown query parameter names the route as a client writes it (it read "/presets/{} takes none": QA), and an
+ * empty item is nothing asked wherever it stands ("?format=f32&" was taken, "?&format=f32" refused). */
+static void query_messages_should_name_the_route_and_empty_items_be_skipped(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    reply r = http(&d, "GET", "/presets/fig4a?x", NULL, 0, NULL);
+    expect_problem(&r, 400, NULL, "unknown query parameter \"x\"; /presets/{name} takes none");
+    free(r.body);
+    r = http(&d, "GET", "/solids/0123456789abcdef0123456789abcdef?y=1", NULL, 0, NULL);
+    expect_problem(&r, 400, NULL, "/solids/{id} takes format, res, compress");
+    free(r.body);
+    static const char *const ok[] = { "/solve?&format=f32&res=2", "/solve?format=f32&res=2&", "/solve?format=f32&&res=2" };
+    for (size_t i = 0; i < sizeof ok / sizeof *ok; i++) {
+        r = post(&d, ok[i], "{\"preset\":\"fig1a\"}");
+        if (r.status != 200)
+            fail_msg("%s: %ld %s", ok[i], r.status, r.body);
+        free(r.body);
+    }
+    r = post(&d, "/solve?=glb", "{\"preset\":\"fig1a\"}");   /* a value without its name is still refused */
+    expect_problem(&r, 400, NULL, "unknown query parameter \"\"");
     free(r.body);
     stop(&d);
 }
@@ -1293,6 +1319,7 @@ int main(void)
         cmocka_unit_test(presets_version_health_metrics_and_cors_should_answer),
         cmocka_unit_test(formats_should_list_the_table_and_each_row_should_hold),
         cmocka_unit_test(compress_should_be_checked_like_every_query_parameter),
+        cmocka_unit_test(query_messages_should_name_the_route_and_empty_items_be_skipped),
         cmocka_unit_test(a_daemon_should_not_outlive_the_test_that_started_it),
     };
     test_filter_from_env();

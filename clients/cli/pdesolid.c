@@ -204,6 +204,12 @@ static char *request_text(const options *o, size_t *len)
             return NULL;
         }
         char *name = strndup(o->params[i], (size_t)(eq - o->params[i]));
+        if (name && cJSON_GetObjectItemCaseSensitive(params, name)) {
+            fprintf(stderr, "pdesolid: --param %s is given twice; give it once\n", name);
+            free(name);
+            cJSON_Delete(req);
+            return NULL;
+        }
         cJSON *v = name ? param_value(name, eq + 1) : NULL;
         if (!v || !cJSON_AddItemToObject(params, name, v)) {
             cJSON_Delete(v);
@@ -471,10 +477,12 @@ static int cmd_solve(const options *oo)
         return rc;
     }
     pde_props props;
-    pde_status st = pde_properties(sol, NULL, &props);
-    if (st != PDE_OK) {
-        fprintf(stderr, "pdesolid: properties: %s\n", pde_strerror(st));
+    api_error err;
+    if (api_properties(sol, NULL, &props, &err) != PDE_OK) {
         pde_solution_free(sol);
+        if (err.status == API_ERR_DOCUMENT)   /* too large: as --format json and --server say it, exit 2 */
+            return report("properties", &err);
+        fprintf(stderr, "pdesolid: %s\n", err.message);
         return 1;
     }
     printf("solid %s\n", id);
