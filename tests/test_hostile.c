@@ -1326,15 +1326,23 @@ static void a_solid_beyond_a_double_should_be_refused_422_without_its_properties
      * the cached solid, so a repeat (and a glb, which computed them again after their NULL) costs nothing. */
     static const char near[] = "{\"preset\":\"fig4a\",\"params\":{\"p0\":1e85}}";
     static const char *const again[] = { "/solve", "/solve?format=vts&res=4" };
+    double first = 0.0;   /* the first request's properties, ms: the work (3 ms optimised, more sanitised) */
     for (int k = 0; k < 3; k++) {
         r = post(&d, k ? again[k - 1] : "/solve", near);
         expect_problem(&r, 422, ANY_POINTER, "too large");
         if (!raw_header(&r, "Server-Timing", st, sizeof st))
             fail_msg("no Server-Timing");
-        if (!k == !!strstr(st, "props;dur=0.000"))
-            fail_msg("request %d of a solid whose properties fail: %s", k, st);
+        const char *pd = strstr(st, "props;dur="), *od = strstr(st, "output;dur=");
+        assert_true(pd && od);
+        const double props = strtod(pd + strlen("props;dur="), NULL), output = strtod(od + strlen("output;dur="), NULL);
         raw_reply_free(&r);
+        if (!k)
+            first = props;
+        else if (!(props + output < first / 20))   /* a repeat ran them again, in props or in the output */
+            fail_msg("request %d of a solid whose properties fail: props %g ms, output %g ms, the first's %g ms", k,
+                     props, output, first);
     }
+    assert_true(first > 0.0);
     stop(&d);
 }
 
