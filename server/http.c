@@ -206,10 +206,17 @@ static int admit(srv_req *r, const char *method)
                                    : "the request has more than one Transfer-Encoding header");
         return 1;
     }
+    /* An absolute-form target's authority stands for Host (RFC 9112 3.2.2; begin() kept it). */
+    if (!r->host)
+        r->host = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
     /* libmicrohttpd's strict mode refuses these with an HTML page; pdesolidd refuses them with a problem. */
-    if (h.bad || (h.hosts != 1 && !strcmp(r->version, MHD_HTTP_VERSION_1_1))) {
+    if (h.bad || (h.hosts != 1 && !strcmp(r->version, MHD_HTTP_VERSION_1_1)) || (r->host && !*r->host)) {
         r->close = r->decided = 1;
-        srv_problem(r, 400, NULL, "%s", h.bad ? h.bad : "an HTTP/1.1 request needs exactly one Host header");
+        srv_problem(r, 400, NULL, "%s",
+                    h.bad                                                     ? h.bad
+                    : r->host == r->target_host                                ? "the request target's host is empty"
+                    : h.hosts != 1 && !strcmp(r->version, MHD_HTTP_VERSION_1_1) ? "an HTTP/1.1 request needs exactly one Host header"
+                                                                               : "the Host header is empty; it names the server the request is for (RFC 9110 7.2)");
         return 1;
     }
     const union MHD_ConnectionInfo *ci = MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
@@ -244,7 +251,7 @@ static int admit(srv_req *r, const char *method)
         return 0;
     }
     /* Before the route, so that a rebound name learns nothing, not even which paths exist (host.h). */
-    const char *host = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
+    const char *host = r->host;
     if (!srv_host_allowed(s->cfg.allow_host, host)) {
         r->decided = 1;
         int name = (int)srv_host_name(host);
@@ -320,6 +327,15 @@ static srv_req *begin(srv_server *s, struct MHD_Connection *conn, const char *ur
     r->phase = SRV_BODY;
     copy(r->method, sizeof r->method, method);
     copy(r->version, sizeof r->version, version);
+    /* RFC 9112 3.2.2: a target in absolute form is routed by its path, and its authority stands for Host. Any
+     * other scheme stays a path, which no route has. */
+    size_t k = !strncasecmp(url, "http://", 7) ? 7 : !strncasecmp(url, "https://", 8) ? 8 : 0;
+    if (k) {
+        size_t n = strcspn(url + k, "/");
+        snprintf(r->target_host, sizeof r->target_host, "%.*s", (int)n, url + k);
+        r->host = r->target_host;
+        url = url[k + n] ? url + k + n : "/";
+    }
     copy(r->path, sizeof r->path, url);
     r->query[0] = '\0';
     atomic_fetch_add(&s->in_flight, 1);

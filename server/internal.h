@@ -83,6 +83,8 @@ typedef struct srv_req {
     char id[API_ID_LEN + 1];
     char etag[96];
     char allow[64];              /* for 405 */
+    const char *host;            /* what stands for Host: the header, or an absolute-form target's authority */
+    char target_host[128];       /* that authority (http://HOST/path), where the target had one */
     int retry_after;
     long long sent;
     char *key;                   /* the response cache's key of this request, or NULL */

@@ -130,7 +130,7 @@ int srv_origin_allowed(srv_req *r)
         return 1;
     /* The same origin: the page this daemon (or the proxy in front) served. Browsers send Origin
      * on same-origin POSTs too, so compare its host with the Host the request was sent to. */
-    const char *host = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
+    const char *host = r->host;
     const char *sep = strstr(origin, "://");
     return host && sep && !strcasecmp(sep + 3, host);
 }

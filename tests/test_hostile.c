@@ -1236,7 +1236,7 @@ static void a_host_name_not_allowed_should_get_403_naming_the_header_the_value_a
     /* Other spellings of names, and names that only start or end like an allowed one. */
     static const char *const refused[] = {
         "EVIL.Example.",  "x",        "localhost:80x", "127.0.0.1:80:80", "localhost.evil.example", "evillocalhost",
-        "localhost.example", "127.0.0.1.evil.example", "[evil.example]", "[::1", "[::1]x", "::1", "",
+        "localhost.example", "127.0.0.1.evil.example", "[evil.example]", "[::1", "[::1]x", "::1",
         "a..localhost", ".localhost", "evil.example/.localhost",
     };
     expect_hosts(&d, refused, sizeof refused / sizeof *refused, 403);
@@ -1282,6 +1282,48 @@ static void allow_host_should_allow_the_names_listed_and_subdomains_of_a_leading
     start(&d, "--allow-host '*'");
     static const char *const any[] = { "evil.example:8080", "x", "EVIL.example.", "[evil.example]" };
     expect_hosts(&d, any, sizeof any / sizeof *any, 200);
+    stop(&d);
+}
+
+/* An empty Host names no server: a malformed request (RFC 9110 7.2 asks for the authority of an http URI), 400,
+ * not the 403 of a name not allowed. */
+static void an_empty_host_header_should_get_400_naming_it(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    static const char *const empty[] = { "", " " };
+    for (size_t i = 0; i < sizeof empty / sizeof *empty; i++) {
+        raw_reply r = ask_host(&d, empty[i], "GET", "/livez", NULL, NULL, 0, 5000);
+        expect_problem(&r, 400, NULL, "Host header is empty");
+        raw_reply_free(&r);
+    }
+    expect_livez(&d);
+    stop(&d);
+}
+
+/* RFC 9112 3.2.2: a server must accept a target in absolute form (http://host/path), and take its host from the
+ * target, not from the Host header: the path is routed as in origin form, and the rebinding check applies to the
+ * target's host. */
+static void an_absolute_form_target_should_be_routed_and_its_host_checked(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    char target[128];
+    snprintf(target, sizeof target, "http://127.0.0.1:%d/livez", d.port);
+    assert_int_equal(status_as(&d, "localhost", target), 200);
+    assert_int_equal(status_as(&d, "localhost", "HTTPS://localhost/presets"), 200);
+    assert_int_equal(status_as(&d, "localhost", "http://localhost"), 200);   /* the front-end's page */
+    assert_int_equal(status_as(&d, "localhost", "http://localhost/nowhere"), 404);
+    /* The target's host decides, whatever Host says. */
+    snprintf(target, sizeof target, "http://evil.example:%d/livez", d.port);
+    raw_reply r = ask_host(&d, "localhost", "GET", target, NULL, NULL, 0, 5000);
+    expect_problem(&r, 403, NULL, "evil.example");
+    raw_reply_free(&r);
+    assert_int_equal(status_as(&d, "evil.example", "http://localhost/livez"), 200);
+    /* Not a URI of this server's schemes: a path like any other. */
+    assert_int_equal(status_as(&d, "localhost", "ftp://localhost/livez"), 404);
     stop(&d);
 }
 
@@ -1374,7 +1416,9 @@ int main(void)
         T(request_ids_should_be_echoed_when_sane_and_replaced_otherwise),
         T(server_timing_should_add_up_to_most_of_the_wall_time_of_a_new_solve),
         T(a_post_from_a_disallowed_origin_should_get_403_and_solve_nothing),
-        T(the_openapi_document_should_be_served),
+        T(an_empty_host_header_should_get_400_naming_it),
+    T(an_absolute_form_target_should_be_routed_and_its_host_checked),
+    T(the_openapi_document_should_be_served),
         T(a_host_name_not_allowed_should_get_403_naming_the_header_the_value_and_the_flag),
         T(ip_literals_and_localhost_should_be_allowed_by_default),
         T(allow_host_should_allow_the_names_listed_and_subdomains_of_a_leading_dot),
