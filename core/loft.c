@@ -28,6 +28,7 @@
 #include "internal.h"
 
 #define LOFT_COND_LIMIT 1e12    /* as solve.c's COND_LIMIT */
+#define LOFT_RESIDUAL_LIMIT 1e-6   /* a solution's section conditions, relative (check_sections_met) */
 #define KL 5                    /* sub-diagonals of the slab system */
 #define KU 10                   /* super-diagonals of its U factor, with the row swaps */
 #define BW (KL + KU + 1)
@@ -321,6 +322,14 @@ static pde_status fail_section(pde_diag *d, pde_status st, int comp, long term, 
     return st;
 }
 
+/* w as given, in the fewest digits that read back as it (0.9999999999999999 is not "1"). */
+static void w_text(char *buf, size_t n, double w)
+{
+    snprintf(buf, n, "%.15g", w);
+    if (strtod(buf, NULL) != w)
+        snprintf(buf, n, "%.17g", w);
+}
+
 static pde_status validate(const pde_loft *lf, pde_diag *diag)
 {
     char msg[200];
@@ -343,7 +352,9 @@ static pde_status validate(const pde_loft *lf, pde_diag *diag)
                           : k > 0 && !(w > lf->sections[k - 1].w)   ? "must be larger than the previous section's"
                                                                     : NULL;
         if (why) {
-            snprintf(msg, sizeof msg, "section %zu: w = %g %s", k, w, why);
+            char wt[32];
+            w_text(wt, sizeof wt, w);
+            snprintf(msg, sizeof msg, "section %zu: w = %s %s", k, wt, why);
             return fail_section(diag, PDE_ERR_INVALID, -1, -1, (int)k, "w", msg);
         }
     }
@@ -645,6 +656,8 @@ static pde_status solve_component(arena *mem, arena *scratch, plan_list *plans, 
     return PDE_OK;
 }
 
+static pde_status check_sections_met(const pde_solution *sol, const pde_loft *lf, pde_diag *diag);
+
 pde_status pde_solve_loft(const pde_loft *loft, const pde_solve_opts *opts, pde_solution **out,
                           pde_diag *diag)
 {
@@ -680,6 +693,8 @@ pde_status pde_solve_loft(const pde_loft *loft, const pde_solve_opts *opts, pde_
         plan_free(&plans.p[i]);
     free(plans.p);
     arena_free(&scratch);
+    if (st == PDE_OK)
+        st = check_sections_met(sol, loft, diag);
     if (st != PDE_OK)
         return pde_solve_abandon(&mem, st, diag);
     if (sol->cond_comp < 0)
@@ -711,12 +726,11 @@ double pde_solution_condition(const pde_solution *sol, int *comp, size_t *mode)
  * add up (each times the largest |f_u f_v| on the unit square), relative to the larger of the data's
  * scale (the same sum over the data) and the size of the derivative being matched.
  */
-double loft_bc_residual(const pde_solution *sol)
+static double bc_worst(const pde_solution *sol, int *worst_comp, size_t *worst_section)
 {
-    if (!sol || !sol->nsections)
-        return 0.0;
     const size_t K = sol->nsections;
     double worst = 0.0;
+    *worst_comp = -1, *worst_section = 0;
     for (int ci = 0; ci < 3; ci++) {
         const comp_solution *cs = &sol->comp[ci];
         double scale = 0.0;
@@ -769,10 +783,45 @@ double loft_bc_residual(const pde_solution *sol)
             }
             for (int o = 0; o < 5; o++) {
                 double ref = fmax(scale, size[o]);
-                if (ref > 0.0)
-                    worst = fmax(worst, err[o] / ref);
+                if (ref > 0.0 && !(err[o] / ref <= worst))   /* NaN counts as the worst */
+                    worst = err[o] / ref, *worst_comp = ci, *worst_section = k;
             }
         }
     }
     return worst;
+}
+
+double loft_bc_residual(const pde_solution *sol)
+{
+    if (!sol || !sol->nsections)
+        return 0.0;
+    int c;
+    size_t k;
+    return bc_worst(sol, &c, &k);
+}
+
+/*
+ * A solution that misses its own sections (loft_bc_residual) beyond LOFT_RESIDUAL_LIMIT: refused, naming
+ * the worst section and its nearer neighbour. A slab thin for the difference of its sections swells as
+ * (difference) / width^2 or more, and its closed form then cancels that many digits: sections 1e-9 apart
+ * that differ by 0.2 have a condition of 1.8e10, under LOFT_COND_LIMIT, but missed their data by 450% of
+ * the solid's size.
+ */
+static pde_status check_sections_met(const pde_solution *sol, const pde_loft *lf, pde_diag *diag)
+{
+    int c;
+    size_t k;
+    const double r = bc_worst(sol, &c, &k);
+    if (r <= LOFT_RESIDUAL_LIMIT)
+        return PDE_OK;
+    const size_t K = lf->nsections;
+    size_t j = k == 0 ? 1 : k == K - 1 ? K - 2 : lf->sections[k + 1].w - lf->sections[k].w < lf->sections[k].w - lf->sections[k - 1].w ? k + 1 : k - 1;
+    char wk[32], wj[32], msg[400];
+    w_text(wk, sizeof wk, lf->sections[k].w);
+    w_text(wj, sizeof wj, lf->sections[j].w);
+    snprintf(msg, sizeof msg,
+             "section %zu (w = %s): the solution misses it by %.2g of the solid's size (%s; limit %g): section "
+             "%zu (w = %s) is %.3g apart, too close for their difference; move them apart or make them alike",
+             k, wk, r, pde_comp_name[c < 0 ? 0 : c], LOFT_RESIDUAL_LIMIT, j, wj, fabs(lf->sections[j].w - lf->sections[k].w));
+    return fail_section(diag, PDE_ERR_SINGULAR, c, -1, (int)k, "w", msg);
 }

@@ -387,6 +387,45 @@ static void a_singular_slab_is_refused_naming_the_slab_and_the_mode(void **state
     assert_non_null(strstr(d.message, "cos"));
 }
 
+/* Two sections 1e-9 apart that differ by 0.2 (QA): the slab between them has a condition of 1.8e10, below
+ * the refusal's, but the solution missed its own sections by 450% of the solid's size (residuals.boundary 4.5)
+ * and was served. It is refused, naming a section beside the thin slab and how far apart the two are; at 1e-5
+ * apart the same loft meets its sections to 1.2e-7 (a swollen solid, as the data asks for) and is solved. */
+static void sections_too_close_for_their_difference_are_refused_naming_them(void **state)
+{
+    (void)state;
+    const int tan[4] = { 0, 0, 0, 0 };
+    const double gaps[2] = { 1e-9, 1e-5 };
+    for (int i = 0; i < 2; i++) {
+        const double w[4] = { 0, 0.5, 0.5 + gaps[i], 1 };
+        lf_t l;
+        lf_init(&l, 4, w, tan);
+        for (int c = 0; c < 3; c++)
+            l.abc[c][2] = 4.0;
+        lf_add(&l, 0, F_pow(1), F_cos(2));
+        lf_add(&l, 1, F_pow(1), F_sin(2));
+        lf_add(&l, 2, F_pow(0), F_pow(0));
+        for (int c = 0; c < 3; c++)
+            for (size_t k = 0; k < 4; k++)
+                l.x[c][0][k] = c == 2 ? 3.0 * w[k] : k == 2 ? 1.2 : 1.0;
+        pde_solution *sol = NULL;
+        pde_diag d;
+        pde_status st = pde_solve_loft(lf_loft(&l), NULL, &sol, &d);
+        if (i == 1) {
+            assert_int_equal(st, PDE_OK);
+            assert_true(loft_bc_residual(sol) < 1e-6);
+            pde_solution_free(sol);
+            continue;
+        }
+        if (st != PDE_ERR_SINGULAR)
+            fail_msg("status %s (%s), expected a refusal", pde_strerror(st), st == PDE_OK ? "solved" : d.message);
+        assert_null(sol);
+        assert_true(d.section == 1 || d.section == 2);
+        if (!strstr(d.message, "0.500000001") || !strstr(d.message, "1e-09 apart"))
+            fail_msg("the message does not name the sections and their distance: %s", d.message);
+    }
+}
+
 typedef struct {
     const char *what;
     pde_status st;
@@ -551,6 +590,7 @@ int main(void)
         cmocka_unit_test(the_boundary_residual_of_a_loft_is_small_and_zero_for_a_model),
         cmocka_unit_test(a_near_resonant_loft_is_solved_and_its_condition_reported),
         cmocka_unit_test(a_singular_slab_is_refused_naming_the_slab_and_the_mode),
+        cmocka_unit_test(sections_too_close_for_their_difference_are_refused_naming_them),
         cmocka_unit_test(every_bad_loft_is_refused_with_its_diag),
         cmocka_unit_test(a_cancelled_loft_solve_returns_cancelled),
         cmocka_unit_test(sampling_and_bounds_use_the_slab_of_w),
