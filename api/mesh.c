@@ -55,6 +55,7 @@
 #include <math.h>
 #include <stdatomic.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -746,6 +747,13 @@ static int mark_nan(float *nrm, uint32_t v, nan_acc *a)
     return 0;
 }
 
+void api_mesh_loop_message(int axis, char *buf, size_t n)
+{
+    const char t = "uvw"[axis];
+    snprintf(buf, n, "res: 3 samples along %c, where the solid closes into a loop (%c = 0 and %c = 1 meet), are 2 "
+             "points around it, and the mesh folds flat onto itself; take at least 4 along %c", t, t, t, t);
+}
+
 int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_mesh *out,
                    api_error *err)
 {
@@ -859,6 +867,13 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
         const size_t n = f0->na * f0->nb;
         seams[a] = join_near(up, p0, p1, (uint32_t)f0->base, (uint32_t)f1->base, n, epsf);
     }
+    char loop[200];
+    for (int a = 0; a < 3; a++)
+        if (res[a] == 3 && seams[a] == faces[2 * a].na * faces[2 * a].nb) {
+            api_mesh_loop_message(a, loop, sizeof loop);
+            why = loop, why_status = API_ERR_DOCUMENT;
+            goto done;
+        }
     /* Roots; a joined sample takes its root's position, so that every copy of a point is the same
      * bits (the root, the least sample, is settled before any other of its set). Almost every sample
      * is its own root and needs no store: 4 a step in SSE2 find the others. */

@@ -50,6 +50,10 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
                    api_error *err);
 /* Gives the mesh's block back for the next build; NULL or a zeroed mesh does nothing. */
 void api_mesh_free(api_mesh *m);
+
+/* Into buf: why res[axis] = 3 samples will not do along an axis that closes into a loop (its opposite faces
+ * meet throughout): 2 points around it, a mesh folded flat onto itself (api_mesh_build, api_volmesh_build). */
+void api_mesh_loop_message(int axis, char *buf, size_t n);
 /* Frees the blocks kept for the next build (at exit, or to hand memory back to the system). */
 void api_mesh_release_spares(void);
 

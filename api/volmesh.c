@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fmt.h"
+#include "mesh.h"
 #include "volmesh.h"
 
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
@@ -203,6 +204,12 @@ int api_volmesh_build(const pde_solution *s, const unsigned res[3], const pde_ca
                     face_axis_collapse(&g, d, sd, p, 1);
     for (int d = 0; d < 3; d++) {
         seamed[d] = seam(&g, d, 0);
+        if (seamed[d] && res[d] == 3) {
+            char loop[200];
+            api_mesh_loop_message(d, loop, sizeof loop);
+            api_fail(err, API_ERR_DOCUMENT, "", "%s", loop);
+            goto fail;
+        }
         if (seamed[d])
             seam(&g, d, 1);
     }

@@ -246,6 +246,25 @@ static void res_should_be_bounded(void **state)
     pde_solution_free(s);
 }
 
+/* 3 samples along v, which loops on fig. 4a, are 2 points around it: cells of no volume (QA). Refused,
+ * naming v and 4. */
+static void three_samples_around_a_loop_should_be_refused_naming_the_axis(void **state)
+{
+    (void)state;
+    pde_solution *s = preset_solution("fig4a");
+    api_volmesh m;
+    api_error err;
+    unsigned three[3] = { 4, 3, 4 }, four[3] = { 3, 4, 3 };
+    assert_int_equal(api_volmesh_build(s, three, NULL, &m, &err), -1);
+    assert_int_equal(err.status, API_ERR_DOCUMENT);
+    if (!strstr(err.message, "along v") || !strstr(err.message, "at least 4"))
+        fail_msg("the message does not name v and 4: %s", err.message);
+    assert_int_equal(api_volmesh_build(s, four, NULL, &m, &err), 0);
+    assert_true(m.ncells > 0);
+    api_volmesh_free(&m);
+    pde_solution_free(s);
+}
+
 static int stop_now(void *arg)
 {
     (void)arg;
@@ -448,6 +467,7 @@ int main(void)
         cmocka_unit_test(fig4a_should_flag_the_cells_where_det_j_is_negative),
         cmocka_unit_test(fig4a_should_have_no_two_points_in_one_place),
         cmocka_unit_test(res_should_be_bounded),
+        cmocka_unit_test(three_samples_around_a_loop_should_be_refused_naming_the_axis),
         cmocka_unit_test(a_cancelled_build_should_say_so),
         cmocka_unit_test(a_solid_with_no_volume_should_get_no_mesh_and_say_why),
         cmocka_unit_test(files_should_read_back_in_meshio),
