@@ -576,6 +576,199 @@ static pde_status single_mode_extremes(const pde_solution *s, int c, double tol,
     return PDE_OK;
 }
 
+/*
+ * A component whose modes all share the factor t^n (n >= 0) along one of u, v (axis a) and have sin
+ * or cos of one frequency k >= 2 along the other (b): x_c = t_a^n (alpha(w) sin k pi t_b + beta(w)
+ * cos k pi t_b), alpha the sum of the sin modes' h, beta of the cos modes' (fig. 4's x and y, fig. 2's
+ * too). The harmonic runs a whole period over [0, 1], so at fixed (t_a, w) it spans
+ * t_a^n [-R, R] exactly, R = sqrt(alpha^2 + beta^2), and x_c's extremes are -+ max_w R(w), at t_a = 1:
+ * a problem in w alone (docs/MATH.md, "Harmonic components").
+ */
+typedef struct {
+    int a, b;                 /* the axes of t^n and of the harmonic */
+    double k;
+    size_t nmodes;
+    const pde_mode *modes;
+} harmonic;
+
+static int harmonic_of(const pde_solution *s, int c, harmonic *hc)
+{
+    const comp_solution *cs = &s->comp[c];
+    if (cs->nmodes == 0)
+        return 0;
+    for (int a = 0; a < 2; a++) {
+        const pde_factor fa = a ? cs->modes[0].v : cs->modes[0].u, fb = a ? cs->modes[0].u : cs->modes[0].v;
+        int ok = fa.kind == PDE_POW && (fb.kind == PDE_SIN || fb.kind == PDE_COS) && fb.p >= 2.0;
+        for (size_t m = 1; m < cs->nmodes && ok; m++) {
+            const pde_factor ga = a ? cs->modes[m].v : cs->modes[m].u, gb = a ? cs->modes[m].u : cs->modes[m].v;
+            ok = ga.kind == PDE_POW && ga.p == fa.p && (gb.kind == PDE_SIN || gb.kind == PDE_COS) && gb.p == fb.p;
+        }
+        if (ok) {
+            *hc = (harmonic){ a, 1 - a, fb.p, cs->nmodes, cs->modes };
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static int harmonic_is_cos(const harmonic *hc, size_t m)
+{
+    return (hc->b ? hc->modes[m].v : hc->modes[m].u).kind == PDE_COS;
+}
+
+/* alpha, beta (ab[0], ab[1]) and their first two derivatives at w. */
+static void harmonic_jet(const harmonic *hc, double w, double ab[2][3])
+{
+    memset(ab, 0, 2 * sizeof ab[0]);
+    for (size_t m = 0; m < hc->nmodes; m++) {
+        double d[3];
+        mode_h_derivs(&hc->modes[m], w, 2, d);
+        double *o = ab[harmonic_is_cos(hc, m)];
+        o[0] += d[0], o[1] += d[1], o[2] += d[2];
+    }
+}
+
+/* alpha^2 + beta^2 at w, and alpha, beta. */
+static double harmonic_sq(const harmonic *hc, double w, double ab[2])
+{
+    ab[0] = ab[1] = 0.0;
+    for (size_t m = 0; m < hc->nmodes; m++) {
+        double h, dh;
+        mode_h(&hc->modes[m], w, &h, &dh);
+        ab[harmonic_is_cos(hc, m)] += h;
+    }
+    return ab[0] * ab[0] + ab[1] * ab[1];
+}
+
+typedef struct {
+    double key;   /* first: bb_heap's; minus the parent's bound of R^2 */
+    double w0, w1;
+} hbox;
+
+/*
+ * max_w R(w) by branch and bound over intervals of w, from start: *upper certified (for the exact
+ * closed form), *best = R(*wbest) attained, upper - best <= tol unless `budget` intervals ran out.
+ * Over [c - r, c + r], alpha = A(d) + e_a with A its Taylor quadratic at c and |e_a| <= T_a r^3 / 6
+ * (T_a bounds |alpha'''| there, from mode_h_bounds), likewise beta, so
+ *
+ *     R^2 <= A^2 + B^2 + 2 (max|A| e_a + max|B| e_b) + e_a^2 + e_b^2,
+ *
+ * and A^2 + B^2, a quartic in d, is at most its quadratic part's max over [-r, r] plus |q3| r^3 +
+ * q4 r^4: a bound within O(r^3) of the interval's max. The quadratic part's argmax is evaluated
+ * too, so that the value found converges as fast (the interval's centre alone: O(r^2)).
+ */
+static pde_status harmonic_max(const pde_solution *s, const harmonic *hc, double start, double tol, size_t budget,
+                               const pde_cancel *cancel, double *upper, double *best, double *wbest)
+{
+    double ab[2], cut = 0.0;   /* cut: the largest bound of R over the intervals dropped */
+    double bsq = harmonic_sq(hc, start, ab);
+    *wbest = start;
+    bb_heap h = { .size = sizeof(hbox) };
+    size_t nslabs, boxes = 0;
+    const double *br = solution_breaks(s, &nslabs);
+    pde_status st = PDE_OK;
+    for (size_t k = 0; k < nslabs && st == PDE_OK; k++) {   /* a Taylor model holds within one slab */
+        const hbox b = { -INFINITY, br[k], br[k + 1] };
+        if (bb_heap_push(&h, &b))
+            st = PDE_ERR_NOMEM;
+    }
+    while (st == PDE_OK && h.n) {
+        const double rb = sqrt(bsq);
+        if (sqrt(-bb_heap_min(&h)) <= rb + tol || boxes >= budget)
+            break;
+        if ((++boxes & 15) == 0 && pde_stopped(cancel)) {
+            st = PDE_ERR_CANCELLED;
+            break;
+        }
+        hbox top;
+        bb_heap_pop(&h, &top);
+        const double c = 0.5 * (top.w0 + top.w1), r = 0.5 * (top.w1 - top.w0);
+        double j[2][3], T[2] = { 0.0, 0.0 };
+        harmonic_jet(hc, c, j);
+        for (size_t m = 0; m < hc->nmodes; m++) {
+            double d[4];
+            mode_h_bounds(&hc->modes[m], top.w0, top.w1, 3, d);
+            T[harmonic_is_cos(hc, m)] += d[3];
+        }
+        const double c2 = j[0][0] * j[0][0] + j[1][0] * j[1][0];
+        if (c2 > bsq)
+            bsq = c2, *wbest = c;
+        /* A^2 + B^2 = q0 + q1 d + q2 d^2 + q3 d^3 + q4 d^4 */
+        const double q1 = 2.0 * (j[0][0] * j[0][1] + j[1][0] * j[1][1]);
+        const double q2 = j[0][1] * j[0][1] + j[1][1] * j[1][1] + j[0][0] * j[0][2] + j[1][0] * j[1][2];
+        const double q3 = j[0][1] * j[0][2] + j[1][1] * j[1][2];
+        const double q4 = 0.25 * (j[0][2] * j[0][2] + j[1][2] * j[1][2]);
+        /* the quadratic part's max over [-r, r]: at an end, or at its vertex when concave */
+        double dm = q1 >= 0.0 ? r : -r;
+        if (q2 < 0.0 && fabs(q1) < -2.0 * q2 * r)
+            dm = -q1 / (2.0 * q2);
+        const double qm = c2 + dm * (q1 + q2 * dm);
+        if (qm > bsq && dm != 0.0) {   /* where the model peaks: a better value there */
+            const double v2 = harmonic_sq(hc, c + dm, ab);
+            if (v2 > bsq)
+                bsq = v2, *wbest = c + dm;
+        }
+        const double r2 = r * r, r3 = r2 * r;
+        const double ea = T[0] * r3 / 6.0, eb = T[1] * r3 / 6.0;
+        const double Am = fabs(j[0][0]) + r * fabs(j[0][1]) + 0.5 * r2 * fabs(j[0][2]);
+        const double Bm = fabs(j[1][0]) + r * fabs(j[1][1]) + 0.5 * r2 * fabs(j[1][2]);
+        const double ub = qm + fabs(q3) * r3 + q4 * r2 * r2 + 2.0 * (Am * ea + Bm * eb) + ea * ea + eb * eb;
+        if (!(ub == ub)) {   /* NaN: no bound (the caller's general path) */
+            st = PDE_ERR_INVALID;
+            break;
+        }
+        if (sqrt(ub) <= sqrt(bsq) + tol || r <= DBL_EPSILON * fabs(c)) {
+            cut = fmax(cut, ub);
+            continue;
+        }
+        const hbox lo = { -ub, top.w0, c }, hi = { -ub, c, top.w1 };
+        if (bb_heap_push(&h, &lo) || bb_heap_push(&h, &hi))
+            st = PDE_ERR_NOMEM;
+    }
+    if (st == PDE_OK) {
+        double u2 = fmax(cut, bsq);
+        if (h.n)
+            u2 = fmax(u2, -bb_heap_min(&h));
+        *upper = sqrt(u2), *best = sqrt(bsq);
+    }
+    free(h.a);
+    return st;
+}
+
+/* The place of the min (e = 0) or max (1) of x_c at w, where alpha, beta are ab: t_a = 1, and the
+ * harmonic's phase k pi t_b = phi (max) or phi + pi (min), phi = atan2(alpha, beta), within [0, 2 pi). */
+static void harmonic_place(const harmonic *hc, double w, const double ab[2], int e, double at[3])
+{
+    double th = fmod(atan2(ab[0], ab[1]) + (e ? 2.0 : 3.0) * M_PI, 2.0 * M_PI);
+    at[hc->a] = 1.0, at[hc->b] = fmin(th / (hc->k * M_PI), 1.0), at[2] = w;
+}
+
+/*
+ * The extremes of such a component (bound, best, at: as single_mode_extremes'); PDE_ERR_INVALID where
+ * it is not one (or its bound is no number). start: a w to begin from.
+ */
+pde_status props_harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
+                                   const pde_cancel *cancel, double bound[2], double best[2], double at[2][3])
+{
+    harmonic hc;
+    if (!harmonic_of(s, c, &hc))
+        return PDE_ERR_INVALID;
+    double up, rb, w, ab[2];
+    pde_status st = harmonic_max(s, &hc, start, tol, budget, cancel, &up, &rb, &w);
+    if (st != PDE_OK)
+        return st;
+    harmonic_sq(&hc, w, ab);
+    for (int e = 0; e < 2; e++) {
+        double x[3];
+        harmonic_place(&hc, w, ab, e, at[e]);
+        pde_eval(s, at[e][0], at[e][1], at[e][2], x);
+        best[e] = x[c];
+    }
+    bound[0] = fmin(-up, best[0]), bound[1] = fmax(up, best[1]);
+    (void)rb;
+    return PDE_OK;
+}
+
 /* The solid's size and det J's from the extremes best (min x, max x, ..., min det J, max det J). */
 static void scales(const double best[8], double *size, double *jscale)
 {
@@ -819,10 +1012,15 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             if ((st = poly_minimise(&po->b[what], sign, what < 3 ? tol : 1e-2 * tol,
                                     what < 3 ? PDE_PROPS_BOXES : jbudget, &b)) != PDE_OK)
                 break;
-        } else if (what < 3 && s->comp[what].nmodes == 1 && !(o & 1)) {
-            /* Both extremes of a component of one mode at once. */
+        } else if (what < 3 && !(o & 1)) {
+            /* Both extremes of a harmonic component, or of one of one mode, at once. */
+            const double *lo = at[o], *hi = at[o + 1];
             double bd[2], bs[2], ba[2][3];
-            if ((st = single_mode_extremes(s, what, tol, cancel, bd, bs, ba)) == PDE_OK) {
+            st = props_harmonic_extremes(s, what, fabs(best[o]) > fabs(best[o + 1]) ? lo[2] : hi[2], tol,
+                                         PDE_PROPS_BOXES, cancel, bd, bs, ba);
+            if (st == PDE_ERR_INVALID && s->comp[what].nmodes == 1)
+                st = single_mode_extremes(s, what, tol, cancel, bd, bs, ba);
+            if (st == PDE_OK) {
                 single[what] = 1;
                 for (int k = 0; k < 2; k++) {
                     sb[what][k].lower = k ? -bd[1] : bd[0], sb[what][k].best = k ? -bs[1] : bs[0];
