@@ -467,6 +467,7 @@ typedef struct {
     double n, k;
     size_t nmodes;
     const pde_mode *modes;
+    double M4[2];             /* bounds of |alpha''''|, |beta''''| over [0, 1] (sums over the modes) */
 } harmonic;
 
 static int harmonic_of(const pde_solution *s, int c, harmonic *hc)
@@ -482,7 +483,12 @@ static int harmonic_of(const pde_solution *s, int c, harmonic *hc)
             ok = ga.kind == PDE_POW && ga.p == fa.p && (gb.kind == PDE_SIN || gb.kind == PDE_COS) && gb.p == fb.p;
         }
         if (ok) {
-            *hc = (harmonic){ a, 1 - a, fa.p, fb.p, cs->nmodes, cs->modes };
+            *hc = (harmonic){ a, 1 - a, fa.p, fb.p, cs->nmodes, cs->modes, { 0.0, 0.0 } };
+            for (size_t m = 0; m < cs->nmodes; m++) {
+                double d[5];
+                mode_h_bounds(&cs->modes[m], 0.0, 1.0, 4, d);
+                hc->M4[(a ? cs->modes[m].u : cs->modes[m].v).kind == PDE_COS] += d[4];
+            }
             return 1;
         }
     }
@@ -631,19 +637,23 @@ static pde_status line_minimise(const pde_solution *s, const line_fn *f, double 
     return st;
 }
 
-/* The models of alpha and beta about c over [w0, w1] (m[0], m[1]). */
+/*
+ * The models of alpha and beta about c over [w0, w1] (m[0], m[1]), their third derivatives bounded
+ * by |alpha'''(c)| + r M4 (r = max |w - c|): no bound of each mode over each interval, and near c as
+ * tight as the sum's own value (a mode's bound loses the cancellation between its terms).
+ */
 static void harmonic_models(const harmonic *hc, double w0, double w1, double c, tm1 m[2])
 {
-    double j[2][3] = { { 0, 0, 0 }, { 0, 0, 0 } }, T[2] = { 0, 0 };
+    const double r = fmax(c - w0, w1 - c);
+    double j[2][4] = { { 0, 0, 0, 0 }, { 0, 0, 0, 0 } };
     for (size_t k = 0; k < hc->nmodes; k++) {
         double d[4];
         const int i = harmonic_is_cos(hc, k);
-        mode_h_derivs(&hc->modes[k], c, 2, d);
-        j[i][0] += d[0], j[i][1] += d[1], j[i][2] += d[2];
-        mode_h_bounds(&hc->modes[k], w0, w1, 3, d);
-        T[i] += d[3];
+        mode_h_derivs(&hc->modes[k], c, 3, d);
+        j[i][0] += d[0], j[i][1] += d[1], j[i][2] += d[2], j[i][3] += d[3];
     }
-    m[0] = tm_jet(j[0], T[0]), m[1] = tm_jet(j[1], T[1]);
+    for (int i = 0; i < 2; i++)
+        m[i] = tm_jet(j[i], fabs(j[i][3]) + r * hc->M4[i]);
 }
 
 /* alpha and beta at w. */

@@ -1770,7 +1770,7 @@ static void harmonic_extremes_should_match_the_general_path_on_figures_2_and_4(v
  * Stress models of the harmonic case against the general path and a dense sampling: alpha and beta
  * peaking at opposite ends, one component of sin modes only and one of cos only, k = 4, sqrt(alpha^2
  * + beta^2) with several interior maxima of nearly equal height (a forced sin(7 pi w)), a negative
- * force, u and v swapped with t^2; and two solids outside the case (k = 1, half a period; two
+ * force, u and v swapped with t^2, boundary layers; and two solids outside the case (k = 1, half a period; two
  * frequencies), which must take the general path and keep their bounds.
  */
 static void harmonic_extremes_should_hold_a_dense_sampling_of_stress_models(void **state)
@@ -1783,36 +1783,43 @@ static void harmonic_extremes_should_hold_a_dense_sampling_of_stress_models(void
         pde_bterm x[2], y[2];
         pde_fterm fx, fy;
         int nharm;
+        double c;
     } models[] = {
         { "alpha, beta peak apart",
           { { F_pow(1), F_sin(2), 1.0, 0, 0.1, 0 }, { F_pow(1), F_cos(2), 0.1, 0, 1.2, 0 } },
-          { { F_pow(1), F_cos(2), 1.0, 0, 0.4, 0 }, nob }, none, none, 2 },
+          { { F_pow(1), F_cos(2), 1.0, 0, 0.4, 0 }, nob }, none, none, 2, -1 },
         { "sin only, cos only, k = 4",
           { { F_pow(1), F_sin(4), 0.5, 2, 0.5, -2 }, nob },
-          { { F_pow(1), F_cos(4), 0.2, 1, -0.3, 0 }, nob }, none, none, 2 },
+          { { F_pow(1), F_cos(4), 0.2, 1, -0.3, 0 }, nob }, none, none, 2, -1 },
         { "k = 4, both",
           { { F_pow(1), F_sin(4), 0.5, 2, 0.5, -2 }, { F_pow(1), F_cos(4), 0.2, 1, -0.3, 0 } },
-          { { F_pow(1), F_cos(4), 0.5, 0, 0.7, 1 }, { F_pow(1), F_sin(4), -0.2, 0, 0.1, 0 } }, none, none, 2 },
+          { { F_pow(1), F_cos(4), 0.5, 0, 0.7, 1 }, { F_pow(1), F_sin(4), -0.2, 0, 0.1, 0 } }, none, none, 2, -1 },
         { "humps of sin(7 pi w), negative p0",
           { { F_pow(1), F_sin(2), 0.5, 0, 0.5, 0 }, nob }, { { F_pow(1), F_cos(2), 0.5, 0, 0.5, 0 }, nob },
-          { -3e3, F_pow(1), F_cos(2), F_sin(7) }, { -3e3, F_pow(1), F_sin(2), F_sin(7) }, 2 },
+          { -3e3, F_pow(1), F_cos(2), F_sin(7) }, { -3e3, F_pow(1), F_sin(2), F_sin(7) }, 2, -1 },
         { "u, v swapped, v^2",
           { { F_sin(2), F_pow(2), 0.5, 1, 0.8, -1 }, { F_cos(2), F_pow(2), 0.3, 0, 0.1, 0 } },
-          { { F_cos(2), F_pow(2), 0.5, 1, 0.8, -1 }, { F_sin(2), F_pow(2), -0.3, 0, -0.1, 0 } }, none, none, 2 },
+          { { F_cos(2), F_pow(2), 0.5, 1, 0.8, -1 }, { F_sin(2), F_pow(2), -0.3, 0, -0.1, 0 } }, none, none, 2, -1 },
         { "k = 1: half a period",
           { { F_pow(1), F_sin(1), 0.5, 0, 0.5, 0 }, { F_pow(1), F_cos(1), 0.3, 0, -0.4, 0 } },
-          { { F_pow(1), F_cos(1), 0.5, 0, 0.5, 0 }, nob }, none, none, 0 },
+          { { F_pow(1), F_cos(1), 0.5, 0, 0.5, 0 }, nob }, none, none, 0, -1 },
         { "two frequencies",
           { { F_pow(1), F_sin(2), 0.5, 0, 0.5, 0 }, { F_pow(1), F_cos(4), 0.1, 0, 0.1, 0 } },
-          { { F_pow(1), F_cos(2), 0.5, 0, 0.5, 0 }, nob }, none, none, 1 },
+          { { F_pow(1), F_cos(2), 0.5, 0, 0.5, 0 }, nob }, none, none, 1, -1 },
+        /* c = -1e-3: layers of width about 0.03 at w = 0 and 1, R tiny in between, where a model
+         * about w = 0.5 sees almost nothing of them */
+        { "layers at w = 0 and 1",
+          { { F_pow(1), F_sin(2), 0.05, 0, 1.0, 0 }, { F_pow(1), F_cos(2), 0.02, 0, -0.5, 0 } },
+          { { F_pow(1), F_cos(2), 0.5, 0, 0.05, 0 }, nob }, none, none, 2, -1e-3 },
     };
     const pde_bterm bz = { F_pow(0), F_pow(0), 0, 1, 2, 3 };
     for (size_t k = 0; k < sizeof models / sizeof models[0]; k++) {
         const size_t nx = models[k].x[1].w0 || models[k].x[1].w1 || models[k].x[1].dw0 ? 2 : 1;
         const size_t ny = models[k].y[1].w0 || models[k].y[1].w1 || models[k].y[1].dw0 ? 2 : 1;
         const size_t fx = models[k].fx.coef != 0, fy = models[k].fy.coef != 0;
-        pde_model m = { { { 1, 1, -1, models[k].x, nx, &models[k].fx, fx },
-                          { 1, 1, -1, models[k].y, ny, &models[k].fy, fy },
+        const double c = models[k].c;
+        pde_model m = { { { 1, 1, c, models[k].x, nx, &models[k].fx, fx },
+                          { 1, 1, c, models[k].y, ny, &models[k].fy, fy },
                           { 1, 1, -1, &bz, 1, NULL, 0 } } };
         pde_solution *sol = NULL;
         pde_diag d;
