@@ -77,4 +77,14 @@ double bb_heap_min(const bb_heap *h);          /* the least key; h not empty */
 pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], const pbox *within,
                        double tol, size_t budget, const pde_cancel *cancel, bb_result *out);
 
+/*
+ * props.c's extremes of a harmonic component c, x_c = t^n (alpha(w) sin k pi s + beta(w) cos k pi s)
+ * with (t, s) = (u, v) or (v, u), k >= 2 (docs/MATH.md, "Harmonic components"): max_w sqrt(alpha^2 +
+ * beta^2) by a branch and bound over w from start, to tol, within budget intervals. bound: certified
+ * [min, max] of x_c (for the exact closed form); best, at: x_c's min and max found, and where.
+ * PDE_ERR_INVALID where c is no such component (pde_properties then takes its general path).
+ */
+pde_status props_harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
+                                   const pde_cancel *cancel, double bound[2], double best[2], double at[2][3]);
+
 #endif

@@ -455,6 +455,408 @@ static double integral_error(const quad_result *q, const quad_result *qa)
 }
 
 /*
+ * A component whose modes all share the factor t^n (n >= 0) along one of u, v (axis a) and have sin
+ * or cos of one frequency k >= 2 along the other (b): x_c = t_a^n (alpha(w) sin k pi t_b + beta(w)
+ * cos k pi t_b), alpha the sum of the sin modes' h, beta of the cos modes' (fig. 4's x and y, fig. 2's
+ * too). The harmonic runs a whole period over [0, 1], so at fixed (t_a, w) it spans
+ * t_a^n [-R, R] exactly, R = sqrt(alpha^2 + beta^2), and x_c's extremes are -+ max_w R(w), at t_a = 1:
+ * a problem in w alone (docs/MATH.md, "Harmonic components").
+ */
+typedef struct {
+    int a, b;                 /* the axes of t^n and of the harmonic */
+    double n, k;
+    size_t nmodes;
+    const pde_mode *modes;
+    double M4[2];             /* bounds of |alpha''''|, |beta''''| over [0, 1] (sums over the modes) */
+} harmonic;
+
+static int harmonic_of(const pde_solution *s, int c, harmonic *hc)
+{
+    const comp_solution *cs = &s->comp[c];
+    if (cs->nmodes == 0)
+        return 0;
+    for (int a = 0; a < 2; a++) {
+        const pde_factor fa = a ? cs->modes[0].v : cs->modes[0].u, fb = a ? cs->modes[0].u : cs->modes[0].v;
+        int ok = fa.kind == PDE_POW && (fb.kind == PDE_SIN || fb.kind == PDE_COS) && fb.p >= 2.0;
+        for (size_t m = 1; m < cs->nmodes && ok; m++) {
+            const pde_factor ga = a ? cs->modes[m].v : cs->modes[m].u, gb = a ? cs->modes[m].u : cs->modes[m].v;
+            ok = ga.kind == PDE_POW && ga.p == fa.p && (gb.kind == PDE_SIN || gb.kind == PDE_COS) && gb.p == fb.p;
+        }
+        if (ok) {
+            *hc = (harmonic){ a, 1 - a, fa.p, fb.p, cs->nmodes, cs->modes, { 0.0, 0.0 } };
+            for (size_t m = 0; m < cs->nmodes; m++) {
+                double d[5];
+                mode_h_bounds(&cs->modes[m], 0.0, 1.0, 4, d);
+                hc->M4[(a ? cs->modes[m].u : cs->modes[m].v).kind == PDE_COS] += d[4];
+            }
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static int harmonic_is_cos(const harmonic *hc, size_t m)
+{
+    return (hc->b ? hc->modes[m].v : hc->modes[m].u).kind == PDE_COS;
+}
+
+/*
+ * Taylor models along w about a point c: f(c + d) = p0 + p1 d + p2 d^2 + e(d), |e(d)| <= k |d|^3 for
+ * |d| <= r. From a function's value and first two derivatives at c and a bound T of |f'''| over the
+ * interval, k = T / 6 (Lagrange's rest). Sums and products keep the form (a product's terms of
+ * degree 3 and 4 and the rests' cross terms go to k), so a bound of a combination holds pointwise
+ * too: near c, where p1 is small, it is as tight as the quadratic, however wide the interval.
+ */
+typedef struct {
+    double p[3], k;
+} tm1;
+
+static tm1 tm_jet(const double d[3], double T)
+{
+    return (tm1){ { d[0], d[1], 0.5 * d[2] }, T / 6.0 };
+}
+
+/* max |p0 + p1 d + p2 d^2| over |d| <= r */
+static double tm_polymax(const tm1 *a, double r)
+{
+    return fabs(a->p[0]) + r * (fabs(a->p[1]) + r * fabs(a->p[2]));
+}
+
+static tm1 tm_add(tm1 a, const tm1 *b, double sb)
+{
+    for (int i = 0; i < 3; i++)
+        a.p[i] += sb * b->p[i];
+    a.k += b->k;
+    return a;
+}
+
+static tm1 tm_mul(const tm1 *a, const tm1 *b, double r)
+{
+    const double *x = a->p, *y = b->p;
+    const double c3 = x[1] * y[2] + x[2] * y[1], c4 = x[2] * y[2];
+    return (tm1){ { x[0] * y[0], x[0] * y[1] + x[1] * y[0], x[0] * y[2] + x[1] * y[1] + x[2] * y[0] },
+                  fabs(c3) + r * fabs(c4) + tm_polymax(a, r) * b->k + tm_polymax(b, r) * a->k + a->k * b->k * r * r * r };
+}
+
+/* min over [0, R] of q0 + q1 s + q2 s^2 - k s^3: at an end or where the derivative vanishes. */
+static double cubic_min(double q0, double q1, double q2, double k, double R)
+{
+    double m = fmin(q0, q0 + R * (q1 + R * (q2 - k * R))), s[2] = { -1.0, -1.0 };
+    const double disc = q2 * q2 + 3.0 * k * q1;
+    if (k > 0.0 && disc >= 0.0) {
+        const double t = q2 + copysign(sqrt(disc), q2);   /* the roots without cancellation */
+        if (t != 0.0)
+            s[0] = t / (3.0 * k), s[1] = -q1 / t;
+    } else if (k == 0.0 && q2 != 0.0)
+        s[0] = -q1 / (2.0 * q2);
+    for (int i = 0; i < 2; i++)
+        if (s[i] > 0.0 && s[i] < R)
+            m = fmin(m, q0 + s[i] * (q1 + s[i] * (q2 - k * s[i])));
+    return m;
+}
+
+/* A function of w alone to minimise: its Taylor model about c over [w0, w1] (w0 <= c <= w1), its value at w. */
+typedef struct {
+    void (*model)(const void *ctx, double w0, double w1, double c, tm1 *m);
+    double (*value)(const void *ctx, double w);
+    const void *ctx;
+} line_fn;
+
+typedef struct {
+    double key;   /* first: bb_heap's; the parent's lower bound */
+    double w0, w1;
+} lbox;
+
+/*
+ * min over [0, 1] of sign f by branch and bound over intervals of w (a loft's slabs first: a model
+ * holds within one), from start: *lower certified (for the exact closed form), *best = sign f(*wbest),
+ * best - lower <= tol / 2 (a margin for the caller's pad) unless `budget` intervals ran out. An
+ * interval's model is about the best point found when it holds it (else its centre), and its bound
+ * is the model's least value with the rest pointwise, so the interval holding the minimum closes as
+ * soon as the quadratic dominates the rest there, not when the rest falls below tol. The quadratic's
+ * own argmin is evaluated too: a Newton step, the best point converging as fast.
+ */
+static pde_status line_minimise(const pde_solution *s, const line_fn *f, double sign, double start, double tol,
+                                size_t budget, const pde_cancel *cancel, double *lower, double *best, double *wbest)
+{
+    double low = DBL_MAX, b = sign * f->value(f->ctx, start);   /* low: over the intervals dropped */
+    *wbest = start;
+    bb_heap h = { .size = sizeof(lbox) };
+    size_t nslabs, boxes = 0;
+    const double *br = solution_breaks(s, &nslabs);
+    pde_status st = PDE_OK;
+    for (size_t k = 0; k < nslabs && st == PDE_OK; k++) {
+        const lbox l = { -INFINITY, br[k], br[k + 1] };
+        if (bb_heap_push(&h, &l))
+            st = PDE_ERR_NOMEM;
+    }
+    tol *= 0.5;
+    while (st == PDE_OK && h.n && bb_heap_min(&h) < b - tol && boxes < budget) {
+        if ((++boxes & 15) == 0 && pde_stopped(cancel)) {
+            st = PDE_ERR_CANCELLED;
+            break;
+        }
+        lbox top;
+        bb_heap_pop(&h, &top);
+        /* about the best point where it lies inside (a loft's slab ends belong to the next slab) */
+        const double mid = 0.5 * (top.w0 + top.w1), wb = *wbest;
+        const double c = (wb > top.w0 && wb < top.w1) || (nslabs == 1 && wb >= top.w0 && wb <= top.w1) ? wb : mid;
+        tm1 m;
+        f->model(f->ctx, top.w0, top.w1, c, &m);
+        const double q0 = sign * m.p[0], q1 = sign * m.p[1], q2 = sign * m.p[2];
+        if (q0 < b)
+            b = q0, *wbest = c;
+        const double lb = fmin(cubic_min(q0, q1, q2, m.k, top.w1 - c), cubic_min(q0, -q1, q2, m.k, c - top.w0));
+        if (!(lb == lb)) {   /* NaN: no bound (the caller's general path) */
+            st = PDE_ERR_INVALID;
+            break;
+        }
+        /* the quadratic's argmin within the interval: a better value there */
+        double dm = q1 > 0.0 ? top.w0 - c : top.w1 - c;
+        if (q2 > 0.0)
+            dm = fmin(fmax(-q1 / (2.0 * q2), top.w0 - c), top.w1 - c);
+        if (dm != 0.0 && q0 + dm * (q1 + q2 * dm) < b) {
+            const double x = sign * f->value(f->ctx, c + dm);
+            if (x < b)
+                b = x, *wbest = c + dm;
+        }
+        if (lb >= b - tol || top.w1 - top.w0 <= 2.0 * DBL_EPSILON * fabs(mid)) {
+            low = fmin(low, lb);
+            continue;
+        }
+        const lbox lo = { lb, top.w0, mid }, hi = { lb, mid, top.w1 };
+        if (bb_heap_push(&h, &lo) || bb_heap_push(&h, &hi))
+            st = PDE_ERR_NOMEM;
+    }
+    if (st == PDE_OK) {
+        if (h.n)
+            low = fmin(low, bb_heap_min(&h));
+        *lower = fmin(low, b), *best = b;
+    }
+    free(h.a);
+    return st;
+}
+
+/*
+ * The models of alpha and beta about c over [w0, w1] (m[0], m[1]), their third derivatives bounded
+ * by |alpha'''(c)| + r M4 (r = max |w - c|): no bound of each mode over each interval, and near c as
+ * tight as the sum's own value (a mode's bound loses the cancellation between its terms).
+ */
+static void harmonic_models(const harmonic *hc, double w0, double w1, double c, tm1 m[2])
+{
+    const double r = fmax(c - w0, w1 - c);
+    double j[2][4] = { { 0, 0, 0, 0 }, { 0, 0, 0, 0 } };
+    for (size_t k = 0; k < hc->nmodes; k++) {
+        double d[4];
+        const int i = harmonic_is_cos(hc, k);
+        mode_h_derivs(&hc->modes[k], c, 3, d);
+        j[i][0] += d[0], j[i][1] += d[1], j[i][2] += d[2], j[i][3] += d[3];
+    }
+    for (int i = 0; i < 2; i++)
+        m[i] = tm_jet(j[i], fabs(j[i][3]) + r * hc->M4[i]);
+}
+
+/* alpha and beta at w. */
+static void harmonic_ab(const harmonic *hc, double w, double ab[2])
+{
+    ab[0] = ab[1] = 0.0;
+    for (size_t m = 0; m < hc->nmodes; m++) {
+        double h, dh;
+        mode_h(&hc->modes[m], w, &h, &dh);
+        ab[harmonic_is_cos(hc, m)] += h;
+    }
+}
+
+/* R^2 = alpha^2 + beta^2, for line_minimise. */
+static void r2_model(const void *ctx, double w0, double w1, double c, tm1 *m)
+{
+    const double r = fmax(c - w0, w1 - c);
+    tm1 ab[2];
+    harmonic_models(ctx, w0, w1, c, ab);
+    const tm1 a2 = tm_mul(&ab[0], &ab[0], r), b2 = tm_mul(&ab[1], &ab[1], r);
+    *m = tm_add(a2, &b2, 1.0);
+}
+
+static double r2_value(const void *ctx, double w)
+{
+    double ab[2];
+    harmonic_ab(ctx, w, ab);
+    return ab[0] * ab[0] + ab[1] * ab[1];
+}
+
+/*
+ * max_w R(w), R = sqrt(alpha^2 + beta^2): *upper certified, *wbest where the largest R found is.
+ * line_minimise's tolerance on R^2 is 2 R tol at the start's R, which R only exceeds: R's gap stays
+ * within tol.
+ */
+static pde_status harmonic_max(const pde_solution *s, const harmonic *hc, double start, double tol, size_t budget,
+                               const pde_cancel *cancel, double *upper, double *wbest)
+{
+    const line_fn f = { r2_model, r2_value, hc };
+    const double tol2 = tol * fmax(2.0 * sqrt(r2_value(hc, start)), tol);
+    double lo, b;
+    pde_status st = line_minimise(s, &f, -1.0, start, tol2, budget, cancel, &lo, &b, wbest);
+    if (st == PDE_OK)
+        *upper = sqrt(fmax(-lo, 0.0));
+    return st;
+}
+
+/* The place of the min (e = 0) or max (1) of x_c at w, where alpha, beta are ab: t_a = 1, and the
+ * harmonic's phase k pi t_b = phi (max) or phi + pi (min), phi = atan2(alpha, beta), within [0, 2 pi). */
+static void harmonic_place(const harmonic *hc, double w, const double ab[2], int e, double at[3])
+{
+    double th = fmod(atan2(ab[0], ab[1]) + (e ? 2.0 : 3.0) * M_PI, 2.0 * M_PI);
+    at[hc->a] = 1.0, at[hc->b] = fmin(th / (hc->k * M_PI), 1.0), at[2] = w;
+}
+
+/*
+ * The extremes of such a component (bound, best, at: as single_mode_extremes'); PDE_ERR_INVALID where
+ * it is not one (or its bound is no number). start: a w to begin from.
+ */
+pde_status props_harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
+                                   const pde_cancel *cancel, double bound[2], double best[2], double at[2][3])
+{
+    harmonic hc;
+    if (!harmonic_of(s, c, &hc))
+        return PDE_ERR_INVALID;
+    double up, w, ab[2];
+    pde_status st = harmonic_max(s, &hc, start, tol, budget, cancel, &up, &w);
+    if (st != PDE_OK)
+        return st;
+    harmonic_ab(&hc, w, ab);
+    for (int e = 0; e < 2; e++) {
+        double x[3];
+        harmonic_place(&hc, w, ab, e, at[e]);
+        pde_eval(s, at[e][0], at[e][1], at[e][2], x);
+        best[e] = x[c];
+    }
+    bound[0] = fmin(-up, best[0]), bound[1] = fmax(up, best[1]);
+    return PDE_OK;
+}
+
+/* Non-zero when every mode of the component has the factors 1 along u and v: x_c = Z(w) (fig. 2's and 4's z). */
+static int w_only(const comp_solution *cs)
+{
+    for (size_t m = 0; m < cs->nmodes; m++)
+        if (cs->modes[m].u.kind != PDE_POW || cs->modes[m].u.p != 0.0 || cs->modes[m].v.kind != PDE_POW ||
+            cs->modes[m].v.p != 0.0)
+            return 0;
+    return 1;
+}
+
+/* Z's model (derivative 0) or Z''s (1), about c over [w0, w1]. */
+static tm1 w_only_model(const comp_solution *cs, int der, double w0, double w1, double c)
+{
+    double j[3] = { 0, 0, 0 }, T = 0.0;
+    for (size_t k = 0; k < cs->nmodes; k++) {
+        double e[5];
+        mode_h_derivs(&cs->modes[k], c, 2 + der, e);
+        j[0] += e[der], j[1] += e[der + 1], j[2] += e[der + 2];
+        mode_h_bounds(&cs->modes[k], w0, w1, 3 + der, e);
+        T += e[3 + der];
+    }
+    return tm_jet(j, T);
+}
+
+static void z_model(const void *ctx, double w0, double w1, double c, tm1 *m)
+{
+    *m = w_only_model(ctx, 0, w0, w1, c);
+}
+
+static double z_value(const void *ctx, double w)
+{
+    const comp_solution *cs = ctx;
+    double z = 0.0;
+    for (size_t k = 0; k < cs->nmodes; k++) {
+        double h, dh;
+        mode_h(&cs->modes[k], w, &h, &dh);
+        z += h;
+    }
+    return z;
+}
+
+/* The extremes of a component x_c = Z(w) (as single_mode_extremes'), from the sample's places start. */
+static pde_status w_only_extremes(const pde_solution *s, int c, const double *start[2], double tol, const pde_cancel *cancel,
+                                  double bound[2], double best[2], double at[2][3])
+{
+    const line_fn f = { z_model, z_value, &s->comp[c] };
+    for (int e = 0; e < 2; e++) {
+        double lo, b, w;
+        pde_status st = line_minimise(s, &f, e ? -1.0 : 1.0, start[e][2], tol, PDE_PROPS_BOXES, cancel, &lo, &b, &w);
+        if (st != PDE_OK)
+            return st;
+        at[e][0] = start[e][0], at[e][1] = start[e][1], at[e][2] = w;
+        double x[3];
+        pde_eval(s, at[e][0], at[e][1], w, x);
+        best[e] = x[c];
+        bound[e] = e ? fmax(-lo, best[e]) : fmin(lo, best[e]);
+    }
+    return PDE_OK;
+}
+
+/*
+ * det J where two components are harmonic (c[0] < c[1], alike: the same axes, n >= 1 and k) and the
+ * third, z, a function of w alone (fig. 2, 4): with x_c[0] = t^n (alpha S + beta C), x_c[1] = t^n
+ * (gamma S + delta C), the rows' (t, s) minor is n k pi t^(2n - 1) (beta gamma - alpha delta)
+ * (S^2 + C^2 = 1), so det J = t^(2n - 1) g(w), g = sigma n k pi Z'(w) (beta gamma - alpha delta),
+ * sigma the sign the rows' and columns' order gives: g's extremes are a problem in w alone.
+ */
+typedef struct {
+    harmonic h[2];
+    const comp_solution *zc;   /* z */
+    double scale;         /* sigma n k pi */
+} detj_line;
+
+static int detj_line_of(const pde_solution *s, detj_line *d)
+{
+    for (int z = 0; z < 3; z++) {
+        const comp_solution *zc = &s->comp[z];
+        const int c0 = z == 0 ? 1 : 0, c1 = z == 2 ? 1 : 2;
+        if (!w_only(zc) || !harmonic_of(s, c0, &d->h[0]) || !harmonic_of(s, c1, &d->h[1]))
+            continue;
+        const harmonic *a = &d->h[0], *b = &d->h[1];
+        if (a->a != b->a || a->n != b->n || a->k != b->k || a->n < 1.0)
+            continue;
+        /* sigma: the determinant with beta = gamma = 1, alpha = delta = 0, n = k pi = Z' = 1 */
+        double M[3][3] = { { 0 } };
+        M[c0][a->a] = 1.0, M[c1][a->b] = 1.0, M[z][2] = 1.0;
+        d->zc = zc;
+        d->scale = det3(M[0], M[1], M[2]) * a->n * a->k * M_PI;
+        return 1;
+    }
+    return 0;
+}
+
+static void detj_line_model(const void *ctx, double w0, double w1, double c, tm1 *m)
+{
+    const detj_line *d = ctx;
+    const double r = fmax(c - w0, w1 - c);
+    tm1 ab[2], gd[2];
+    harmonic_models(&d->h[0], w0, w1, c, ab);
+    harmonic_models(&d->h[1], w0, w1, c, gd);
+    const tm1 zp = w_only_model(d->zc, 1, w0, w1, c), bg = tm_mul(&ab[1], &gd[0], r), ad = tm_mul(&ab[0], &gd[1], r);
+    const tm1 q = tm_add(bg, &ad, -1.0);
+    *m = tm_mul(&zp, &q, r);
+    for (int k = 0; k < 3; k++)
+        m->p[k] *= d->scale;
+    m->k *= fabs(d->scale);
+}
+
+static double detj_line_value(const void *ctx, double w)
+{
+    const detj_line *d = ctx;
+    double ab[2], gd[2], zp = 0.0;
+    harmonic_ab(&d->h[0], w, ab);
+    harmonic_ab(&d->h[1], w, gd);
+    for (size_t k = 0; k < d->zc->nmodes; k++) {
+        double h, dh;
+        mode_h(&d->zc->modes[k], w, &h, &dh);
+        zp += dh;
+    }
+    return d->scale * zp * (ab[1] * gd[0] - ab[0] * gd[1]);
+}
+
+/*
  * The extreme of sign * det J (what 3) or of a coordinate where det J separates (quad.h: det J =
  * t^p D1, D1 det J on the face t = 1, p = n ns - 1; x_c = t^(n in[c]) X_c): branch and bound over
  * that face alone, a 2-D problem, then over t exactly: t^p is 1 when p = 0, else it spans [0, 1],
@@ -482,8 +884,15 @@ static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, i
         face.hi[t] = len;
         at[t] = a > len ? per - a : a;
     }
-    bb_result b;
-    pde_status st = bb_minimise(s, what, sign, at, &face, tol, budget, cancel, &b);
+    bb_result b = { .at = { at[0], at[1], at[2] } };
+    pde_status st = PDE_ERR_INVALID;
+    detj_line dl;
+    if (what == 3 && sp->free >= 0 && detj_line_of(s, &dl) && dl.h[0].a == sp->axis) {
+        const line_fn f = { detj_line_model, detj_line_value, &dl };   /* g(w) alone */
+        st = line_minimise(s, &f, sign, at[2], tol, budget, cancel, &b.lower, &b.best, &b.at[2]);
+    }
+    if (st == PDE_ERR_INVALID)
+        st = bb_minimise(s, what, sign, at, &face, tol, budget, cancel, &b);
     if (st != PDE_OK)
         return st;
     if (what == 3 ? sp->n * sp->ns > 1 : sp->in[what]) {
@@ -819,10 +1228,18 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             if ((st = poly_minimise(&po->b[what], sign, what < 3 ? tol : 1e-2 * tol,
                                     what < 3 ? PDE_PROPS_BOXES : jbudget, &b)) != PDE_OK)
                 break;
-        } else if (what < 3 && s->comp[what].nmodes == 1 && !(o & 1)) {
-            /* Both extremes of a component of one mode at once. */
+        } else if (what < 3 && !(o & 1)) {
+            /* Both extremes of a component of w alone, a harmonic one, or one of one mode, at once. */
+            const double *lo = at[o], *hi = at[o + 1];
             double bd[2], bs[2], ba[2][3];
-            if ((st = single_mode_extremes(s, what, tol, cancel, bd, bs, ba)) == PDE_OK) {
+            const double *starts[2] = { lo, hi };
+            st = s->comp[what].nmodes && w_only(&s->comp[what])
+                     ? w_only_extremes(s, what, starts, tol, cancel, bd, bs, ba)
+                     : props_harmonic_extremes(s, what, fabs(best[o]) > fabs(best[o + 1]) ? lo[2] : hi[2], tol,
+                                               PDE_PROPS_BOXES, cancel, bd, bs, ba);
+            if (st == PDE_ERR_INVALID && s->comp[what].nmodes == 1)
+                st = single_mode_extremes(s, what, tol, cancel, bd, bs, ba);
+            if (st == PDE_OK) {
                 single[what] = 1;
                 for (int k = 0; k < 2; k++) {
                     sb[what][k].lower = k ? -bd[1] : bd[0], sb[what][k].best = k ? -bs[1] : bs[0];

@@ -22,6 +22,7 @@
 #include "internal.h"   /* to perturb a solution's closed form, which the public API keeps immutable */
 #include "quad.h"       /* the separable integrals against the cube's */
 #include "poly.h"       /* polynomial solids' Bernstein bounds */
+#include "bound.h"      /* the 1-D extremes against the general branch and bound */
 #include "model.h"
 #include "support.h"
 #include "template.h"
@@ -1663,6 +1664,176 @@ static void det_j_bounds_over_one_period_should_hold_the_whole_face_on_solids_tu
     }
 }
 
+/*
+ * The 1-D extremes (core/props.c: harmonic components, components of w alone, det J = t^(2n-1) g(w))
+ * against the general branch and bound of bound.h over the face where det J separates (the path they
+ * replace; the whole cube where it does not separate), name's components c0 .. c1 - 1 harmonic.
+ * Each certified bound must hold the values the other path attains, each attained value lie within
+ * the other's bounds, and the extremes found agree to 2e-12 of the solid's size (det J: 2e-9 of its
+ * scale), the places given included.
+ */
+static void expect_line_extremes_match_the_general_path(const char *name, const pde_solution *sol, int nharm)
+{
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    double size = 0.0;
+    for (int c = 0; c < 3; c++)
+        size = fmax(size, p.bbox_max[c] - p.bbox_min[c]);
+    const int axis = pde_properties_flat_axis(sol);
+    pbox face = { { 0, 0, 0 }, { 1, 1, 1 } };
+    if (axis >= 0)
+        face.lo[axis] = 1.0;
+    int harm = 0;
+    for (int c = 0; c < 3; c++) {
+        const double pad = 64.0 * DBL_EPSILON * obj_magnitude(sol, c) + 1e-14 * size, tol = 1e-12 * size;
+        double bd[2], bs[2], at[2][3];
+        const pde_status st = props_harmonic_extremes(sol, c, 0.5, tol, PDE_PROPS_BOXES, NULL, bd, bs, at);
+        if (st == PDE_ERR_INVALID) {
+            /* not harmonic: pde_properties' bounds against the general path's */
+            bb_result g[2];
+            for (int e = 0; e < 2; e++) {
+                const double start[3] = { axis == 0 ? 1.0 : 0.5, axis == 1 ? 1.0 : 0.5, 0.5 };
+                assert_int_equal(bb_minimise(sol, c, e ? -1.0 : 1.0, start, axis >= 0 && c < 2 ? &face : NULL, tol,
+                                             PDE_PROPS_BOXES, NULL, &g[e]),
+                                 PDE_OK);
+            }
+            if (!(p.bbox_min[c] <= g[0].best + pad && p.bbox_max[c] >= -g[1].best - pad &&
+                  fabs(p.bbox_min[c] - g[0].best) <= 2e-12 * size + pad && fabs(p.bbox_max[c] + g[1].best) <= 2e-12 * size + pad))
+                fail_msg("%s: x%d's bounds [%.17g, %.17g], the general path found [%.17g, %.17g]", name, c, p.bbox_min[c],
+                         p.bbox_max[c], g[0].best, -g[1].best);
+            continue;
+        }
+        assert_int_equal(st, PDE_OK);
+        harm++;
+        bb_result g[2];
+        for (int e = 0; e < 2; e++) {
+            const double start[3] = { axis == 0 ? 1.0 : 0.5, axis == 1 ? 1.0 : 0.5, 0.5 };
+            assert_int_equal(
+                bb_minimise(sol, c, e ? -1.0 : 1.0, start, axis >= 0 ? &face : NULL, tol, PDE_PROPS_BOXES, NULL, &g[e]),
+                PDE_OK);
+            const double gbest = e ? -g[e].best : g[e].best, glow = e ? -g[e].lower : g[e].lower;
+            double x[3];
+            pde_eval(sol, at[e][0], at[e][1], at[e][2], x);
+            if (!(e ? bd[1] >= gbest - pad : bd[0] <= gbest + pad) ||
+                !(e ? glow >= bs[1] - pad : glow <= bs[0] + pad) || fabs(bs[e] - gbest) > 2e-12 * size ||
+                fabs(bd[e] - bs[e]) > tol + pad || x[c] != bs[e])
+                fail_msg("%s: x%d's %s: bound %.17g, found %.17g at (%g, %g, %g) (x there %.17g); the general path: "
+                         "bound %.17g, found %.17g",
+                         name, c, e ? "max" : "min", bd[e], bs[e], at[e][0], at[e][1], at[e][2], x[c], glow, gbest);
+        }
+        /* pde_properties takes them (from its sample's start, its pad on top) */
+        if (!(fabs(p.bbox_min[c] - bd[0]) <= tol + 2 * pad && fabs(p.bbox_max[c] - bd[1]) <= tol + 2 * pad))
+            fail_msg("%s: x%d's box [%.17g, %.17g], the harmonic bounds [%.17g, %.17g]", name, c, p.bbox_min[c],
+                     p.bbox_max[c], bd[0], bd[1]);
+    }
+    if (harm != nharm)
+        fail_msg("%s: %d harmonic components, expected %d", name, harm, nharm);
+    /* det J: g(w) = det J on the face, along a segment of w (det J does not depend on the face's other
+     * parameter here), by the general branch and bound; det J = t^(2n-1) g spans 0 too */
+    const double jscale = fmax(fabs(p.detj_min_found), fabs(p.detj_max_found));
+    pbox seg = face;
+    if (axis >= 0)
+        seg.lo[1 - axis] = seg.hi[1 - axis] = 0.3;
+    for (int e = 0; e < 2 && axis >= 0 && pde_properties_free_axis(sol) >= 0; e++) {
+        const double start[3] = { seg.lo[0], seg.lo[1], 0.5 }, pad = 64.0 * DBL_EPSILON * obj_magnitude(sol, 3);
+        bb_result g;
+        assert_int_equal(bb_minimise(sol, 3, e ? -1.0 : 1.0, start, &seg, 1e-10 * jscale, 20000, NULL, &g), PDE_OK);
+        const double gbest = e ? fmax(-g.best, 0.0) : fmin(g.best, 0.0), glow = e ? fmax(-g.lower, 0.0) : fmin(g.lower, 0.0);
+        const double bound = e ? p.detj_max : p.detj_min, found = e ? p.detj_max_found : p.detj_min_found;
+        const double *where = e ? p.detj_max_at : p.detj_min_at;
+        const double there = pde_eval_detj(sol, where[0], where[1], where[2]);
+        if (!(e ? bound >= gbest - pad : bound <= gbest + pad) || !(e ? glow >= found - pad : glow <= found + pad) ||
+            fabs(found - gbest) > 2e-9 * jscale || fabs(there - found) > 1e-12 * jscale + pad)
+            fail_msg("%s: det J's %s: bound %.17g, found %.17g (det J there %.17g); the general path: bound %.17g, "
+                     "found %.17g",
+                     name, e ? "max" : "min", bound, found, there, glow, gbest);
+    }
+}
+
+static void harmonic_extremes_should_match_the_general_path_on_figures_2_and_4(void **state)
+{
+    (void)state;
+    size_t n = 0;
+    for (size_t i = 0; i < api_preset_count(); i++) {
+        const char *name = api_preset_at(i)->name;
+        if (strncmp(name, "fig2", 4) && strncmp(name, "fig4", 4))
+            continue;
+        pde_solution *sol = preset_solution(name);
+        expect_line_extremes_match_the_general_path(name, sol, 2);
+        pde_solution_free(sol);
+        n++;
+    }
+    assert_int_equal(n, 27);
+}
+
+/*
+ * Stress models of the harmonic case against the general path and a dense sampling: alpha and beta
+ * peaking at opposite ends, one component of sin modes only and one of cos only, k = 4, sqrt(alpha^2
+ * + beta^2) with several interior maxima of nearly equal height (a forced sin(7 pi w)), a negative
+ * force, u and v swapped with t^2, boundary layers; and two solids outside the case (k = 1, half a period; two
+ * frequencies), which must take the general path and keep their bounds.
+ */
+static void harmonic_extremes_should_hold_a_dense_sampling_of_stress_models(void **state)
+{
+    (void)state;
+    static const pde_bterm nob = { { PDE_POW, 0 }, { PDE_POW, 0 }, 0, 0, 0, 0 };
+    static const pde_fterm none = { 0, { PDE_POW, 0 }, { PDE_POW, 0 }, { PDE_POW, 0 } };
+    struct {
+        const char *name;
+        pde_bterm x[2], y[2];
+        pde_fterm fx, fy;
+        int nharm;
+        double c;
+    } models[] = {
+        { "alpha, beta peak apart",
+          { { F_pow(1), F_sin(2), 1.0, 0, 0.1, 0 }, { F_pow(1), F_cos(2), 0.1, 0, 1.2, 0 } },
+          { { F_pow(1), F_cos(2), 1.0, 0, 0.4, 0 }, nob }, none, none, 2, -1 },
+        { "sin only, cos only, k = 4",
+          { { F_pow(1), F_sin(4), 0.5, 2, 0.5, -2 }, nob },
+          { { F_pow(1), F_cos(4), 0.2, 1, -0.3, 0 }, nob }, none, none, 2, -1 },
+        { "k = 4, both",
+          { { F_pow(1), F_sin(4), 0.5, 2, 0.5, -2 }, { F_pow(1), F_cos(4), 0.2, 1, -0.3, 0 } },
+          { { F_pow(1), F_cos(4), 0.5, 0, 0.7, 1 }, { F_pow(1), F_sin(4), -0.2, 0, 0.1, 0 } }, none, none, 2, -1 },
+        { "humps of sin(7 pi w), negative p0",
+          { { F_pow(1), F_sin(2), 0.5, 0, 0.5, 0 }, nob }, { { F_pow(1), F_cos(2), 0.5, 0, 0.5, 0 }, nob },
+          { -3e3, F_pow(1), F_cos(2), F_sin(7) }, { -3e3, F_pow(1), F_sin(2), F_sin(7) }, 2, -1 },
+        { "u, v swapped, v^2",
+          { { F_sin(2), F_pow(2), 0.5, 1, 0.8, -1 }, { F_cos(2), F_pow(2), 0.3, 0, 0.1, 0 } },
+          { { F_cos(2), F_pow(2), 0.5, 1, 0.8, -1 }, { F_sin(2), F_pow(2), -0.3, 0, -0.1, 0 } }, none, none, 2, -1 },
+        { "k = 1: half a period",
+          { { F_pow(1), F_sin(1), 0.5, 0, 0.5, 0 }, { F_pow(1), F_cos(1), 0.3, 0, -0.4, 0 } },
+          { { F_pow(1), F_cos(1), 0.5, 0, 0.5, 0 }, nob }, none, none, 0, -1 },
+        { "two frequencies",
+          { { F_pow(1), F_sin(2), 0.5, 0, 0.5, 0 }, { F_pow(1), F_cos(4), 0.1, 0, 0.1, 0 } },
+          { { F_pow(1), F_cos(2), 0.5, 0, 0.5, 0 }, nob }, none, none, 1, -1 },
+        /* c = -1e-3: layers of width about 0.03 at w = 0 and 1, R tiny in between, where a model
+         * about w = 0.5 sees almost nothing of them */
+        { "layers at w = 0 and 1",
+          { { F_pow(1), F_sin(2), 0.05, 0, 1.0, 0 }, { F_pow(1), F_cos(2), 0.02, 0, -0.5, 0 } },
+          { { F_pow(1), F_cos(2), 0.5, 0, 0.05, 0 }, nob }, none, none, 2, -1e-3 },
+    };
+    const pde_bterm bz = { F_pow(0), F_pow(0), 0, 1, 2, 3 };
+    for (size_t k = 0; k < sizeof models / sizeof models[0]; k++) {
+        const size_t nx = models[k].x[1].w0 || models[k].x[1].w1 || models[k].x[1].dw0 ? 2 : 1;
+        const size_t ny = models[k].y[1].w0 || models[k].y[1].w1 || models[k].y[1].dw0 ? 2 : 1;
+        const size_t fx = models[k].fx.coef != 0, fy = models[k].fy.coef != 0;
+        const double c = models[k].c;
+        pde_model m = { { { 1, 1, c, models[k].x, nx, &models[k].fx, fx },
+                          { 1, 1, c, models[k].y, ny, &models[k].fy, fy },
+                          { 1, 1, -1, &bz, 1, NULL, 0 } } };
+        pde_solution *sol = NULL;
+        pde_diag d;
+        if (pde_solve(&m, &sol, &d) != PDE_OK)
+            fail_msg("%s: %s", models[k].name, d.message);
+        double t0 = mono_now();
+        expect_line_extremes_match_the_general_path(models[k].name, sol, models[k].nharm);
+        expect_bounds_contain_samples(models[k].name, sol, 9, 200, 200, 100000);
+        print_message("%s: %.2f s\n", models[k].name, mono_now() - t0);
+        pde_solution_free(sol);
+    }
+}
+
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1701,6 +1872,8 @@ int main(void)
         cmocka_unit_test(props_of_a_scaled_solid_should_scale_up_to_the_limit_of_a_double),
         cmocka_unit_test(area_over_one_period_should_match_the_whole_face_and_the_reference_on_solids_turned_about_z),
         cmocka_unit_test(det_j_bounds_over_one_period_should_hold_the_whole_face_on_solids_turned_about_z),
+        cmocka_unit_test(harmonic_extremes_should_match_the_general_path_on_figures_2_and_4),
+        cmocka_unit_test(harmonic_extremes_should_hold_a_dense_sampling_of_stress_models),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
