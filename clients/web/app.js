@@ -407,25 +407,32 @@ function serverTimes(header, roundTrip) {
 
 // ---- det J on the skin: _DETJ per vertex (glTF), red where the solid folds ----
 const DETJ_BAD = new THREE.Color(0xd01c1c), DETJ_LO = new THREE.Color(0xf2e3b3), DETJ_HI = new THREE.Color(0x2c5fa8);
-function detjColour(d, hi, tiny, c) {
-  if (d < -tiny) return c.copy(DETJ_BAD);
-  return c.lerpColors(DETJ_LO, DETJ_HI, Math.min(Math.max(d / hi, 0), 1) ** 0.6);
+// The solid's orientation s (the sign of its signed volume: fig. 2's parametrisation is left-handed, det J <= 0
+// throughout, and does not fold), the largest s det J, and what counts as 0 (rounding at a collapsed axis).
+function detjScale(props) {
+  const s = (props?.signed_volume ?? 1) < 0 ? -1 : 1;
+  const hi = Math.max(s * (s > 0 ? props?.detJ?.max_found ?? 1 : props?.detJ?.min_found ?? -1), 1e-300);
+  return { s, hi, tiny: 1e-9 * Math.max(hi, Math.abs(props?.detJ?.min_found ?? 0), Math.abs(props?.detJ?.max_found ?? 0)) };
+}
+// Red where s det J < 0: the solid turns inside out there.
+function detjColour(d, k, c) {
+  if (k.s * d < -k.tiny) return c.copy(DETJ_BAD);
+  return c.lerpColors(DETJ_LO, DETJ_HI, Math.min(Math.max(k.s * d / k.hi, 0), 1) ** 0.6);
 }
 function colourByDetJ(geometry, props) {
   const dj = geometry.attributes._detj;
   el('legend').hidden = !(dj && state.detj);
   if (!dj) return false;
   const n = dj.count, col = new Float32Array(3 * n), c = new THREE.Color();
-  const hi = Math.max(props?.detJ?.max_found ?? 0, 1e-300);
-  // Rounding at a collapsed axis (det J = 0, not a fold) is not painted as a fold.
-  const tiny = 1e-9 * Math.max(hi, Math.abs(props?.detJ?.min_found ?? 0));
+  const k = detjScale(props), hi = k.s * k.hi;
   for (let i = 0; i < n; i++) {
-    detjColour(dj.getX(i), hi, tiny, c);
+    detjColour(dj.getX(i), k, c);
     col[3 * i] = c.r; col[3 * i + 1] = c.g; col[3 * i + 2] = c.b;
   }
   geometry.setAttribute('color', new THREE.BufferAttribute(col, 3));
   el('legend-lo').textContent = '0';
   el('legend-hi').textContent = short(hi);
+  el('legend-bad').textContent = k.s > 0 ? '< 0 folded' : '> 0 folded';   // folded: against the solid's sign
   return true;
 }
 function applySkinColour() {
@@ -596,11 +603,11 @@ const section = {
     const N = g.n, P = g.points, D = g.detj, f = new Float32Array(N * N * N);
     for (let i = 0; i < f.length; i++) f[i] = P[3 * i + k] - d;
     const pos = [], col = [], c = new THREE.Color();
-    const hiJ = Math.max(state.props?.detJ?.max_found ?? 1, 1e-300), tiny = 1e-9 * hiJ;
+    const kj = detjScale(state.props);
     const put = (a, b) => {   // the point where f = 0 on the edge a-b
       const t = f[a] / (f[a] - f[b]);
       for (let q = 0; q < 3; q++) pos.push(P[3 * a + q] + t * (P[3 * b + q] - P[3 * a + q]));
-      detjColour(D[a] + t * (D[b] - D[a]), hiJ, tiny, c);
+      detjColour(D[a] + t * (D[b] - D[a]), kj, c);
       col.push(c.r, c.g, c.b);
     };
     const TETS = [[0, 1, 3, 7], [0, 1, 5, 7], [0, 2, 3, 7], [0, 2, 6, 7], [0, 4, 5, 7], [0, 4, 6, 7]];
@@ -631,11 +638,11 @@ const section = {
     const g = this.grid, N = g.n, x = at * (N - 1), s0 = Math.min(Math.floor(x), N - 2), t = x - s0;
     const id = (a, b, s) => axis === 0 ? (b * N + a) * N + s : axis === 1 ? (b * N + s) * N + a : (s * N + b) * N + a;
     const pos = new Float32Array(N * N * 3), col = new Float32Array(N * N * 3), idx = [], c = new THREE.Color();
-    const hiJ = Math.max(state.props?.detJ?.max_found ?? 1, 1e-300), tiny = 1e-9 * hiJ;
+    const kj = detjScale(state.props);
     for (let b = 0; b < N; b++) for (let a = 0; a < N; a++) {
       const p = id(a, b, s0), q = id(a, b, s0 + 1), o = b * N + a;
       for (let k = 0; k < 3; k++) pos[3 * o + k] = g.points[3 * p + k] * (1 - t) + g.points[3 * q + k] * t;
-      detjColour(g.detj[p] * (1 - t) + g.detj[q] * t, hiJ, tiny, c);
+      detjColour(g.detj[p] * (1 - t) + g.detj[q] * t, kj, c);
       col.set([c.r, c.g, c.b], 3 * o);
     }
     for (let b = 0; b < N - 1; b++) for (let a = 0; a < N - 1; a++) {

@@ -487,6 +487,18 @@ await check('folds: fig4a is red where det J < 0, with a legend; the warning fli
   await page.locator('[data-view="frame"] button').click();
 });
 
+// fig. 2a's parametrisation is left-handed: det J <= 0 throughout, and it does not fold (QA: it was all red).
+await check('folds: fig2a, det J < 0 throughout but no fold, has no red', async () => {
+  await gallery('fig2a');
+  const s = await state();
+  if (!s.detj) return console.log('# skip the fold colouring: this server\'s glb has no _DETJ attribute');
+  if (s.props?.folds) throw new Error('fig2a reported as folding');
+  const whole = await page.evaluate(() => ({ x: 0, y: 0, w: innerWidth, h: innerHeight - 72 }));
+  const shot = await snapshot(whole);
+  if (shot.red > 0.0005) throw new Error(`fig2a, which does not fold, is ${(100 * shot.red).toFixed(2)}% red`);
+  if (shot.ink < 0.02) throw new Error(`fig2a is not drawn (ink ${shot.ink})`);
+});
+
 await check('the page asks for meshopt glb when GET /formats says glb takes compress=meshopt', async () => {
   const glb = (await (await fetch(`${base}/formats`)).json()).find((f) => f.name === 'glb');
   const want = Array.isArray(glb.compress) && glb.compress.includes('meshopt');
