@@ -82,6 +82,11 @@ static void make_key(srv_req *r)
     r->klen = (size_t)(k - r->key) + tl;
 }
 
+/* What a 413 suggests: a loft's profiles are the usual large bodies, and keep harmonics below half their points. */
+#define BODY_HINT                                                                                                 \
+    "; a loft's profile needs no more points than twice the highest harmonic it should keep (see docs/API.md), "  \
+    "or run the CLI offline, which has no such limit"
+
 /* ---- the first call: what the headers decide ---- */
 
 /* What a connection carries from request to request. */
@@ -235,8 +240,8 @@ static int admit(srv_req *r, const char *method)
     if (cl > (long long)s->cfg.max_body) {
         const char *expect = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_EXPECT);
         r->decided = r->close = 1;
-        srv_problem(r, 413, NULL, "the body of %lld bytes is more than the limit of %zu bytes (--max-body)", cl,
-                    s->cfg.max_body);
+        srv_problem(r, 413, NULL, "the body of %lld bytes is more than the limit of %zu bytes (--max-body)%s", cl,
+                    s->cfg.max_body, BODY_HINT);
         /* Expect: 100-continue: the client waits, and sends nothing. Too large to discard: close. */
         return (expect && !strcasecmp(expect, "100-continue")) || cl > (long long)DRAIN_BYTES;
     }
@@ -437,7 +442,8 @@ static enum MHD_Result take_body(srv_req *r, const char *upload, size_t n)
         r->decided = r->close = 1;
         free(r->body);
         r->body = NULL;
-        srv_problem(r, 413, NULL, "the body is more than the limit of %zu bytes (--max-body)", s->cfg.max_body);
+        srv_problem(r, 413, NULL, "the body is more than the limit of %zu bytes (--max-body)%s", s->cfg.max_body,
+                    BODY_HINT);
         r->drained = r->len + n;
         r->len = r->cap = 0;
         return MHD_YES;

@@ -96,6 +96,9 @@ const mean = (pts) => [0, 1, 2].map((i) => pts.reduce((a, p) => a + p[i], 0) / M
 export function loftDocument(st) {
   const profiles = st.sections.map((s) => profile(s, st.height));
   const sections = st.sections.map((s, k) => {
+    // An uploaded grid or closed form goes back as it came: the editor draws and transforms profiles only.
+    if (s.shape === 'uploaded' && s.grid) return { w: s.w, grid: s.grid, ...(s.periodic !== undefined ? { periodic: s.periodic } : {}) };
+    if (s.shape === 'uploaded' && s.terms) return { w: s.w, terms: s.terms };
     const out = { w: s.w, profile: profiles[k] };
     if (st.tangents && (k === 0 || k === st.sections.length - 1) && profiles.length > 1) {
       const a = mean(profiles[k === 0 ? 0 : k - 1]), b = mean(profiles[k === 0 ? 1 : k]);
@@ -106,7 +109,7 @@ export function loftDocument(st) {
     if (s.centre) out.centre = s.centre;
     return out;
   });
-  return { loft: { pde: { a: [...st.a], b: [...st.b], c: [...st.c] }, sections } };
+  return { loft: { pde: { a: [...st.a], b: [...st.b], c: [...st.c] }, ...(st.tol !== undefined ? { tol: st.tol } : {}), sections } };
 }
 
 export function newSection(shape, w) {
@@ -129,7 +132,9 @@ export function stateOf(doc) {
   st.sections = l.sections.map((s) => ({
     shape: 'uploaded', raw: Array.isArray(s.profile) ? s.profile : [], points: Array.isArray(s.profile) ? s.profile.length : 0,
     params: {}, size: 1, rotation: 0, x: 0, y: 0, w: s.w, tangent: s.tangent, centre: s.centre,
+    grid: s.grid, periodic: s.periodic, terms: s.terms,
   }));
+  if (l.tol !== undefined) st.tol = l.tol;
   // A section switched to a generator sits at z = w height: the height the upload's last section has.
   const last = st.sections[st.sections.length - 1]?.raw;
   const z = last?.length ? mean(last.map((p) => [0, 0, Number(p?.[2]) || 0]))[2] : 0;

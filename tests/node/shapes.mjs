@@ -73,5 +73,18 @@ check('star: r = 1 - 0.35 (1 - cos 5t) / 2 at each point\'s own angle',
   check('section z is w times the height', maxOf(doc.sections.flatMap((s) => s.profile.map((p) => Math.abs(p[2] - 2 * s.w)))), 0);
 }
 
+// An uploaded document of every kind of section, and tol: the editor sends it back as it came (QA: grid and
+// terms sections became 0-point profiles, and tol was dropped).
+{
+  const doc = { loft: { pde: { a: [1, 1, 1], b: [1, 1, 1], c: [1e4, 1e4, 1e4] }, tol: 1e-9, sections: [
+    { w: 0, profile: [[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]] },
+    { w: 0.5, grid: [[[0, 0, 1], [1, 0, 1]], [[0, 1, 1], [1, 1, 1]], [[0, 2, 1], [1, 2, 1]]], periodic: true },
+    { w: 1, terms: { x: [{ u: { pow: 1 }, v: { cos: 2 }, c: 1, dw: 0.5 }], y: [{ c: 0 }], z: [{ c: 2 }] } },
+  ] } };
+  const again = loftDocument(stateOf(doc));
+  check('an uploaded grid and terms section, and tol, come back as they were',
+    JSON.stringify(again) === JSON.stringify(doc) ? 0 : 1, 0);
+}
+
 console.log(failed ? `${failed} of ${step} checks failed` : `all ${step} checks passed`);
 process.exit(failed ? 1 : 0);
