@@ -84,9 +84,7 @@ char *api_preset_json(const api_preset *ps)
     return s;
 }
 
-/* Every number under j as 17 digits: cJSON prints 15 where they read back within an epsilon, and a
- * document that does not read back exactly would get another id. */
-static void exact_numbers(cJSON *j)
+void api_json_exact_numbers(cJSON *j)
 {
     for (cJSON *c = j->child, *next; c; c = next) {
         next = c->next;
@@ -99,7 +97,7 @@ static void exact_numbers(cJSON *j)
             else if (raw)
                 cJSON_ReplaceItemViaPointer(j, c, raw);
         } else
-            exact_numbers(c);
+            api_json_exact_numbers(c);
     }
 }
 
@@ -121,7 +119,7 @@ char *api_loft_preset_json(const char *name)
     cJSON *loft = cJSON_DetachItemFromObjectCaseSensitive(doc, "loft");
     cJSON_Delete(doc);
     if (loft)
-        exact_numbers(loft);
+        api_json_exact_numbers(loft);
     cJSON *root = cJSON_CreateObject();
     cJSON_AddStringToObject(root, "name", name);
     cJSON_AddStringToObject(root, "template", "loft");

@@ -5,7 +5,13 @@
 #ifndef API_CATALOG_H
 #define API_CATALOG_H
 
+#include <cJSON.h>
+
 #include "template.h"
+
+/* Every number under j as 17 digits, in place: cJSON prints 15 where they read back within an epsilon, and a
+ * document that does not read back exactly would get another id. */
+void api_json_exact_numbers(cJSON *j);
 
 /* {"presets": [{"name", "template", "caption"}], "templates": [{"name", "title", "params": [...]}]}; malloc'd. */
 char *api_presets_json(void);

@@ -364,8 +364,9 @@ static api_model *parse_request(const cJSON *root, api_error *err)
         if (doc) {
             api_model *m = NULL;
             if (k[2])
-                api_fail(err, API_ERR_DOCUMENT, "/params", "the loft preset \"%s\" takes no params; POST its document (GET /presets/%s) "
-                         "with your changes", name->valuestring, name->valuestring);
+                api_fail(err, API_ERR_DOCUMENT, "/params", "the loft preset \"%s\" takes no params; change its document (GET /presets/%s, "
+                         "or pdesolid presets --preset %s) and give that", name->valuestring, name->valuestring,
+                         name->valuestring);
             else if (!(m = calloc(1, sizeof *m)))
                 api_fail(err, API_ERR_NOMEM, "", "out of memory");
             else if (!(m->loft = api_loft_parse(cJSON_GetObjectItemCaseSensitive(doc, "loft"), "/loft", err))) {

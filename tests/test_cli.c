@@ -435,6 +435,45 @@ static void presets_and_formats_should_work_from_the_command_line(void **state)
     }
 }
 
+/* `presets --preset NAME` prints the preset's document, as GET /presets/NAME does: a loft preset's to edit offline
+ * (QA: it could only be had from a server); solved, it is the preset's solid. */
+static void a_preset_s_document_should_be_printed_offline(void **state)
+{
+    (void)state;
+    static const char *const names[] = { "vase", "fig4a" };
+    for (size_t i = 0; i < 2; i++) {
+        char args[128], *doc, *err, *a, *b;
+        snprintf(args, sizeof args, "presets --preset %s -o doc.json", names[i]);
+        assert_int_equal(run(0, args, &doc, &err), 0);
+        free(doc);
+        free(err);
+        char path[256];
+        snprintf(path, sizeof path, "%s/doc.json", dir);
+        doc = read_file(path, NULL);
+        cJSON *j = cJSON_Parse(doc);
+        if (!j || !cJSON_GetObjectItem(j, i ? "preset" : "loft"))
+            fail_msg("%s: not its document: %.200s", names[i], doc);
+        cJSON_Delete(j);
+        free(doc);
+        snprintf(args, sizeof args, "solve --preset %s --format json", names[i]);
+        assert_int_equal(run(0, args, &a, &err), 0);
+        free(err);
+        assert_int_equal(run(0, "solve doc.json --format json", &b, &err), 0);
+        free(err);
+        cJSON *ja = cJSON_Parse(a), *jb = cJSON_Parse(b);
+        assert_string_equal(cJSON_GetObjectItem(ja, "id")->valuestring, cJSON_GetObjectItem(jb, "id")->valuestring);
+        cJSON_Delete(ja);
+        cJSON_Delete(jb);
+        free(a);
+        free(b);
+    }
+    char *out, *err;
+    assert_int_equal(run(0, "presets --preset nowhere", &out, &err), 2);
+    assert_non_null(strstr(err, "nowhere"));
+    free(out);
+    free(err);
+}
+
 /* Runs the tool and expects status st with words in stderr (or in stdout when on_out), then frees both. */
 static void expect(int sanitised, const char *args, int st, const char *words)
 {
@@ -621,7 +660,8 @@ static void arguments_should_be_refused_with_a_specific_message(void **state)
         { "solve --preset fig4a --server http://a --server http://b", "--server is given twice" },
         { "eval - - <pts.json", "both standard input" },
         { "eval --preset fig4a pts.json --format glb", "eval takes no --format" },
-        { "presets --preset fig4a", "presets takes no --preset" },
+        { "presets --template example4", "presets takes no --template" },
+        { "presets --preset fig4a --param p0=1", "presets takes no --param" },
         { "solve --preset fig4a --param p0=0x10", "\"0x10\" is not a number" },
         { "solve --preset fig4a --param 'p0= 5'", "\" 5\" is not a number" },
         { "solve --preset fig4a --param 'p0=5 '", "\"5 \" is not a number" },
@@ -680,7 +720,7 @@ static void arguments_should_be_refused_with_a_specific_message(void **state)
     } helps[] = {
         { "solve", "usage: pdesolid solve [MODEL.json]", "POINTS.json" },
         { "eval", "usage: pdesolid eval MODEL.json POINTS.json", "--format" },
-        { "presets", "usage: pdesolid presets", "--preset" },
+        { "presets", "usage: pdesolid presets", "--format" },
     };
     for (size_t i = 0; i < sizeof helps / sizeof *helps; i++) {
         snprintf(args, sizeof args, "%s --help", helps[i].cmd);
@@ -917,6 +957,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(presets_and_formats_should_work_from_the_command_line),
+        cmocka_unit_test(a_preset_s_document_should_be_printed_offline),
         cmocka_unit_test(output_file_should_never_be_ignored),
         cmocka_unit_test(format_and_the_output_extension_should_agree),
         cmocka_unit_test(templates_should_work_from_the_command_line),

@@ -16,6 +16,7 @@
 
 #include <cJSON.h>
 
+#include "catalog.h"
 #include "describe.h"
 #include "id.h"
 #include "loft.h"
@@ -49,7 +50,7 @@ static const struct opt_row {
     size_t field;
     const char *help;
 } opt_rows[] = {
-    { "--preset", "NAME", CMD_SOLVE | CMD_EVAL, 0, offsetof(options, preset),
+    { "--preset", "NAME", CMD_SOLVE | CMD_EVAL | CMD_PRESETS, 0, offsetof(options, preset),
       "instead of MODEL.json: a preset (see `pdesolid presets`)" },
     { "--template", "NAME", CMD_SOLVE | CMD_EVAL, 0, offsetof(options, template),
       "instead of MODEL.json: a template (example1 to example4,\ndocs/API.md), its defaults changed by --param" },
@@ -86,8 +87,8 @@ static const struct cmd_row {
       "another format is refused)", cmd_solve },
     { "eval", CMD_EVAL, { "MODEL.json", "POINTS.json" }, "MODEL.json POINTS.json",
       "[[x,y,z], ...] at each [u,v,w] of POINTS.json, with\n17 significant digits", cmd_eval },
-    { "presets", CMD_PRESETS, { NULL }, "", "the paper's solids and the loft presets: name,\ntemplate and caption",
-      cmd_presets },
+    { "presets", CMD_PRESETS, { NULL }, "", "the paper's solids and the loft presets: name,\ntemplate and caption; "
+      "with --preset NAME, its document\n(a loft, or the figure's parameters) to edit and solve", cmd_presets },
 };
 #define NCMDS (sizeof cmd_rows / sizeof *cmd_rows)
 #define NOPTS (sizeof opt_rows / sizeof *opt_rows)
@@ -558,8 +559,51 @@ static void preset_row(const char *name, const char *template, const char *capti
     printf("%-6s %-9s %s\n", name, template, caption);
 }
 
+/* A preset's document, from GET /presets/NAME's answer (api_preset_json, api_loft_preset_json): the loft of
+ * a loft preset, {"preset", "params"} with every parameter of a paper figure's; what `solve` takes back. */
+static int print_preset_document(const char *name, const char *catalog)
+{
+    cJSON *c = cJSON_Parse(catalog ? catalog : ""), *doc = cJSON_CreateObject();
+    cJSON *loft = cJSON_DetachItemFromObjectCaseSensitive(c, "loft");
+    cJSON *params = cJSON_DetachItemFromObjectCaseSensitive(c, "params");
+    if (loft)
+        cJSON_AddItemToObject(doc, "loft", loft);
+    else if (params) {
+        cJSON_AddStringToObject(doc, "preset", name);
+        cJSON_AddItemToObject(doc, "params", params);
+        params = NULL;
+    }
+    api_json_exact_numbers(doc);   /* the same id as the preset's */
+    char *text = loft || cJSON_GetObjectItem(doc, "preset") ? cJSON_Print(doc) : NULL;
+    cJSON_Delete(params);
+    cJSON_Delete(doc);
+    cJSON_Delete(c);
+    if (!text) {
+        fprintf(stderr, "pdesolid: presets: the preset %s has no document\n", name);
+        return 1;
+    }
+    printf("%s\n", text);
+    free(text);
+    return 0;
+}
+
 static int cmd_presets(const options *o)
 {
+    if (o->preset) {
+        const api_preset *p = api_preset_find(o->preset);
+        char *catalog = NULL;
+        int rc = 0;
+        if (o->server)
+            rc = remote_preset(o->server, o->preset, &catalog);
+        else if (!(catalog = p ? api_preset_json(p) : api_loft_preset_json(o->preset))) {
+            fprintf(stderr, "pdesolid: presets: no preset \"%s\"; `pdesolid presets` lists them\n", o->preset);
+            rc = 2;
+        }
+        if (!rc)
+            rc = print_preset_document(o->preset, catalog);
+        free(catalog);
+        return rc;
+    }
     if (o->server)
         return remote_presets(o->server, preset_row);
     for (size_t i = 0; i < api_preset_count(); i++) {

@@ -308,6 +308,25 @@ int remote_eval(const char *server, const char *body, size_t len, const char *lo
     return rc;
 }
 
+int remote_preset(const char *server, const char *name, char **json)
+{
+    char path[160];
+    snprintf(path, sizeof path, "/presets/%s", name);
+    char *url = url_of(server, path);
+    reply r;
+    int rc = !url || post(url, NULL, 0, &r);
+    free(url);
+    if (rc)
+        return 1;
+    if (r.status != 200) {
+        rc = problem(server, &r);
+        free(r.data);
+        return rc;
+    }
+    *json = r.data;
+    return 0;
+}
+
 int remote_presets(const char *server, void (*row)(const char *name, const char *template, const char *caption))
 {
     char *url = url_of(server, "/presets");

@@ -29,4 +29,7 @@ int remote_eval(const char *server, const char *body, size_t len, const char *id
 /* GET URL/presets, each row through row(name, template, caption). Returns the exit status as remote_solve(). */
 int remote_presets(const char *server, void (*row)(const char *name, const char *template, const char *caption));
 
+/* GET URL/presets/NAME into *json (malloc'd). Returns the exit status as remote_solve(). */
+int remote_preset(const char *server, const char *name, char **json);
+
 #endif
