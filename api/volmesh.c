@@ -401,13 +401,19 @@ static size_t face_base(const api_volmesh *m, int f)
     return t;
 }
 
-static void bbox(const api_volmesh *m, double lo[3], double hi[3])
+/* The box of the mesh's points (face < 0), or of face's quads' corners. */
+static void bbox(const api_volmesh *m, int face, double lo[3], double hi[3])
 {
     for (int c = 0; c < 3; c++)
         lo[c] = INFINITY, hi[c] = -INFINITY;
-    for (size_t k = 0; k < m->npoints; k++)
+    const size_t n = face < 0 ? m->npoints : 4 * m->face_nquads[face];
+    for (size_t i = 0; i < n; i++) {
+        const size_t k = face < 0 ? i : m->face_quads[face][i];
+        if (k == UINT32_MAX)   /* a triangle's 4th */
+            continue;
         for (int c = 0; c < 3; c++)
             lo[c] = fmin(lo[c], m->pos[3 * k + c]), hi[c] = fmax(hi[c], m->pos[3 * k + c]);
+    }
 }
 
 enum { M_HEAD, M_TAGS, M_XYZ, M_ELHEAD, M_FACE0, M_HEX = M_FACE0 + 12, M_WEDGE, M_EDATA, M_EDATA_VOL, M_NDATA,
@@ -419,8 +425,8 @@ static int msh_step(const api_volmesh *m, const pde_props *props, api_volmesh_cu
     size_t vbase = face_base(m, 6);
     switch (c->phase) {
     case M_HEAD: {
-        double lo[3], hi[3];
-        bbox(m, lo, hi);
+        double lo[3], hi[3], flo[3], fhi[3];
+        bbox(m, -1, lo, hi);
         int ns = 0;
         for (int f = 0; f < 6; f++)
             ns += m->face_nquads[f] > 0;
@@ -429,9 +435,11 @@ static int msh_step(const api_volmesh *m, const pde_props *props, api_volmesh_cu
             addf(b, "2 %d \"%s\"\n", f + 1, face_names[f]);
         addf(b, "3 7 \"solid\"\n$EndPhysicalNames\n$Entities\n0 0 %d 1\n", ns);
         for (int f = 0; f < 6; f++)
-            if (m->face_nquads[f])
-                addf(b, "%d %.17g %.17g %.17g %.17g %.17g %.17g 1 %d 0\n", f + 1, lo[0], lo[1], lo[2], hi[0],
-                     hi[1], hi[2], f + 1);
+            if (m->face_nquads[f]) {
+                bbox(m, f, flo, fhi);
+                addf(b, "%d %.17g %.17g %.17g %.17g %.17g %.17g 1 %d 0\n", f + 1, flo[0], flo[1], flo[2], fhi[0],
+                     fhi[1], fhi[2], f + 1);
+            }
         addf(b, "1 %.17g %.17g %.17g %.17g %.17g %.17g 1 7 %d", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], ns);
         for (int f = 0; f < 6; f++)
             if (m->face_nquads[f])

@@ -301,6 +301,57 @@ static void write_file(const api_volmesh *m, const pde_props *props, const char 
     assert_int_equal(fclose(f), 0);
 }
 
+/* The msh's $Entities: each surface's box is its own face's (QA: every one was the whole solid's). fig. 1a is
+ * the cuboid [-0.5, 0.5]^2 x [0, 1]: its face u = 0 (surface 1) lies at x = -0.5, w = 1 (surface 6) at z = 1;
+ * the volume's box is the whole. */
+static void msh_entities_should_bound_their_own_faces(void **state)
+{
+    (void)state;
+    pde_solution *s = preset_solution("fig1a");
+    api_volmesh m;
+    api_error err;
+    const unsigned res[3] = { 3, 3, 3 };
+    assert_int_equal(api_volmesh_build(s, res, NULL, &m, &err), 0);
+    char path[] = "/tmp/pdesolid-ent-XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    write_file(&m, NULL, path, 0);
+    FILE *f = fopen(path, "r");
+    char line[512];
+    int in = 0, seen = 0;
+    while (fgets(line, sizeof line, f)) {
+        if (!strncmp(line, "$Entities", 9)) {
+            in = 1;
+            assert_non_null(fgets(line, sizeof line, f));   /* the counts */
+            continue;
+        }
+        if (!strncmp(line, "$EndEntities", 12))
+            break;
+        int tag;
+        double b[6];
+        if (!in || sscanf(line, "%d %lf %lf %lf %lf %lf %lf", &tag, &b[0], &b[1], &b[2], &b[3], &b[4], &b[5]) != 7)
+            continue;
+        const double whole[6] = { -0.5, -0.5, 0, 0.5, 0.5, 1 };
+        double want[6];
+        memcpy(want, whole, sizeof want);
+        if (seen < 6) {   /* surface tag = 2 axis + side + 1: that coordinate is the side's end; the volume last */
+            const int axis = (tag - 1) / 2, side = (tag - 1) % 2;
+            want[axis] = want[axis + 3] = whole[axis + 3 * side];
+        }
+        for (int k = 0; k < 6; k++)
+            if (fabs(b[k] - want[k]) > 1e-12)
+                fail_msg("entity %d (line %d): box %g %g %g %g %g %g, want %g %g %g %g %g %g", tag, seen, b[0], b[1],
+                         b[2], b[3], b[4], b[5], want[0], want[1], want[2], want[3], want[4], want[5]);
+        seen++;
+    }
+    fclose(f);
+    unlink(path);
+    assert_int_equal(seen, 7);
+    api_volmesh_free(&m);
+    pde_solution_free(s);
+}
+
 /* meshio reads the files back; det J at sample points is checked against core's pde_eval_d. */
 static void files_should_read_back_in_meshio(void **state)
 {
@@ -468,6 +519,7 @@ int main(void)
         cmocka_unit_test(fig4a_should_have_no_two_points_in_one_place),
         cmocka_unit_test(res_should_be_bounded),
         cmocka_unit_test(three_samples_around_a_loop_should_be_refused_naming_the_axis),
+        cmocka_unit_test(msh_entities_should_bound_their_own_faces),
         cmocka_unit_test(a_cancelled_build_should_say_so),
         cmocka_unit_test(a_solid_with_no_volume_should_get_no_mesh_and_say_why),
         cmocka_unit_test(files_should_read_back_in_meshio),
