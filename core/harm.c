@@ -16,7 +16,6 @@
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
-#include <stdio.h>
 
 #include "harm.h"
 
@@ -25,7 +24,8 @@
 #define TRAP_TOL 1e-8   /* two levels agree to this, relative: geometric convergence puts the finer
                          * near its square */
 #define DEPTH 40        /* halvings of a panel of w, at most */
-#define NOISE 1e-12     /* ... none once it agrees with its halves to this, relative: the rounding of a mean */
+#define NOISE 1e-11     /* ... none once it agrees with its halves to this, relative: the rounding of a mean */
+#define DEEP 0.02       /* an element below this of its largest at 64 points of 2 pi goes there directly */
 #define GRADE 0.45      /* a dip in theta: pieces graded towards its least value, each this of the distance left */
 #define GRADE_LEVELS 60 /* ... this many at most */
 #define DIP 0.05        /* a panel of w that fails its halves with the element below this of its largest */
@@ -101,14 +101,18 @@ static double q_at(const trig4 *q, const double cs[8])
 /* The element at theta (a piece's rule between two least values): from x_t x x_w, not from its
  * square, whose rounding near a least value m (of its coefficients' size times 1e-16) would be
  * 1e-16 / m^2 of m^2 and swamp the rule's tolerance there (fig. 4a: m 2e-3 of 44). */
+static double elem_cs(const trig4 *q, double c1, double s1)
+{
+    const double c2 = c1 * c1 - s1 * s1, s2 = 2.0 * s1 * c1;
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = q->v[0][k] + q->v[1][k] * c1 + q->v[2][k] * s1 + q->v[3][k] * c2 + q->v[4][k] * s2;
+    return sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+}
+
 static void elem_fn(void *arg, double th, double *val)
 {
-    const trig4 *q = arg;
-    double cs[8], c[3];
-    harmonics(th, cs);
-    for (int k = 0; k < 3; k++)
-        c[k] = q->v[0][k] + q->v[1][k] * cs[0] + q->v[2][k] * cs[4] + q->v[3][k] * cs[1] + q->v[4][k] * cs[5];
-    *val = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    *val = elem_cs(arg, cos(th), sin(th));
 }
 
 /* |x_t x x_w|^2's least in [lo, hi] (around a least sample), by Newton on its derivative kept inside
@@ -146,21 +150,37 @@ static double least(const trig4 *q, double lo, double hi, double *d2)
  */
 static double toward(const harm_opts *o, const trig4 *q, double far, double c, double scale)
 {
-    double sum = 0.0, d = far - c, piece;
-    for (int k = 0; k < GRADE_LEVELS && fabs(d) > 0.25 * scale; k++, d *= GRADE) {
-        rule(o, elem_fn, (void *)q, c + GRADE * d, c + d, 1, &piece);
-        sum += fabs(piece);
+    const double cc = cos(c), sc = sin(c);
+    double sum = 0.0, d = far - c;
+    for (int k = 0; k <= GRADE_LEVELS; k++, d *= GRADE) {
+        const int last = k == GRADE_LEVELS || !(fabs(d) > fmax(0.25 * scale, 1e-7));
+        const double lo = last ? 0.0 : GRADE * d, len = d - lo;
+        double piece = 0.0;
+        for (int i = 0; i < o->n; i++) {
+            /* cos and sin of the offset t from c: near c (most points), by their series */
+            const double t = lo + len * o->x[i], t2 = t * t;
+            double ct, st;
+            if (t2 < 1e-2) {
+                ct = 1.0 - t2 / 2 * (1.0 - t2 / 12 * (1.0 - t2 / 30 * (1.0 - t2 / 56 * (1.0 - t2 / 90))));
+                st = t * (1.0 - t2 / 6 * (1.0 - t2 / 20 * (1.0 - t2 / 42 * (1.0 - t2 / 72 * (1.0 - t2 / 110)))));
+            } else
+                ct = cos(t), st = sin(t);
+            piece += o->wt[i] * elem_cs(q, cc * ct - sc * st, sc * ct + cc * st);
+        }
+        sum += fabs(len) * piece;
+        if (last)
+            break;
     }
-    rule(o, elem_fn, (void *)q, c, c + d, 1, &piece);
-    return sum + fabs(piece);
+    return sum;
 }
 
 /*
  * The mean of |x_t x x_w| over a period: the trapezoidal rule on N0, 2 N0, ... NT points of 2 pi
  * (half as many over pi) until two levels agree. Where they never do, the element dips towards 0
  * within the period (a rounded fold, or a section that degenerates to a segment): the period is cut at
- * the least values of the NT samples, located (least), and each piece between two cuts integrated
- * graded towards both (toward). *dip: the least sample over the largest.
+ * the least values of the samples, located (least), and each piece between two cuts integrated
+ * graded towards both (toward); so too at once where the first samples dip below DEEP of their
+ * largest. *dip: the least sample over the largest.
  */
 static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
 {
@@ -172,7 +192,8 @@ static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
         lo = fmin(lo, e[i]), big = fmax(big, e[i]);
     }
     mean = sum * stride / per;
-    while (stride > 1) {
+    *dip = big > 0.0 ? lo / big : 1.0;
+    while (stride > 1 && !(stride <= NT / 64 && *dip < DEEP)) {
         const int half = stride / 2;
         for (int i = half; i < per; i += stride) {
             sum += e[i] = sqrt(fmax(q_at(q, trig[i]), 0.0));
@@ -185,14 +206,15 @@ static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
             return next;
         mean = next;
     }
-    const double dt = 2.0 * M_PI / NT, period = per * dt;
+    const double dt = stride * 2.0 * M_PI / NT, period = per * (2.0 * M_PI / NT);
+    const int ns = per / stride;
     double cut[NT], scale[NT];
     int ncut = 0;
-    for (int i = 0; i < per; i++) {
-        const double l = e[(i + per - 1) % per], r = e[(i + 1) % per];
-        if (e[i] < l && e[i] <= r) {
+    for (int j = 0; j < ns; j++) {
+        const double l = e[(j + ns - 1) % ns * stride], r = e[(j + 1) % ns * stride], ej = e[j * stride];
+        if (ej < l && ej <= r) {
             double d2, m;
-            cut[ncut] = least(q, (i - 1) * dt, (i + 1) * dt, &d2);
+            cut[ncut] = least(q, (j - 1) * dt, (j + 1) * dt, &d2);
             elem_fn((void *)q, cut[ncut], &m);
             scale[ncut++] = d2 > 0.0 ? m / sqrt(0.5 * d2) : 0.0;
         }

@@ -93,7 +93,7 @@
 #define ROW_TOL 1e-13         /* a span agrees with its halves to this of the solid's volume */
 #define FREE_DEPTH 2          /* halvings along w where det J does not depend on the face's other parameter */
 #define HARM_RULE 10          /* harm_face's Gauss points per panel of w and piece of theta */
-#define HARM_TOL 1e-12        /* ... and its tolerance on a unit of w, of the solid's size squared */
+#define HARM_TOL 1e-10        /* ... and its tolerance on a unit of w, of the solid's size squared */
 
 /* The panels: their edges along each axis, the points of each axis's rule, and its estimated error. */
 typedef struct {
