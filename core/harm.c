@@ -3,7 +3,7 @@
  *
  * Why: on fig. 2 and 4 the face u = 1 took three quarters of pde_properties (2-D panels along lines,
  * refined around the rounded folds), where its element is a trigonometric polynomial in theta at
- * each w: a mean over theta, a 1-D integral in w. At a point w, with a = A_c(w) and so on:
+ * each w: a mean over theta, a 1-D integral in w. At a point w, with A = (A_x, A_y, A_z)(w) and so on:
  *
  *     x_t = k pi (A cos theta - B sin theta),   x_w = A' sin theta + B' cos theta + D',
  *     x_t x x_w = c0 + c1 cos theta + s1 sin theta + c2 cos 2 theta + s2 sin 2 theta,
@@ -24,15 +24,16 @@
 #define TRAP_TOL 1e-8   /* two levels agree to this, relative: geometric convergence puts the finer
                          * near its square */
 #define DEPTH 40        /* halvings of a panel of w, at most */
-#define NOISE 1e-11     /* ... none once it agrees with its halves to this, relative: the rounding of a mean */
+#define NOISE 1e-11     /* ... nor once it agrees with its halves to this, relative: a mean's own error (the
+                         * cuts and pieces of a dip change with w) is not smooth in w */
 #define DEEP 0.02       /* an element below this of its largest at 64 points of 2 pi goes there directly */
 #define GRADE 0.45      /* a dip in theta: pieces graded towards its least value, each this of the distance left */
 #define GRADE_LEVELS 60 /* ... this many at most */
 #define DIP 0.05        /* a panel of w that fails its halves with the element below this of its largest */
 #define DIP_EPS 1e-7    /* ... is cut at the least place, located to this of the panel (once: its pieces
                          * are halved), */
-#define W_GRADE 0.2     /* ... and graded towards it, each piece this of the distance left, */
-#define W_LEVELS 4      /* ... in this many pieces and the last */
+#define W_GRADE 0.1     /* ... and graded towards it, each piece this of the distance left, */
+#define W_LEVELS 2      /* ... in this many pieces and the last */
 
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
@@ -145,8 +146,9 @@ static double least(const trig4 *q, double lo, double hi, double *d2)
 /*
  * Near a least value m at c, the element is about sqrt(m^2 + kappa^2 (theta - c)^2): smooth only on
  * the scale m / kappa. So from far to c, pieces graded geometrically, each GRADE of the distance
- * left, down to that scale, each with the rule: a piece's nearest singularity lies at least
- * 2 GRADE / (1 - GRADE) of its half-length beyond it, and the rule converges like 3.4^-2n there.
+ * left, down to a quarter of that scale (or 1e-7: a kink), each with the rule: a piece's nearest
+ * singularity lies at least 2 GRADE / (1 - GRADE) of its half-length beyond its end, where the rule's
+ * error falls like 5^-2n; the last piece's lies 8 of them away.
  */
 static double toward(const harm_opts *o, const trig4 *q, double far, double c, double scale)
 {
