@@ -26,9 +26,11 @@
 #define DEPTH 40        /* halvings of a panel of w, at most */
 #define NOISE 1e-11     /* ... nor once it agrees with its halves to this, relative: a mean's own error (the
                          * cuts and pieces of a dip change with w) is not smooth in w */
-#define DEEP 0.02       /* an element below this of its largest at 64 points of 2 pi goes there directly */
+#define DEEP 0.02       /* an element below this of its largest at 64 points of 2 pi, in a narrow dip
+                         * (narrow), goes there directly */
 #define GRADE 0.45      /* a dip in theta: pieces graded towards its least value, each this of the distance left */
-#define GRADE_LEVELS 60 /* ... this many at most */
+#define GRADE_LEVELS 60 /* ... this many at most, */
+#define PIECE_MAX 0.5   /* ... none wider than this (a wide dip's) */
 #define DIP 0.05        /* a panel of w that fails its halves with the element below this of its largest */
 #define DIP_EPS 1e-7    /* ... is cut at the least place, located to this of the panel (once: its pieces
                          * are halved), */
@@ -152,28 +154,42 @@ static double least(const trig4 *q, double lo, double hi, double *d2)
  */
 static double toward(const harm_opts *o, const trig4 *q, double far, double c, double scale)
 {
-    const double cc = cos(c), sc = sin(c);
     double sum = 0.0, d = far - c;
     for (int k = 0; k <= GRADE_LEVELS; k++, d *= GRADE) {
         const int last = k == GRADE_LEVELS || !(fabs(d) > fmax(0.25 * scale, 1e-7));
-        const double lo = last ? 0.0 : GRADE * d, len = d - lo;
-        double piece = 0.0;
-        for (int i = 0; i < o->n; i++) {
-            /* cos and sin of the offset t from c: near c (most points), by their series */
-            const double t = lo + len * o->x[i], t2 = t * t;
-            double ct, st;
-            if (t2 < 1e-2) {
-                ct = 1.0 - t2 / 2 * (1.0 - t2 / 12 * (1.0 - t2 / 30 * (1.0 - t2 / 56 * (1.0 - t2 / 90))));
-                st = t * (1.0 - t2 / 6 * (1.0 - t2 / 20 * (1.0 - t2 / 42 * (1.0 - t2 / 72 * (1.0 - t2 / 110)))));
-            } else
-                ct = cos(t), st = sin(t);
-            piece += o->wt[i] * elem_cs(q, cc * ct - sc * st, sc * ct + cc * st);
+        const double lo = last ? 0.0 : GRADE * d;
+        const int np = (int)ceil(fabs(d - lo) / PIECE_MAX);   /* a wide dip's pieces: the rest of theta too */
+        const double len = (d - lo) / np;
+        for (int p = 0; p < np; p++) {
+            /* cos and sin at the piece's start, and of each point's offset from it (at most PIECE_MAX)
+             * by their series: one sin and cos a piece */
+            const double t0 = c + lo + len * p, cb = cos(t0), sb = sin(t0);
+            double piece = 0.0;
+            for (int i = 0; i < o->n; i++) {
+                const double t = len * o->x[i], t2 = t * t;
+                const double ct = 1.0 - t2 / 2 * (1.0 - t2 / 12 * (1.0 - t2 / 30 * (1.0 - t2 / 56 * (1.0 - t2 / 90 *
+                                  (1.0 - t2 / 132 * (1.0 - t2 / 182))))));
+                const double st = t * (1.0 - t2 / 6 * (1.0 - t2 / 20 * (1.0 - t2 / 42 * (1.0 - t2 / 72 * (1.0 - t2 / 110 *
+                                  (1.0 - t2 / 156 * (1.0 - t2 / 210)))))));
+                piece += o->wt[i] * elem_cs(q, cb * ct - sb * st, sb * ct + cb * st);
+            }
+            sum += fabs(len) * piece;
         }
-        sum += fabs(len) * piece;
         if (last)
             break;
     }
     return sum;
+}
+
+/* The least of the samples e[0, stride, ...] is under half its neighbours: a dip narrower than
+ * their spacing, which the trapezoidal rule would take many levels to resolve. */
+static int narrow(const double *e, int per, int stride)
+{
+    int at = 0;
+    for (int i = stride; i < per; i += stride)
+        if (e[i] < e[at])
+            at = i;
+    return 2.0 * e[at] < e[(at + per - stride) % per] && 2.0 * e[at] < e[(at + stride) % per];
 }
 
 /*
@@ -195,7 +211,7 @@ static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
     }
     mean = sum * stride / per;
     *dip = big > 0.0 ? lo / big : 1.0;
-    while (stride > 1 && !(stride <= NT / 64 && *dip < DEEP)) {
+    while (stride > 1 && !(stride <= NT / 64 && *dip < DEEP && narrow(e, per, stride))) {
         const int half = stride / 2;
         for (int i = half; i < per; i += stride) {
             sum += e[i] = sqrt(fmax(q_at(q, trig[i]), 0.0));
@@ -338,7 +354,7 @@ static int outer_toward(harm_ctx *H, double c, double d, int depth, double *out)
         const double lo = k < W_LEVELS ? c + W_GRADE * d : c, hi = c + d, a = fmin(lo, hi), b = fmax(lo, hi);
         double coarse[2];
         rule(H->o, at_w, H, a, b, 2, coarse);
-        if (!outer(H, a, b, coarse, depth, 0, out))
+        if (!outer(H, a, b, coarse, depth, 1, out))
             return 0;
     }
     return 1;
@@ -374,10 +390,13 @@ static int outer(harm_ctx *H, double a, double b, const double *coarse, int dept
     if (depth >= DEPTH)
         return 0;
     if (split && H->dip < DIP) {
-        const double q = 0.125 * (b - a), w0 = dip_place(H, fmax(a, H->dip_at - q), fmin(b, H->dip_at + q));
-        if (w0 - a > 1e3 * DIP_EPS * (b - a) && b - w0 > 1e3 * DIP_EPS * (b - a))
-            return outer_toward(H, w0, a - w0, depth + 1, out) && outer_toward(H, w0, b - w0, depth + 1, out);
-        split = 0;   /* at an end: its place is known */
+        const double q = 0.125 * (b - a), near = 1e3 * DIP_EPS * (b - a);
+        double w0 = dip_place(H, fmax(a, H->dip_at - q), fmin(b, H->dip_at + q));
+        w0 = w0 - a <= near ? a : b - w0 <= near ? b : w0;
+        if (split == 2 || (w0 > a && w0 < b))   /* at an end, graded towards it from one side */
+            return (w0 == a || outer_toward(H, w0, a - w0, depth + 1, out)) &&
+                   (w0 == b || outer_toward(H, w0, b - w0, depth + 1, out));
+        split = 0;   /* the dip is at an end, where a cut was: halves */
     }
     return outer(H, a, m, l, depth + 1, split, out) && outer(H, m, b, r, depth + 1, split, out);
 }
@@ -440,7 +459,7 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
             break;
         }
         rule(o, at_w, &H, o->edge[i], o->edge[i + 1], 2, coarse);
-        ok = outer(&H, o->edge[i], o->edge[i + 1], coarse, 0, 1, sum);
+        ok = outer(&H, o->edge[i], o->edge[i + 1], coarse, 0, 2, sum);
     }
     free(H.wt);
     free(H.slot);
