@@ -32,8 +32,7 @@
 #define GRADE_LEVELS 60 /* ... this many at most, */
 #define PIECE_MAX 0.5   /* ... none wider than this (a wide dip's) */
 #define DIP 0.05        /* a panel of w that fails its halves with the element below this of its largest */
-#define DIP_EPS 1e-7    /* ... is cut at the least place, located to this of the panel (once: its pieces
-                         * are halved), */
+#define DIP_EPS 1e-7    /* ... is cut at the least place, located to this of the panel, */
 #define W_GRADE 0.1     /* ... and graded towards it, each piece this of the distance left, */
 #define W_LEVELS 2      /* ... in this many pieces and the last */
 
@@ -365,8 +364,10 @@ static int outer_toward(harm_ctx *H, double c, double d, int depth, double *out)
  * tolerances per unit length, or NOISE of the value) halved again; but where the element dipped below
  * DIP of its largest at a point of theirs (a section degenerating to a segment, where the element's
  * mean over theta has a singularity (w - w0)^2 log |w - w0|; a rounded fold, smooth on its own small
- * scale), cut at the deepest place w0 (dip_place; where split, once along a line of halvings) and
- * graded towards it from both sides.
+ * scale), cut at the deepest place w0 (dip_place) and graded towards it from both sides: split 2 (a
+ * panel of the plan), also where w0 is at an end (fig. 2c's layer at w = 0), from one side; 1 (a
+ * graded piece: fig. 2c's second dip, 0.02 from the first), where w0 is inside; 0 not (halves whose
+ * dip is at the cut already made).
  */
 static int outer(harm_ctx *H, double a, double b, const double *coarse, int depth, int split, double *out)
 {
