@@ -35,6 +35,7 @@
 #define DIP_EPS 1e-7    /* ... is cut at the least place, located to this of the panel, */
 #define W_GRADE 0.1     /* ... and graded towards it, each piece this of the distance left, */
 #define W_LEVELS 2      /* ... in this many pieces and the last */
+#define POLL_NODES 256  /* points of w between polls of the caller's stop() */
 
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
@@ -62,7 +63,8 @@ typedef struct {
     unsigned char *slot;       /* per mode: 3 part + c, part 0 sin (A), 1 cos (B), 2 the factor 1 (D) */
     double kpi, tol[2];
     double dip, dip_at;        /* the least element over its largest at the points of w since reset, and where */
-    size_t nodes;
+    size_t nodes, next_poll;
+    int stopped;               /* o->cancel asked to stop */
 } harm_ctx;
 
 typedef void (*harm_fn)(void *arg, double t, double *val);
@@ -373,6 +375,12 @@ static int outer(harm_ctx *H, double a, double b, const double *coarse, int dept
 {
     const double m = 0.5 * (a + b);
     double l[2], r[2];
+    if (H->nodes >= H->next_poll) {   /* a dip's points of w may take a few ms */
+        H->next_poll = H->nodes + POLL_NODES;
+        H->stopped |= pde_stopped(H->o->cancel);
+    }
+    if (H->stopped)
+        return 0;
     H->dip = INFINITY;
     rule(H->o, at_w, H, a, m, 2, l);
     rule(H->o, at_w, H, m, b, 2, r);
@@ -455,13 +463,11 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
     int ok = 1;
     for (int i = 0; i < o->np && ok == 1; i++) {
         double coarse[2];
-        if (pde_stopped(o->cancel)) {
-            ok = -1;
-            break;
-        }
         rule(o, at_w, &H, o->edge[i], o->edge[i + 1], 2, coarse);
         ok = outer(&H, o->edge[i], o->edge[i + 1], coarse, 0, 2, sum);
     }
+    if (H.stopped)
+        ok = -1;
     free(H.wt);
     free(H.slot);
     *nodes += H.nodes;
