@@ -36,6 +36,9 @@
 #define W_GRADE 0.1     /* ... and graded towards it, each piece this of the distance left, */
 #define W_LEVELS 2      /* ... in this many pieces and the last */
 #define POLL_NODES 256  /* points of w between polls of the caller's stop() */
+#define MAX_SPLITS 32   /* cuts at dips of w in a face, at most: a cut inside a graded piece may cut
+                         * again (a stiff model's valley of dips cut 30 deep, each deeper) */
+#define MAX_NODES 40000 /* points of w in a face, at most (fig. 2c: 2400), else the panels */
 
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
@@ -64,6 +67,7 @@ typedef struct {
     double kpi, tol[2];
     double dip, dip_at;        /* the least element over its largest at the points of w since reset, and where */
     size_t nodes, next_poll;
+    int splits;                /* cuts at a dip of w left */
     int stopped;               /* o->cancel asked to stop */
 } harm_ctx;
 
@@ -379,8 +383,8 @@ static int outer(harm_ctx *H, double a, double b, const double *coarse, int dept
         H->next_poll = H->nodes + POLL_NODES;
         H->stopped |= pde_stopped(H->o->cancel);
     }
-    if (H->stopped)
-        return 0;
+    if (H->stopped || H->nodes > MAX_NODES)
+        return 0;   /* the panels then, which bound their work */
     H->dip = INFINITY;
     rule(H->o, at_w, H, a, m, 2, l);
     rule(H->o, at_w, H, m, b, 2, r);
@@ -398,7 +402,8 @@ static int outer(harm_ctx *H, double a, double b, const double *coarse, int dept
     }
     if (depth >= DEPTH)
         return 0;
-    if (split && H->dip < DIP) {
+    if (split && H->dip < DIP && H->splits > 0) {
+        H->splits--;
         const double q = 0.125 * (b - a), near = 1e3 * DIP_EPS * (b - a);
         double w0 = dip_place(H, fmax(a, H->dip_at - q), fmin(b, H->dip_at + q));
         w0 = w0 - a <= near ? a : b - w0 <= near ? b : w0;
@@ -435,7 +440,7 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
     double k;
     if (axis > 1 || !harm_form(s, axis, &k))
         return 0;
-    harm_ctx H = { .o = o, .s = s, .kpi = k * M_PI };
+    harm_ctx H = { .o = o, .s = s, .kpi = k * M_PI, .splits = MAX_SPLITS };
     for (int c = 0; c < 3; c++)
         H.nm += s->comp[c].nmodes;
     H.wt = malloc(3 * H.nm * sizeof *H.wt);
