@@ -49,6 +49,7 @@
 #include <string.h>
 
 #include "bound.h"
+#include "harm.h"
 #include "quad.h"
 
 #define GMAX 24        /* Gauss points per panel axis, at most */
@@ -91,6 +92,8 @@
 #define ROW_EPS 1e-9          /* those points located to this, in w */
 #define ROW_TOL 1e-13         /* a span agrees with its halves to this of the solid's volume */
 #define FREE_DEPTH 2          /* halvings along w where det J does not depend on the face's other parameter */
+#define HARM_RULE 10          /* harm_face's Gauss points per panel of w and piece of theta */
+#define HARM_TOL 1e-10        /* ... and its tolerance on a unit of w, of the solid's size squared */
 
 /* The panels: their edges along each axis, the points of each axis's rule, and its estimated error. */
 typedef struct {
@@ -2318,6 +2321,18 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
                 total += face;
                 continue;
             }
+            if (!(period & QUAD_GENERAL)) {   /* a face of one harmonic along u or v (harm.h) */
+                const harm_opts ho = { .edge = p.edge[2], .np = p.np[2], .x = q->gx[HARM_RULE], .wt = q->gw[HARM_RULE],
+                                       .n = HARM_RULE, .tol = HARM_TOL * size * size, .size = size, .cancel = cancel };
+                const int h = harm_face(s, axis, side, &ho, &face, &fflux, &q->r.evals);
+                if (h < 0)
+                    c->stopped = 1;
+                if (h) {
+                    flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fflux;
+                    total += face;
+                    continue;
+                }
+            }
             c->line = (face_line){ .q = q, .axis = axis, .side = side, .o = { o[0], o[1] } };
             c->flat = face_separates(s, &sp, axis, &ascale, &fscale);
             /* np[k] panels along the face's parameter k: p's edges, or [i, i + 1] / div[k] where div[k] > 0
@@ -2327,7 +2342,7 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
             double fdet = 1.0, rdet = 0.0;
             for (int k = 0; k < 2 && per == 1; k++)
                 if (o[k] <= 1 && k != c->flat)
-                    per = face_period(s, o[k], period, &rot, &np[k], &div[k], &half, &fdet, &rdet);
+                    per = face_period(s, o[k], period & QUAD_PERIOD, &rot, &np[k], &div[k], &half, &fdet, &rdet);
             for (int pa = 0; pa < np[0] && !c->stopped; pa++)
                 for (int pb = 0; pb < np[1] && !c->stopped; pb++) {
                     const int i[2] = { pa, pb };
@@ -2371,5 +2386,5 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
 
 pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area, quad_result *info)
 {
-    return quad_area_period(s, size, 1, cancel, area, info);
+    return quad_area_period(s, size, QUAD_PERIOD, cancel, area, info);
 }

@@ -71,7 +71,9 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
 pde_status quad_area(const pde_solution *s, double size, const pde_cancel *cancel, double *area,
                      quad_result *info);
 /* The same with period 0: each face whole, its periods' panels kept but no period used (tests; quad.c's
- * face_period); 1: quad_area. */
+ * face_period); QUAD_PERIOD: quad_area; QUAD_GENERAL added: no face of one harmonic by its fast path
+ * (harm.h), the panels instead (tests). */
+enum { QUAD_PERIOD = 1, QUAD_GENERAL = 2 };
 pde_status quad_area_period(const pde_solution *s, double size, int period, const pde_cancel *cancel, double *area,
                             quad_result *info);
 

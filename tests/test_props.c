@@ -1834,6 +1834,94 @@ static void harmonic_extremes_should_hold_a_dense_sampling_of_stress_models(void
 }
 
 
+ * core/harm.c, a face of one harmonic: on the face u = 1 of fig. 2 and 4 every mode's factor of v is
+ * sin or cos 2 pi v or 1, and quad_area integrates the face's element as a mean over theta in w.
+ * Against the general face integration (QUAD_GENERAL) and the reference: the area to 1e-9, the
+ * flux's signed volume to 1e-9 of the volume, on presets (fig. 4o: xi = 11) and on stress models: a
+ * section that degenerates to a segment (x = u (a sin + b cos), y = u (b sin + a cos), a = b at a w),
+ * a mode of z of the harmonic that only the force makes, with an offset of x that varies along w (odd
+ * harmonics: the element's period is 2 pi), and k = 4 with a force. The fast path must have run: its
+ * points (of w) under a third of the general path's.
+ */
+static pde_solution *harm_model(int which)
+{
+    static pde_bterm bx[2], by[2], bz[1];
+    static pde_fterm fz[1], fx[1];
+    pde_model m = { { { 1, 1, -1, bx, 1, NULL, 0 }, { 1, 1, -1, by, 1, NULL, 0 }, { 1, 1, -1, bz, 1, NULL, 0 } } };
+    const double k = which == 2 ? 4 : 2;
+    bz[0] = (pde_bterm){ F_pow(0), F_pow(0), 0, 1, 1, 1 };
+    if (which == 0) {   /* a = b at a w: the section there a segment */
+        bx[0] = (pde_bterm){ F_pow(1), F_sin(k), 1, 0, 0.2, 0 }, bx[1] = (pde_bterm){ F_pow(1), F_cos(k), 0.2, 0, 1, 0 };
+        by[0] = (pde_bterm){ F_pow(1), F_sin(k), 0.2, 0, 1, 0 }, by[1] = (pde_bterm){ F_pow(1), F_cos(k), 1, 0, 0.2, 0 };
+        m.comp[0].nbterms = m.comp[1].nbterms = 2;
+    } else {
+        bx[0] = (pde_bterm){ F_pow(1), F_sin(k), 0.5, 0, 1, 0 }, by[0] = (pde_bterm){ F_pow(1), F_cos(k), 1, 0, 0.5, 0 };
+        bz[0] = (pde_bterm){ F_pow(0), F_pow(0), 0, 1, 2, 0 };
+    }
+    if (which == 1) {   /* forced only: z's mode of cos 2 pi v; an offset of x along w */
+        bx[1] = (pde_bterm){ F_pow(0), F_pow(0), 0.3, 0.5, 0.8, 0 };
+        m.comp[0].nbterms = 2;
+        fz[0] = (pde_fterm){ 40, F_pow(0), F_cos(k), F_sin(1) };
+        m.comp[2].fterms = fz, m.comp[2].nfterms = 1;
+    }
+    if (which == 2) {   /* k = 4, and a force of x */
+        fx[0] = (pde_fterm){ 3e3, F_pow(1), F_cos(k), F_sin(5) };
+        m.comp[0].fterms = fx, m.comp[0].nfterms = 1;
+    }
+    pde_solution *sol = NULL;
+    assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
+    return sol;
+}
+
+static void harm_face_should_match_the_general_path_and_the_reference_on_presets_and_stress_models(void **state)
+{
+    (void)state;
+    static const char *const presets[] = { "fig2a", "fig2b", "fig2c", "fig4a", "fig4c", "fig4o", "fig4t" };
+    static const char *const stress[] = { "a section that is a segment", "forced only, an offset", "k = 4, forced" };
+    const size_t np = sizeof presets / sizeof *presets, ns = sizeof stress / sizeof *stress;
+    for (size_t k = 0; k < np + ns; k++) {
+        api_model *m = NULL;
+        pde_solution *sol;
+        ref_props_out own;
+        const ref_props_out *r = &own;
+        const char *name = k < np ? presets[k] : stress[k - np];
+        if (k < np) {
+            const api_preset *ps = api_preset_find(name);
+            api_params prm;
+            api_error err;
+            api_preset_params(ps, &prm);
+            m = api_template_expand(api_preset_template(ps), &prm, &err);
+            assert_non_null(m);
+            assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
+            r = preset_ref(preset_index(name), sol);
+        } else {
+            sol = harm_model((int)(k - np));
+            assert_int_equal(ref_props(sol, &own), 0);
+            assert_true(own.converged);
+        }
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        double size = 0.0, fast, general;
+        for (int c = 0; c < 3; c++)
+            size = fmax(size, p.bbox_max[c] - p.bbox_min[c]);
+        quad_result qf, qg;
+        assert_int_equal(quad_area_period(sol, size, QUAD_PERIOD, NULL, &fast, &qf), PDE_OK);
+        assert_int_equal(quad_area_period(sol, size, QUAD_PERIOD | QUAD_GENERAL, NULL, &general, &qg), PDE_OK);
+        print_message("%s: area %.3g off the reference (general path %.3g), signed volume %.3g; %zu and %zu points\n",
+                      name, (fast - r->surface_area) / r->surface_area, (general - r->surface_area) / r->surface_area,
+                      (qf.acc[Q_SIGNED] - r->signed_volume) / r->volume, qf.evals, qg.evals);
+        if (!(3 * qf.evals < qg.evals))
+            fail_msg("%s: the fast path did not run (%zu points, the general path %zu)", name, qf.evals, qg.evals);
+        assert_rel(fast, r->surface_area, 1e-9, 0);
+        assert_rel(fast, general, 1e-9, 0);
+        assert_rel(p.surface_area, fast, 1e-12, 0);
+        assert_rel(qf.acc[Q_SIGNED], r->signed_volume, 1e-9, r->volume);
+        assert_rel(qf.acc[Q_SIGNED], qg.acc[Q_SIGNED], 1e-9, r->volume);
+        pde_solution_free(sol);
+        api_model_free(m);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1874,6 +1962,7 @@ int main(void)
         cmocka_unit_test(det_j_bounds_over_one_period_should_hold_the_whole_face_on_solids_turned_about_z),
         cmocka_unit_test(harmonic_extremes_should_match_the_general_path_on_figures_2_and_4),
         cmocka_unit_test(harmonic_extremes_should_hold_a_dense_sampling_of_stress_models),
+        cmocka_unit_test(harm_face_should_match_the_general_path_and_the_reference_on_presets_and_stress_models),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);

@@ -1,0 +1,482 @@
+/*
+ * harm.c: the area of a face of one harmonic (harm.h).
+ *
+ * Why: on fig. 2 and 4 the face u = 1 took three quarters of pde_properties (2-D panels along lines,
+ * refined around the rounded folds), where its element is a trigonometric polynomial in theta at
+ * each w: a mean over theta, a 1-D integral in w. At a point w, with A = (A_x, A_y, A_z)(w) and so on:
+ *
+ *     x_t = k pi (A cos theta - B sin theta),   x_w = A' sin theta + B' cos theta + D',
+ *     x_t x x_w = c0 + c1 cos theta + s1 sin theta + c2 cos 2 theta + s2 sin 2 theta,
+ *
+ * c0 = k pi (A x B' - B x A') / 2, c1 = k pi A x D', s1 = -k pi B x D', c2 = k pi (A x B' + B x A') / 2,
+ * s2 = k pi (A x A' - B x B') / 2; |x_t x x_w|^2 from their dot products, nine Fourier coefficients,
+ * and the flux's mean D . c0 + (A . s1 + B . c1) / 2 exactly.
+ */
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harm.h"
+
+#define NT 256          /* points of theta per 2 pi on the trapezoidal rule's finest level */
+#define N0 16           /* ... on its first */
+#define TRAP_TOL 1e-8   /* two levels agree to this, relative: geometric convergence puts the finer
+                         * near its square */
+#define DEPTH 40        /* halvings of a panel of w, at most */
+#define NOISE 1e-11     /* ... nor once it agrees with its halves to this, relative: a mean's own error (the
+                         * cuts and pieces of a dip change with w) is not smooth in w */
+#define DEEP 0.02       /* an element below this of its largest at 64 points of 2 pi, in a narrow dip
+                         * (narrow), goes there directly */
+#define GRADE 0.45      /* a dip in theta: pieces graded towards its least value, each this of the distance left */
+#define GRADE_LEVELS 60 /* ... this many at most, */
+#define PIECE_MAX 0.5   /* ... none wider than this (a wide dip's) */
+#define DIP 0.05        /* a panel of w that fails its halves with the element below this of its largest */
+#define DIP_EPS 1e-7    /* ... is cut at the least place, located to this of the panel, */
+#define W_GRADE 0.1     /* ... and graded towards it, each piece this of the distance left, */
+#define W_LEVELS 2      /* ... in this many pieces and the last */
+#define POLL_NODES 256  /* points of w between polls of the caller's stop() */
+#define MAX_SPLITS 32   /* cuts at dips of w in a face, at most: a cut inside a graded piece may cut
+                         * again (a stiff model's valley of dips cut 30 deep, each deeper) */
+#define MAX_NODES 40000 /* points of w in a face, at most (fig. 2c: 2400), else the panels */
+
+/* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
+static double trig[NT][8];
+static pthread_once_t trig_once = PTHREAD_ONCE_INIT;
+
+static void trig_init(void)
+{
+    for (int i = 0; i < NT; i++)
+        for (int j = 1; j <= 4; j++)
+            trig[i][j - 1] = cos(2.0 * M_PI * i * j / NT), trig[i][j + 3] = sin(2.0 * M_PI * i * j / NT);
+}
+
+/* x_t x x_w = v[0] + v[1] cos theta + v[2] sin theta + v[3] cos 2 theta + v[4] sin 2 theta, and its
+ * square |x_t x x_w|^2 = a[0] + sum_j a[j] cos j theta + b[j] sin j theta; period pi where odd is 0 */
+typedef struct {
+    double v[5][3], a[5], b[5];
+    int odd;
+} trig4;
+
+typedef struct {
+    const harm_opts *o;
+    const pde_solution *s;
+    size_t nm;
+    double *wt, *h, *dh;       /* per mode: its factor of the face's fixed parameter at the side; h, h' */
+    unsigned char *slot;       /* per mode: 3 part + c, part 0 sin (A), 1 cos (B), 2 the factor 1 (D) */
+    double kpi, tol[2];
+    double dip, dip_at;        /* the least element over its largest at the points of w since reset, and where */
+    size_t nodes, next_poll;
+    int splits;                /* cuts at a dip of w left */
+    int stopped;               /* o->cancel asked to stop */
+} harm_ctx;
+
+typedef void (*harm_fn)(void *arg, double t, double *val);
+
+/* The rule over [a, b] of fn's nval (<= 2) values, into sum. */
+static void rule(const harm_opts *o, harm_fn fn, void *arg, double a, double b, int nval, double *sum)
+{
+    double v[2];
+    for (int k = 0; k < nval; k++)
+        sum[k] = 0.0;
+    for (int i = 0; i < o->n; i++) {
+        fn(arg, a + (b - a) * o->x[i], v);
+        for (int k = 0; k < nval; k++)
+            sum[k] += o->wt[i] * v[k];
+    }
+    for (int k = 0; k < nval; k++)
+        sum[k] *= b - a;
+}
+
+/* cos j theta into cs[j - 1], sin j theta into cs[j + 3], j = 1..4 */
+static void harmonics(double th, double cs[8])
+{
+    cs[0] = cos(th), cs[4] = sin(th);
+    for (int j = 1; j < 4; j++) {
+        cs[j] = cs[j - 1] * cs[0] - cs[j + 3] * cs[4];
+        cs[j + 4] = cs[j + 3] * cs[0] + cs[j - 1] * cs[4];
+    }
+}
+
+static double q_at(const trig4 *q, const double cs[8])
+{
+    double v = q->a[0];
+    for (int j = 1; j <= 4; j++)
+        v += q->a[j] * cs[j - 1] + q->b[j] * cs[j + 3];
+    return v;
+}
+
+/* The element at theta (a piece's rule between two least values): from x_t x x_w, not from its
+ * square, whose rounding near a least value m (of its coefficients' size times 1e-16) would be
+ * 1e-16 / m^2 of m^2 and swamp the rule's tolerance there (fig. 4a: m 2e-3 of 44). */
+static double elem_cs(const trig4 *q, double c1, double s1)
+{
+    const double c2 = c1 * c1 - s1 * s1, s2 = 2.0 * s1 * c1;
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = q->v[0][k] + q->v[1][k] * c1 + q->v[2][k] * s1 + q->v[3][k] * c2 + q->v[4][k] * s2;
+    return sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+}
+
+static void elem_fn(void *arg, double th, double *val)
+{
+    *val = elem_cs(arg, cos(th), sin(th));
+}
+
+/* |x_t x x_w|^2's least in [lo, hi] (around a least sample), by Newton on its derivative kept inside
+ * the bracket, bisecting where a step leaves it; its second derivative there into *d2. */
+static double least(const trig4 *q, double lo, double hi, double *d2)
+{
+    double x = 0.5 * (lo + hi);
+    for (int it = 0; it < 60; it++) {
+        double cs[8], d1 = 0.0;
+        harmonics(x, cs);
+        *d2 = 0.0;
+        for (int j = 1; j <= 4; j++) {
+            d1 += j * (q->b[j] * cs[j - 1] - q->a[j] * cs[j + 3]);
+            *d2 -= j * j * (q->a[j] * cs[j - 1] + q->b[j] * cs[j + 3]);
+        }
+        if (d1 < 0.0)
+            lo = x;
+        else
+            hi = x;
+        double nx = *d2 > 0.0 ? x - d1 / *d2 : NAN;
+        if (!(nx > lo && nx < hi))
+            nx = 0.5 * (lo + hi);
+        if (fabs(nx - x) <= 1e-15 * (1.0 + fabs(x)))
+            return nx;
+        x = nx;
+    }
+    return x;
+}
+
+/*
+ * Near a least value m at c, the element is about sqrt(m^2 + kappa^2 (theta - c)^2): smooth only on
+ * the scale m / kappa. So from far to c, pieces graded geometrically, each GRADE of the distance
+ * left, down to a quarter of that scale (or 1e-7: a kink), each with the rule: a piece's nearest
+ * singularity lies at least 2 GRADE / (1 - GRADE) of its half-length beyond its end, where the rule's
+ * error falls like 5^-2n; the last piece's lies 8 of them away.
+ */
+static double toward(const harm_opts *o, const trig4 *q, double far, double c, double scale)
+{
+    double sum = 0.0, d = far - c;
+    for (int k = 0; k <= GRADE_LEVELS; k++, d *= GRADE) {
+        const int last = k == GRADE_LEVELS || !(fabs(d) > fmax(0.25 * scale, 1e-7));
+        const double lo = last ? 0.0 : GRADE * d;
+        const int np = (int)ceil(fabs(d - lo) / PIECE_MAX);   /* a wide dip's pieces: the rest of theta too */
+        const double len = (d - lo) / np;
+        for (int p = 0; p < np; p++) {
+            /* cos and sin at the piece's start, and of each point's offset from it (at most PIECE_MAX)
+             * by their series: one sin and cos a piece */
+            const double t0 = c + lo + len * p, cb = cos(t0), sb = sin(t0);
+            double piece = 0.0;
+            for (int i = 0; i < o->n; i++) {
+                const double t = len * o->x[i], t2 = t * t;
+                const double ct = 1.0 - t2 / 2 * (1.0 - t2 / 12 * (1.0 - t2 / 30 * (1.0 - t2 / 56 * (1.0 - t2 / 90 *
+                                  (1.0 - t2 / 132 * (1.0 - t2 / 182))))));
+                const double st = t * (1.0 - t2 / 6 * (1.0 - t2 / 20 * (1.0 - t2 / 42 * (1.0 - t2 / 72 * (1.0 - t2 / 110 *
+                                  (1.0 - t2 / 156 * (1.0 - t2 / 210)))))));
+                piece += o->wt[i] * elem_cs(q, cb * ct - sb * st, sb * ct + cb * st);
+            }
+            sum += fabs(len) * piece;
+        }
+        if (last)
+            break;
+    }
+    return sum;
+}
+
+/* The least of the samples e[0, stride, ...] is under half its neighbours: a dip narrower than
+ * their spacing, which the trapezoidal rule would take many levels to resolve. */
+static int narrow(const double *e, int per, int stride)
+{
+    int at = 0;
+    for (int i = stride; i < per; i += stride)
+        if (e[i] < e[at])
+            at = i;
+    return 2.0 * e[at] < e[(at + per - stride) % per] && 2.0 * e[at] < e[(at + stride) % per];
+}
+
+/*
+ * The mean of |x_t x x_w| over a period: the trapezoidal rule on N0, 2 N0, ... NT points of 2 pi
+ * (half as many over pi) until two levels agree. Where they never do, the element dips towards 0
+ * within the period (a rounded fold, or a section that degenerates to a segment): the period is cut at
+ * the least values of the samples, located (least), and each piece between two cuts integrated
+ * graded towards both (toward); so too at once where the first samples dip below DEEP of their
+ * largest. *dip: the least sample over the largest.
+ */
+static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
+{
+    const int per = q->odd ? NT : NT / 2;
+    double e[NT], sum = 0.0, mean, lo = INFINITY, big = 0.0;
+    int stride = NT / N0;
+    for (int i = 0; i < per; i += stride) {
+        sum += e[i] = sqrt(fmax(q_at(q, trig[i]), 0.0));
+        lo = fmin(lo, e[i]), big = fmax(big, e[i]);
+    }
+    mean = sum * stride / per;
+    *dip = big > 0.0 ? lo / big : 1.0;
+    while (stride > 1 && !(stride <= NT / 64 && *dip < DEEP && narrow(e, per, stride))) {
+        const int half = stride / 2;
+        for (int i = half; i < per; i += stride) {
+            sum += e[i] = sqrt(fmax(q_at(q, trig[i]), 0.0));
+            lo = fmin(lo, e[i]), big = fmax(big, e[i]);
+        }
+        stride = half;
+        const double next = sum * stride / per;
+        *dip = big > 0.0 ? lo / big : 1.0;
+        if (fabs(next - mean) <= TRAP_TOL * next)
+            return next;
+        mean = next;
+    }
+    const double dt = stride * 2.0 * M_PI / NT, period = per * (2.0 * M_PI / NT);
+    const int ns = per / stride;
+    double cut[NT], scale[NT];
+    int ncut = 0;
+    for (int j = 0; j < ns; j++) {
+        const double l = e[(j + ns - 1) % ns * stride], r = e[(j + 1) % ns * stride], ej = e[j * stride];
+        if (ej < l && ej <= r) {
+            double d2, m;
+            cut[ncut] = least(q, (j - 1) * dt, (j + 1) * dt, &d2);
+            elem_fn((void *)q, cut[ncut], &m);
+            scale[ncut++] = d2 > 0.0 ? m / sqrt(0.5 * d2) : 0.0;
+        }
+    }
+    if (!ncut)
+        cut[ncut] = 0.0, scale[ncut++] = period;
+    double total = 0.0;
+    for (int j = 0; j < ncut; j++) {
+        const int k = (j + 1) % ncut;
+        const double a = cut[j], b = j + 1 < ncut ? cut[j + 1] : cut[0] + period, mid = 0.5 * (a + b);
+        if (b > a)
+            total += toward(o, q, mid, a, scale[j]) + toward(o, q, mid, b, scale[k]);
+    }
+    return total / period;
+}
+
+static void cross(const double a[3], const double b[3], double s, double *out)
+{
+    out[0] = s * (a[1] * b[2] - a[2] * b[1]);
+    out[1] = s * (a[2] * b[0] - a[0] * b[2]);
+    out[2] = s * (a[0] * b[1] - a[1] * b[0]);
+}
+
+static double dot(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* The section at w: x_t x x_w's coefficients and its square's into q; the flux's mean over theta,
+ * returned. */
+static double section(harm_ctx *H, double w, trig4 *q)
+{
+    double x[9] = { 0 }, d[9] = { 0 };   /* A, B, D and their w-derivatives, component c of part p at 3 p + c */
+    solution_factors(H->s, 2, w, H->h, H->dh);
+    for (size_t m = 0; m < H->nm; m++)
+        x[H->slot[m]] += H->wt[m] * H->h[m], d[H->slot[m]] += H->wt[m] * H->dh[m];
+    H->nodes++;
+    const double *A = x, *B = x + 3, *D = x + 6, *Ap = d, *Bp = d + 3, *Dp = d + 6, s = 0.5 * H->kpi;
+    double (*v)[3] = q->v, t[3];
+    cross(A, Bp, s, v[0]), cross(Ap, B, s, t);
+    for (int c = 0; c < 3; c++)
+        v[3][c] = v[0][c] - t[c], v[0][c] += t[c];
+    cross(A, Dp, H->kpi, v[1]), cross(Dp, B, H->kpi, v[2]);
+    cross(A, Ap, s, v[4]), cross(B, Bp, s, t);
+    for (int c = 0; c < 3; c++)
+        v[4][c] -= t[c];
+    double g[5][5];
+    for (int i = 0; i < 5; i++)
+        for (int j = i; j < 5; j++)
+            g[i][j] = dot(v[i], v[j]);
+    const double a[5] = { g[0][0] + 0.5 * (g[1][1] + g[2][2] + g[3][3] + g[4][4]), 2.0 * g[0][1] + g[1][3] + g[2][4],
+                          2.0 * g[0][3] + 0.5 * (g[1][1] - g[2][2]), g[1][3] - g[2][4], 0.5 * (g[3][3] - g[4][4]) };
+    const double b[5] = { 0.0, 2.0 * g[0][2] + g[1][4] - g[2][3], 2.0 * g[0][4] + g[1][2], g[1][4] + g[2][3], g[3][4] };
+    memcpy(q->a, a, sizeof a), memcpy(q->b, b, sizeof b);
+    /* Odd harmonics come from D' alone (c1, s1); below rounding, the period is pi. */
+    q->odd = !(fabs(a[1]) + fabs(b[1]) + fabs(a[3]) + fabs(b[3]) <= 1e-15 * a[0]);
+    if (!q->odd)
+        q->a[1] = q->b[1] = q->a[3] = q->b[3] = 0.0;
+    return dot(D, v[0]) + 0.5 * (dot(A, v[2]) + dot(B, v[1]));
+}
+
+/* At w: val[0] the element's mean over theta, val[1] the flux's; the least of the element over its
+ * largest kept in H->dip, where it is at in H->dip_at. */
+static void at_w(void *arg, double w, double *val)
+{
+    harm_ctx *H = arg;
+    trig4 q;
+    double dip;
+    val[1] = section(H, w, &q);
+    val[0] = elem_mean(H->o, &q, &dip);
+    if (dip < H->dip)
+        H->dip = dip, H->dip_at = w;
+}
+
+/* The element's least over theta at w, located (least) from a coarse sample: what a degenerate
+ * section or a rounded fold along w makes small. */
+static double least_at(harm_ctx *H, double w)
+{
+    trig4 q;
+    section(H, w, &q);
+    const int per = q.odd ? NT : NT / 2, stride = NT / N0;
+    int at = 0;
+    double lo = INFINITY, d2, m;
+    for (int i = 0; i < per; i += stride) {
+        const double e = q_at(&q, trig[i]);
+        if (e < lo)
+            lo = e, at = i;
+    }
+    const double dt = 2.0 * M_PI / NT;
+    elem_fn(&q, least(&q, (at - stride) * dt, (at + stride) * dt, &d2), &m);
+    return m;
+}
+
+/* By golden section: where the element's least over theta is least in [a, b]. */
+static double dip_place(harm_ctx *H, double a, double b)
+{
+    const double g = 0.5 * (3.0 - sqrt(5.0)), len = b - a;
+    double c = a + g * (b - a), d = b - g * (b - a), fc = least_at(H, c), fd = least_at(H, d);
+    while (b - a > DIP_EPS * len) {
+        if (fc < fd) {
+            b = d, d = c, fd = fc;
+            c = a + g * (b - a);
+            fc = least_at(H, c);
+        } else {
+            a = c, c = d, fc = fd;
+            d = b - g * (b - a);
+            fd = least_at(H, d);
+        }
+    }
+    return fc < fd ? c : d;
+}
+
+static int outer(harm_ctx *H, double a, double b, const double *coarse, int depth, int split, double *out);
+
+/* [c, c + d] (d < 0: [c + d, c]) graded towards c, each piece with outer. */
+static int outer_toward(harm_ctx *H, double c, double d, int depth, double *out)
+{
+    for (int k = 0; k <= W_LEVELS; k++, d *= W_GRADE) {
+        const double lo = k < W_LEVELS ? c + W_GRADE * d : c, hi = c + d, a = fmin(lo, hi), b = fmax(lo, hi);
+        double coarse[2];
+        rule(H->o, at_w, H, a, b, 2, coarse);
+        if (!outer(H, a, b, coarse, depth, 1, out))
+            return 0;
+    }
+    return 1;
+}
+
+/*
+ * [a, b], whose rule gave coarse, against its halves, and where they differ (by more than the
+ * tolerances per unit length, or NOISE of the value) halved again; but where the element dipped below
+ * DIP of its largest at a point of theirs (a section degenerating to a segment, where the element's
+ * mean over theta has a singularity (w - w0)^2 log |w - w0|; a rounded fold, smooth on its own small
+ * scale), cut at the deepest place w0 (dip_place) and graded towards it from both sides: split 2 (a
+ * panel of the plan), also where w0 is at an end (fig. 2c's layer at w = 0), from one side; 1 (a
+ * graded piece: fig. 2c's second dip, 0.02 from the first), where w0 is inside; 0 not (halves whose
+ * dip is at the cut already made).
+ */
+static int outer(harm_ctx *H, double a, double b, const double *coarse, int depth, int split, double *out)
+{
+    const double m = 0.5 * (a + b);
+    double l[2], r[2];
+    if (H->nodes >= H->next_poll) {   /* a dip's points of w may take a few ms */
+        H->next_poll = H->nodes + POLL_NODES;
+        H->stopped |= pde_stopped(H->o->cancel);
+    }
+    if (H->stopped || H->nodes > MAX_NODES)
+        return 0;   /* the panels then, which bound their work */
+    H->dip = INFINITY;
+    rule(H->o, at_w, H, a, m, 2, l);
+    rule(H->o, at_w, H, m, b, 2, r);
+    int ok = 1;
+    for (int k = 0; k < 2; k++) {
+        const double fine = l[k] + r[k];
+        if (isnan(fine))
+            return 0;   /* no refinement mends it */
+        ok &= fabs(fine - coarse[k]) <= fmax(H->tol[k] * (b - a), NOISE * fabs(fine));
+    }
+    if (ok) {
+        for (int k = 0; k < 2; k++)
+            out[k] += l[k] + r[k];
+        return 1;
+    }
+    if (depth >= DEPTH)
+        return 0;
+    if (split && H->dip < DIP && H->splits > 0) {
+        H->splits--;
+        const double q = 0.125 * (b - a), near = 1e3 * DIP_EPS * (b - a);
+        double w0 = dip_place(H, fmax(a, H->dip_at - q), fmin(b, H->dip_at + q));
+        w0 = w0 - a <= near ? a : b - w0 <= near ? b : w0;
+        if (split == 2 || (w0 > a && w0 < b))   /* at an end, graded towards it from one side */
+            return (w0 == a || outer_toward(H, w0, a - w0, depth + 1, out)) &&
+                   (w0 == b || outer_toward(H, w0, b - w0, depth + 1, out));
+        split = 0;   /* the dip is at an end, where a cut was: halves */
+    }
+    return outer(H, a, m, l, depth + 1, split, out) && outer(H, m, b, r, depth + 1, split, out);
+}
+
+/* The face's modes: 1 where each has the factor 1 or sin, cos of one even k along the face's other
+ * parameter (k into *k), else 0. */
+static int harm_form(const pde_solution *s, int axis, double *k)
+{
+    *k = 0.0;
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
+            const pde_factor f = axis == 0 ? s->comp[c].modes[m].v : s->comp[c].modes[m].u;
+            const double p = fabs(f.p);
+            if (f.kind == PDE_POW && f.p == 0.0)
+                continue;
+            if (!((f.kind == PDE_SIN || f.kind == PDE_COS) && p >= 2.0 && p <= PDE_MAX_FREQ &&
+                  p == 2.0 * floor(0.5 * p)) || (*k != 0.0 && p != *k))
+                return 0;
+            *k = p;
+        }
+    return *k != 0.0;
+}
+
+int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, double *area, double *flux,
+              size_t *nodes)
+{
+    double k;
+    if (axis > 1 || !harm_form(s, axis, &k))
+        return 0;
+    harm_ctx H = { .o = o, .s = s, .kpi = k * M_PI, .splits = MAX_SPLITS };
+    for (int c = 0; c < 3; c++)
+        H.nm += s->comp[c].nmodes;
+    H.wt = malloc(3 * H.nm * sizeof *H.wt);
+    H.slot = malloc(H.nm);
+    if (!H.wt || !H.slot) {
+        free(H.wt);
+        free(H.slot);
+        return 0;
+    }
+    H.h = H.wt + H.nm, H.dh = H.h + H.nm;
+    for (int c = 0, m = 0; c < 3; c++)
+        for (size_t i = 0; i < s->comp[c].nmodes; i++, m++) {
+            const pde_mode *md = &s->comp[c].modes[i];
+            const pde_factor f = axis == 0 ? md->v : md->u;
+            double der;
+            factor_eval(axis == 0 ? md->u : md->v, side, &H.wt[m], &der);
+            const int part = f.kind == PDE_SIN ? 0 : f.kind == PDE_COS ? 1 : 2;
+            if (f.kind == PDE_SIN && f.p < 0.0)
+                H.wt[m] = -H.wt[m];
+            H.slot[m] = (unsigned char)(3 * part + c);
+        }
+    pthread_once(&trig_once, trig_init);
+    H.tol[0] = o->tol, H.tol[1] = o->tol * o->size;
+    double sum[2] = { 0.0, 0.0 };
+    int ok = 1;
+    for (int i = 0; i < o->np && ok == 1; i++) {
+        double coarse[2];
+        rule(o, at_w, &H, o->edge[i], o->edge[i + 1], 2, coarse);
+        ok = outer(&H, o->edge[i], o->edge[i + 1], coarse, 0, 2, sum);
+    }
+    if (H.stopped)
+        ok = -1;
+    free(H.wt);
+    free(H.slot);
+    *nodes += H.nodes;
+    if (ok == 1)
+        *area = sum[0], *flux = sum[1];
+    return ok;
+}

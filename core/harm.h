@@ -1,0 +1,44 @@
+/*
+ * harm.h: the area of a face of one harmonic (internal to core/; used by quad.c's quad_area_period).
+ *
+ * On the face u = side (or v = side) of a solid whose every mode has, along the face's other parameter
+ * t, the factor sin(k pi t), cos(k pi t) (one even k for all) or 1, each coordinate is
+ *
+ *     x_c(t, w) = A_c(w) sin theta + B_c(w) cos theta + D_c(w),    theta = k pi t,
+ *
+ * (fig. 2 and 4: the sections w = const are ellipses), so the element x_t x x_w is a trigonometric
+ * polynomial of degree 2 in theta, |x_t x x_w|^2 one of degree 4, and t in [0, 1] covers k / 2 whole
+ * periods of both: the face's area is the integral over w of the element's mean over theta (the
+ * trapezoidal rule, geometric where the element keeps away from 0; adaptive between its located
+ * least values where it dips), and its flux x . (x_t x x_w) the integral of a mean known exactly from
+ * the coefficients. A, B, D and their w-derivatives come from every mode's h(w) once per point of w;
+ * a point of theta costs a dozen flops (docs/MATH.md, "A face of one harmonic").
+ */
+#ifndef PDE_HARM_H
+#define PDE_HARM_H
+
+#include "internal.h"
+
+/* What harm_face needs besides the solution: w's panels to start from (edge[0] = 0 < ... <
+ * edge[np] = 1, every slab's break among them), an n-point Gauss-Legendre rule on [0, 1] (x, wt),
+ * and the tolerance of the area on a unit of w (the flux's: tol times size). */
+typedef struct {
+    const double *edge;
+    int np;
+    const double *x, *wt;
+    int n;
+    double tol, size;
+    const pde_cancel *cancel;
+} harm_opts;
+
+/*
+ * The face (axis, side), axis 0 or 1, when it has that form: returns 1 with its area in *area, the
+ * integral of x . (x_a x x_b) over it in *flux (a, b its parameters in axis order) and the points of w
+ * evaluated added to *nodes; 0, nothing set, where the face is not of that form, memory ran out, or
+ * the integration did not converge within its depth (the general path then); -1 where o->cancel
+ * stopped it. Reentrant.
+ */
+int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, double *area, double *flux,
+              size_t *nodes);
+
+#endif
