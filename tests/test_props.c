@@ -1834,6 +1834,7 @@ static void harmonic_extremes_should_hold_a_dense_sampling_of_stress_models(void
 }
 
 
+/*
  * core/harm.c, a face of one harmonic: on the face u = 1 of fig. 2 and 4 every mode's factor of v is
  * sin or cos 2 pi v or 1, and quad_area integrates the face's element as a mean over theta in w.
  * Against the general face integration (QUAD_GENERAL) and the reference: the area to 1e-9, the
