@@ -24,7 +24,9 @@
  * Where det J separates along u or v (quad_separate: det J = n t^p G), all of
  * this runs on the face t = 1 alone, the flat axis (n 0: one point, weight 1),
  * and the integrals over t are exact (separable_moments); so do the skin's
- * faces whose element separates too (face_separates). Where det J may change
+ * faces whose element separates too (face_separates). Where G = g(w) moreover
+ * (fig. 2, 4), the integrals over the face's other parameter are exact too,
+ * from the modes' moments, and only a rule along w is left (free_solid). Where det J may change
  * sign there, depends on both of the face's parameters, and the solid repeats
  * itself along the other one (param_symmetry, or turned about an axis:
  * param_rotation), one period of the face goes by rows of w instead of 2-D

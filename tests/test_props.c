@@ -1667,9 +1667,10 @@ static void det_j_bounds_over_one_period_should_hold_the_whole_face_on_solids_tu
  * core/quad.c free_solid: where det J = n t^p g(w) (quad_sep's free), the integrals are 1-D along w
  * (exact moments over v). Against the independent quadrature (ref_props: lines along w with every
  * least of |det J| searched) to 1e-10, on fig. 4a's closed form with z's cubic replaced so that g has
- * two roots, a double root (g touches 0), and a lobe 2e-3 wide and 3e-6 deep at a panel's edge (w =
- * 1/2) and inside one (w = 0.55), and with x's and y's factors of v replaced by the other pairs of
- * constant Wronskian (sinh and cosh, exp(+-2v), 1 and v). Missing a lobe costs 8e-9 of the volume.
+ * two roots, a double root (g touches 0), a lobe 6e-4 wide between a panel's edge (w = 1/2, where |g|
+ * is least among the samples) and its first node, and one 2e-3 wide inside a panel (w = 0.55); and
+ * with x's and y's factors of v replaced by the other pairs of constant Wronskian (sinh and cosh,
+ * exp(+-2v), 1 and v). Missing either lobe costs 1e-9 to 1e-7 of the volume.
  */
 static void free_integrals_should_match_the_reference_on_folds_lobes_and_every_wronskian_pair(void **state)
 {
@@ -1677,7 +1678,7 @@ static void free_integrals_should_match_the_reference_on_folds_lobes_and_every_w
     static const double zs[][4] = {
         { 0, 0.56, -1.5, 1 },                     /* z' = 3 w^2 - 3 w + 0.56: roots 0.248, 0.752 */
         { 0, 0.75, -1.5, 1 },                     /* z' = 3 (w - 1/2)^2 */
-        { 0, 0.75 - 3e-6, -1.5, 1 },              /* z' = 3 (w - 1/2)^2 - 3e-6 */
+        { 0, 3 * 0.5004 * 0.5004 - 2.7e-7, -3 * 0.5004, 1 },   /* z' = 3 (w - 0.5004)^2 - 2.7e-7 */
         { 0, 3 * 0.55 * 0.55 - 3e-6, -3 * 0.55, 1 },
     };
     static const pde_factor pairs[][2] = {
