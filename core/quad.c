@@ -1019,6 +1019,7 @@ static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
  */
 #define FREE_MODES 48         /* modes at most for that path: its points cost a multiply-add per pair */
 #define FREE_SPAN_DEPTH 12    /* halvings of a w-panel where its halves disagree, at most */
+#define FREE_KNOWN 32         /* roots and dips remembered per w-panel */
 
 typedef struct {
     qctx *q;
@@ -1028,6 +1029,10 @@ typedef struct {
     double *mom1, *mom2;         /* mt, mt x mt */
     double *da, *ds, *dw;        /* det J's partials' coefficients at s0: F'_t F_s, F_t F'_s, F_t F_s */
     double *h, *dh;              /* mt: the current point's h, h' */
+    /* The current w-panel's roots of G, and its dip searches' leasts (where G's sign at them), found
+     * by its coarse rule: its halves' brackets that hold one take it rather than search again. */
+    double root[FREE_KNOWN], dip_at[FREE_KNOWN], dip_f[FREE_KNOWN];
+    int nroot, ndip;
 } free_ctx;
 
 /* det J at w on the face (at s0), and into m[Q_N] the integrals over s of 1, x_c, x_c x_d at w. */
@@ -1092,9 +1097,27 @@ static void free_gauss(free_ctx *f, double a, double b, double acc[Q_N])
     }
 }
 
+/* G's root in [a, b], where ga and gb have opposite signs: one the panel's coarse rule located
+ * inside (a, b), else by Illinois (and remembered). */
+static double free_root(free_ctx *f, double a, double b, double ga, double gb)
+{
+    for (int i = 0; i < f->nroot; i++)
+        if (f->root[i] > a && f->root[i] < b)
+            return f->root[i];
+    const double r = illinois(free_detj, f, a, b, ga, gb);
+    if (f->nroot < FREE_KNOWN)
+        f->root[f->nroot++] = r;
+    return r;
+}
+
 /* The extreme of sign * G between t0 and t2 by golden section, as line_dip; 1 when it crosses 0. */
 static int free_dip(free_ctx *f, double t0, double t2, double sign, double *at, double *fat)
 {
+    for (int i = 0; i < f->ndip; i++)
+        if (f->dip_at[i] > t0 && f->dip_at[i] < t2) {
+            *at = f->dip_at[i], *fat = f->dip_f[i];
+            return sign * *fat < -f->q->jtol;
+        }
     const double g = 0.5 * (3.0 - sqrt(5.0));
     double a = t0, b = t2;
     double c = a + g * (b - a), d = b - g * (b - a);
@@ -1114,6 +1137,8 @@ static int free_dip(free_ctx *f, double t0, double t2, double sign, double *at, 
     }
     *at = fc < fd ? c : d;
     *fat = sign * fmin(fc, fd);
+    if (f->ndip < FREE_KNOWN)
+        f->dip_at[f->ndip] = *at, f->dip_f[f->ndip++] = *fat;
     return fmin(fc, fd) < -f->q->jtol;
 }
 
@@ -1142,13 +1167,13 @@ static int free_rule(free_ctx *f, double a, double b, double acc[Q_N])
             least = !(out >= 0.0 && out <= 1.0) || fabs(free_detj(f, out)) > fabs(g[i]);
         }
         if (i && sign_changes(g[last], g[i], q->jtol))
-            cut[ncut++] = illinois(free_detj, f, t[last], t[i], g[last], g[i]);
+            cut[ncut++] = free_root(f, t[last], t[i], g[last], g[i]);
         else if (least && !(i < m && sign_changes(g[i], g[i + 1], q->jtol))) {
             double at, fat;
             if (free_dip(f, t[i ? i - 1 : 0], t[i < m ? i + 1 : m], g[i] > 0 ? 1.0 : -1.0, &at, &fat)) {
                 const int l = at > t[i] ? i : i - 1, r = at < t[i] ? i : i + 1;
-                cut[ncut++] = illinois(free_detj, f, t[l], at, g[l], fat);
-                cut[ncut++] = illinois(free_detj, f, at, t[r], fat, g[r]);
+                cut[ncut++] = free_root(f, t[l], at, g[l], fat);
+                cut[ncut++] = free_root(f, at, t[r], fat, g[r]);
             }
         }
         if (fabs(g[i]) > q->jtol || fabs(g[last]) <= q->jtol)
@@ -1239,6 +1264,7 @@ static int free_solid(qctx *q, const qplan *p, int flat, int sa)
     for (int l = 0; l < p->np[2] && !poll(q); l++) {
         const double lo = p->edge[2][l], hi = p->edge[2][l + 1];
         double coarse[Q_N], acc[Q_N];
+        f.nroot = f.ndip = 0;
         free_rule(&f, lo, hi, coarse);
         if (q->jsign)
             memcpy(acc, coarse, sizeof acc);
