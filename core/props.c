@@ -257,12 +257,23 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
         if (nm == 0 && cs->nfterms == 0)
             continue;
         /* Per mode and sample: f_u, its fourth derivative, f_v, its fourth, h, its fourth; then per mode
-         * the products of the u- and v-factors of the three terms on the current (u, v). */
-        double *tab = malloc((6 * nm * n + 3 * nm + 1) * sizeof *tab);
+         * the products of the u- and v-factors of the three terms on the current (u, v). The force's
+         * terms likewise: each factor at the samples, and per term coef f_u f_v on the current (u, v)
+         * (pde_force's values, in its order, without its three factor evaluations a point). */
+        const size_t nf = cs->nfterms;
+        double *tab = malloc((6 * nm * n + 3 * nm + 3 * nf * n + nf + 1) * sizeof *tab);
         if (!tab)
             return PDE_ERR_NOMEM;
         double *fu = tab, *fu4 = fu + nm * n, *fv = fu4 + nm * n, *fv4 = fv + nm * n;
         double *h = fv4 + nm * n, *h4 = h + nm * n, *uv = h4 + nm * n;
+        double *pu = uv + 3 * nm, *pv = pu + nf * n, *pw = pv + nf * n, *puv = pw + nf * n;
+        for (size_t t = 0; t < nf; t++)
+            for (size_t i = 0; i < n; i++) {
+                const pde_fterm *ft = &cs->fterms[t];
+                pu[t * n + i] = factor_deriv(ft->u, (i + 0.5) / res, 0);
+                pv[t * n + i] = factor_deriv(ft->v, (i + 0.5) / res, 0);
+                pw[t * n + i] = factor_deriv(ft->w, (i + 0.5) / res, 0);
+            }
         for (size_t m = 0; m < nm; m++) {
             const pde_mode *md = &cs->modes[m];
             if (poll_after(pl, n * (4 + md->nterms * 8))) {
@@ -297,6 +308,8 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
                     const double a = fu[m * n + i], b = fv[m * n + j];
                     uv[3 * m] = fu4[m * n + i] * b, uv[3 * m + 1] = a * fv4[m * n + j], uv[3 * m + 2] = a * b;
                 }
+                for (size_t t = 0; t < nf; t++)
+                    puv[t] = cs->fterms[t].coef * pu[t * n + i] * pv[t * n + j];
                 for (size_t k = 0; k < n; k++) {
                     double tu = 0.0, tv = 0.0, tw = 0.0;
                     for (size_t m = 0; m < nm; m++) {
@@ -305,7 +318,9 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
                         tw += uv[3 * m + 2] * h4[m * n + k];
                     }
                     tu *= cs->a, tv *= cs->b, tw *= cs->c;
-                    double p = cs->nfterms ? pde_force(s, c, (i + 0.5) / res, (j + 0.5) / res, (k + 0.5) / res) : 0.0;
+                    double p = 0.0;
+                    for (size_t t = 0; t < nf; t++)
+                        p += puv[t] * pw[t * n + k];
                     err = max2(err, fabs(tu + tv + tw - p));
                     scale = max2(scale, max2(max2(fabs(tu), fabs(tv)), max2(fabs(tw), fabs(p))));
                 }

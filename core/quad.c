@@ -24,7 +24,9 @@
  * Where det J separates along u or v (quad_separate: det J = n t^p G), all of
  * this runs on the face t = 1 alone, the flat axis (n 0: one point, weight 1),
  * and the integrals over t are exact (separable_moments); so do the skin's
- * faces whose element separates too (face_separates). Where det J may change
+ * faces whose element separates too (face_separates). Where G = g(w) moreover
+ * (fig. 2, 4), the integrals over the face's other parameter are exact too,
+ * from the modes' moments, and only a rule along w is left (free_solid). Where det J may change
  * sign there, depends on both of the face's parameters, and the solid repeats
  * itself along the other one (param_symmetry, or turned about an axis:
  * param_rotation), one period of the face goes by rows of w instead of 2-D
@@ -1008,6 +1010,289 @@ static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
     panel_lines(q, b, k, definite, acc);
 }
 
+/*
+ * Where det J does not depend on the face's other parameter s (quad_sep's free, with few modes): on
+ * the face t = 1 det J = n G(w), and every integrand is |G| (or G) times 1, x_c or x_c x_d with x_c =
+ * sum_o F_o(s) H_o(w) over c's modes o (F_o: the mode's factors of t at 1 and of s). So the integrals
+ * over s are sums over the modes of exact moments, mom1[o] = int F_o ds and mom2[o][o'] = int F_o
+ * F_o' ds (the plan's rule along s, once), and what is left is 1-D in w: per point of w, h and h' of
+ * every mode, det J at one s, and a few multiply-adds per pair of modes (free_point). Along w, each
+ * panel's samples locate G's sign changes and dips through zero (as line_integrate's), each piece
+ * between them takes its own rule, and a panel is checked against its halves (free_span).
+ */
+#define FREE_MODES 48         /* modes at most for that path: its points cost a multiply-add per pair */
+#define FREE_SPAN_DEPTH 12    /* halvings of a w-panel where its halves disagree, at most */
+#define FREE_KNOWN 32         /* roots and dips remembered per w-panel */
+
+typedef struct {
+    qctx *q;
+    int flat, free;              /* the face's fixed axis t, and s */
+    size_t mt;
+    const int *comp;             /* each mode's component */
+    double *mom1, *mom2;         /* mt, mt x mt */
+    double *da, *ds, *dw;        /* det J's partials' coefficients at s0: F'_t F_s, F_t F'_s, F_t F_s */
+    double *h, *dh;              /* mt: the current point's h, h' */
+    /* The current w-panel's roots of G, and its dip searches' leasts (where G's sign at them), found
+     * by its coarse rule: its halves' brackets that hold one take it rather than search again. */
+    double root[FREE_KNOWN], dip_at[FREE_KNOWN], dip_f[FREE_KNOWN];
+    int nroot, ndip;
+} free_ctx;
+
+/* det J at w on the face (at s0), and into m[Q_N] the integrals over s of 1, x_c, x_c x_d at w. */
+static double free_point(free_ctx *f, double w, double m[Q_N])
+{
+    qctx *q = f->q;
+    solution_factors(q->s, 2, w, f->h, f->dh);
+    q->r.evals++;
+    double d[3][3] = { { 0 } };
+    for (size_t o = 0; o < f->mt; o++) {
+        const int c = f->comp[o];
+        d[f->flat][c] += f->da[o] * f->h[o], d[f->free][c] += f->ds[o] * f->h[o], d[2][c] += f->dw[o] * f->dh[o];
+    }
+    const double j = det3(d[0], d[1], d[2]);
+    if (!m)
+        return j;
+    for (int e = 0; e < Q_N; e++)
+        m[e] = 0.0;
+    m[Q_VOL] = 1.0;
+    for (size_t o = 0; o < f->mt; o++) {
+        const int c = f->comp[o];
+        const double ho = f->h[o], *row = f->mom2 + o * f->mt;
+        m[Q_M1 + c] += f->mom1[o] * ho;
+        for (size_t p = 0; p < f->mt; p++) {   /* each pair (c <= d) once: o's component first */
+            const int cd = f->comp[p];
+            if (cd < c)
+                continue;
+            const double v = row[p] * ho * f->h[p];
+            if (cd == c)
+                m[Q_M2 + c] += v;
+            else
+                m[Q_M2 + (c == 0 ? (cd == 1 ? 3 : 4) : 5)] += v;
+        }
+    }
+    return j;
+}
+
+static double free_detj(void *arg, double w)
+{
+    free_ctx *f = arg;
+    f->q->off_evals++;
+    return free_point(f, w, NULL);
+}
+
+/* Adds |j| wt times m (and j wt to the signed volume) into acc. */
+static void free_add(double acc[Q_N], const double m[Q_N], double j, double wt)
+{
+    const double a = wt * fabs(j);
+    for (int e = 0; e < Q_SIGNED; e++)
+        acc[e] += a * m[e];
+    acc[Q_SIGNED] += wt * j;
+}
+
+/* [a, b], a piece of w between G's roots, with a rule sized to it. */
+static void free_gauss(free_ctx *f, double a, double b, double acc[Q_N])
+{
+    const int n = axis_points(f->q, 2, b - a);
+    for (int i = 0; i < n; i++) {
+        double m[Q_N];
+        const double j = free_point(f, a + (b - a) * f->q->gx[n][i], m);
+        free_add(acc, m, j, (b - a) * f->q->gw[n][i]);
+    }
+}
+
+/* G's root in [a, b], where ga and gb have opposite signs: one the panel's coarse rule located
+ * inside (a, b), else by Illinois (and remembered). */
+static double free_root(free_ctx *f, double a, double b, double ga, double gb)
+{
+    for (int i = 0; i < f->nroot; i++)
+        if (f->root[i] > a && f->root[i] < b)
+            return f->root[i];
+    const double r = illinois(free_detj, f, a, b, ga, gb);
+    if (f->nroot < FREE_KNOWN)
+        f->root[f->nroot++] = r;
+    return r;
+}
+
+/* The extreme of sign * G between t0 and t2 by golden section, as line_dip; 1 when it crosses 0. */
+static int free_dip(free_ctx *f, double t0, double t2, double sign, double *at, double *fat)
+{
+    for (int i = 0; i < f->ndip; i++)
+        if (f->dip_at[i] > t0 && f->dip_at[i] < t2) {
+            *at = f->dip_at[i], *fat = f->dip_f[i];
+            return sign * *fat < -f->q->jtol;
+        }
+    const double g = 0.5 * (3.0 - sqrt(5.0));
+    double a = t0, b = t2;
+    double c = a + g * (b - a), d = b - g * (b - a);
+    double fc = sign * free_detj(f, c), fd = sign * free_detj(f, d);
+    for (int it = 0; it < 40 && b - a > 1e-9 * (t2 - t0); it++) {
+        if (fc < fd) {
+            b = d, d = c, fd = fc;
+            c = a + g * (b - a);
+            fc = sign * free_detj(f, c);
+        } else {
+            a = c, c = d, fc = fd;
+            d = b - g * (b - a);
+            fd = sign * free_detj(f, d);
+        }
+        if (fmin(fc, fd) < -f->q->jtol)
+            break;
+    }
+    *at = fc < fd ? c : d;
+    *fat = sign * fmin(fc, fd);
+    if (f->ndip < FREE_KNOWN)
+        f->dip_at[f->ndip] = *at, f->dip_f[f->ndip++] = *fat;
+    return fmin(fc, fd) < -f->q->jtol;
+}
+
+/* The panel [a, b] of w: G at its ends and rule's nodes, its sign changes and dips located, and each
+ * piece between them with its own rule (none: the nodes are the rule). Returns the roots found. */
+static int free_rule(free_ctx *f, double a, double b, double acc[Q_N])
+{
+    qctx *q = f->q;
+    const int n = axis_points(q, 2, b - a), m = n + 1;
+    double t[GMAX + 2], g[GMAX + 2], mv[GMAX + 2][Q_N], cut[2 * GMAX + 4];
+    memset(acc, 0, Q_N * sizeof *acc);
+    t[0] = a, t[m] = b;
+    for (int i = 1; i <= n; i++)
+        t[i] = a + (b - a) * q->gx[n][i - 1];
+    for (int i = 0; i <= m; i++)
+        g[i] = free_point(f, t[i], i && i < m ? mv[i] : NULL);
+    int ncut = 0, last = 0;
+    for (int i = 0; i <= m && !q->jsign && off_budget(q); i++) {
+        /* A least |G| among the samples, the panel's ends included: a lobe next to a panel's edge,
+         * where |G| is least, has samples on one side only in each panel. An end counts where |G|
+         * grows beyond it too (a sample as far outside, none beyond [0, 1]), not on a slope. */
+        int least = fabs(g[i]) > q->jtol && (i == 0 || fabs(g[i]) <= fabs(g[i - 1])) &&
+                    (i == m || fabs(g[i]) < fabs(g[i + 1]));
+        if (least && (i == 0 || i == m)) {
+            const double out = i ? 2 * t[m] - t[m - 1] : 2 * t[0] - t[1];
+            least = !(out >= 0.0 && out <= 1.0) || fabs(free_detj(f, out)) > fabs(g[i]);
+        }
+        if (i && sign_changes(g[last], g[i], q->jtol))
+            cut[ncut++] = free_root(f, t[last], t[i], g[last], g[i]);
+        else if (least && !(i < m && sign_changes(g[i], g[i + 1], q->jtol))) {
+            double at, fat;
+            if (free_dip(f, t[i ? i - 1 : 0], t[i < m ? i + 1 : m], g[i] > 0 ? 1.0 : -1.0, &at, &fat)) {
+                const int l = at > t[i] ? i : i - 1, r = at < t[i] ? i : i + 1;
+                cut[ncut++] = free_root(f, t[l], at, g[l], fat);
+                cut[ncut++] = free_root(f, at, t[r], fat, g[r]);
+            }
+        }
+        if (fabs(g[i]) > q->jtol || fabs(g[last]) <= q->jtol)
+            last = i;
+    }
+    if (!ncut) {
+        for (int i = 1; i <= n; i++)
+            free_add(acc, mv[i], g[i], (b - a) * q->gw[n][i - 1]);
+        return 0;
+    }
+    double t0 = a;
+    for (int c = 0; c < ncut; c++)
+        if (cut[c] > t0) {
+            free_gauss(f, t0, cut[c], acc);
+            t0 = cut[c];
+        }
+    free_gauss(f, t0, b, acc);
+    return ncut;
+}
+
+/* [a, b] against its two halves, each refined the same way where they differ by more than ROW_TOL of
+ * the volume, down to FREE_SPAN_DEPTH halvings. */
+static void free_span(free_ctx *f, double a, double b, const double coarse[Q_N], int depth, double out[Q_N])
+{
+    qctx *q = f->q;
+    const double mid = 0.5 * (a + b);
+    double half[2][Q_N];
+    free_rule(f, a, mid, half[0]);
+    free_rule(f, mid, b, half[1]);
+    const double fine = half[0][Q_VOL] + half[1][Q_VOL];
+    const int agreed = fabs(fine - coarse[Q_VOL]) <= ROW_TOL * q->vscale;
+    if (agreed || depth + 1 >= FREE_SPAN_DEPTH || poll(q) || q->r.evals * q->modes >= REFINE_WORK) {
+        if (!agreed)
+            q->r.refine_left += fabs(fine - coarse[Q_VOL]);
+        for (int e = 0; e < Q_N; e++)
+            out[e] = half[0][e] + half[1][e];
+        return;
+    }
+    double o[2][Q_N];
+    free_span(f, a, mid, half[0], depth + 1, o[0]);
+    free_span(f, mid, b, half[1], depth + 1, o[1]);
+    for (int e = 0; e < Q_N; e++)
+        out[e] = o[0][e] + o[1][e];
+}
+
+/* The face t = 1 where G = g(w) (quad_sep's free): 1-D along w, as above. Returns 0 (nothing done)
+ * where it has too many modes for the moments of pairs, or out of memory. */
+static int free_solid(qctx *q, const qplan *p, int flat, int sa)
+{
+    const size_t mt = q->mt;
+    if (mt == 0 || mt > FREE_MODES)
+        return 0;
+    double *buf = malloc((2 * mt * mt + 11 * mt) * sizeof *buf);
+    int *comp = malloc(mt * sizeof *comp);
+    if (!buf || !comp) {
+        free(buf);
+        free(comp);
+        return 0;
+    }
+    free_ctx f = { .q = q, .flat = flat, .free = sa, .mt = mt, .comp = comp };
+    f.mom2 = buf, f.mom1 = buf + mt * mt, f.da = f.mom1 + mt, f.ds = f.da + mt, f.dw = f.ds + mt;
+    f.h = f.dw + mt, f.dh = f.h + mt;
+    double *ft = f.dh + mt, *dft = ft + mt, *fs = dft + mt, *dfs = fs + mt, *abs2 = dfs + mt, *abs1 = abs2 + mt * mt;
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < q->s->comp[c].nmodes; m++)
+            comp[q->off[c] + m] = c;
+    solution_factors(q->s, flat, 1.0, ft, dft);
+    /* det J's coefficients at s0 = 1/2: G is the same at every s */
+    solution_factors(q->s, sa, 0.5, fs, dfs);
+    for (size_t o = 0; o < mt; o++)
+        f.da[o] = dft[o] * fs[o], f.ds[o] = ft[o] * dfs[o], f.dw[o] = ft[o] * fs[o];
+    /* The moments over s with the plan's panels and rule along it (exact to 1e-14 on five factors). */
+    memset(buf, 0, (mt * mt + mt) * sizeof *buf);
+    memset(abs2, 0, (mt * mt + mt) * sizeof *abs2);
+    for (int i = 0; i < p->np[sa]; i++) {
+        const double lo = p->edge[sa][i], h = p->edge[sa][i + 1] - lo;
+        const int n = p->n[sa];
+        for (int k = 0; k < n; k++) {
+            const double wt = h * q->gw[n][k];
+            solution_factors(q->s, sa, lo + h * q->gx[n][k], fs, dfs);
+            for (size_t o = 0; o < mt; o++) {
+                const double a = ft[o] * fs[o];
+                f.mom1[o] += wt * a, abs1[o] += wt * fabs(a);
+                for (size_t r = 0; r < mt; r++) {
+                    const double b = wt * a * ft[r] * fs[r];
+                    f.mom2[o * mt + r] += b, abs2[o * mt + r] += fabs(b);
+                }
+            }
+        }
+    }
+    /* A moment within the rule's error (1e-14 of its factors' size) of 0 is 0, as the integral of
+     * sin 2 pi v is: fig. 2 and 4's centroids on the axis and products of inertia about it exact. */
+    for (size_t o = 0; o < mt * mt + mt; o++)
+        if (fabs(buf[o]) <= 1e-14 * abs2[o])
+            buf[o] = 0.0;
+    for (int l = 0; l < p->np[2] && !poll(q); l++) {
+        const double lo = p->edge[2][l], hi = p->edge[2][l + 1];
+        double coarse[Q_N], acc[Q_N];
+        f.nroot = f.ndip = 0;
+        free_rule(&f, lo, hi, coarse);
+        if (q->jsign)
+            memcpy(acc, coarse, sizeof acc);
+        else {
+            q->r.lined++;
+            free_span(&f, lo, hi, coarse, 0, acc);
+            q->r.refined++;
+            q->r.refine_change += fabs(acc[Q_VOL] - coarse[Q_VOL]);
+        }
+        for (int e = 0; e < Q_N; e++)
+            q->r.acc[e] += acc[e];
+    }
+    free(buf);
+    free(comp);
+    return 1;
+}
+
 static void panel(qctx *q, const pbox *b)
 {
     if (q->free >= 0) {
@@ -1601,9 +1886,11 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
      * solid repeats itself, or half of one mirrored: the rest by symmetry (sym_moments). A reflection
      * or half-turn (param_symmetry) where the period is a whole number of panels; else, where the face
      * is integrated by rows (face_rows), a rotation (param_rotation), with the period's own panels. */
+    /* G = g(w): 1-D along w over the whole face, no period needed */
+    const int one_d = q->free >= 0 && free_solid(q, &p, sp.axis, q->free);
     qsym sy = { .k = 0 };
     const int folds = sp.axis >= 0 && q->free < 0 && !jsign;   /* on the face, G depending on both */
-    for (int t = 0; t < 2 && sp.axis >= 0 && separate != 3 && !sy.k; t++) {
+    for (int t = 0; t < 2 && sp.axis >= 0 && separate != 3 && !sy.k && !one_d; t++) {
         int sd[3], sm[3], per;
         if (t != sp.axis && (per = param_symmetry(s, t, sd, sm)) > 1 && p.np[t] % per == 0) {
             sy = (qsym){ .t = t, .k = per, .half = sm[0] && p.np[t] % (2 * per) == 0 ? 2 : 1 };
@@ -1623,7 +1910,9 @@ pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, 
     /* By rows over a period; without one (an odd n_xy of fig. 3a), by the face's boxes: whole lines
      * of its other parameter exhaust OFF_WORK where it is fast (fig. 3a at n_xy = 25: 2.1 M points off
      * the tables, 0.01 reported), except in the tests (separate 2, 3). */
-    if (folds && (sy.k || separate >= 2))
+    if (one_d)
+        (void)0;
+    else if (folds && (sy.k || separate >= 2))
         face_rows(q, &p, 1 - sp.axis);
     else
         for (int i = 0; i < p.np[0]; i++)

@@ -1923,6 +1923,108 @@ static void harm_face_should_match_the_general_path_and_the_reference_on_presets
     }
 }
 
+/*
+ * core/quad.c free_solid: where det J = n t^p g(w) (quad_sep's free), the integrals are 1-D along w
+ * (exact moments over v). Against the independent quadrature (ref_props: lines along w with every
+ * least of |det J| searched) to 1e-10, on fig. 4a's closed form with z's cubic replaced so that g has
+ * two roots, a double root (g touches 0), a lobe 6e-4 wide between a panel's edge (w = 1/2, where |g|
+ * is least among the samples) and its first node, and one 2e-3 wide inside a panel (w = 0.55); and
+ * with x's and y's factors of v replaced by the other pairs of constant Wronskian (sinh and cosh,
+ * exp(+-2v), 1 and v). Missing either lobe costs 1e-9 to 1e-7 of the volume.
+ */
+static void free_integrals_should_match_the_reference_on_folds_lobes_and_every_wronskian_pair(void **state)
+{
+    (void)state;
+    static const double zs[][4] = {
+        { 0, 0.56, -1.5, 1 },                     /* z' = 3 w^2 - 3 w + 0.56: roots 0.248, 0.752 */
+        { 0, 0.75, -1.5, 1 },                     /* z' = 3 (w - 1/2)^2 */
+        { 0, 3 * 0.5004 * 0.5004 - 2.7e-7, -3 * 0.5004, 1 },   /* z' = 3 (w - 0.5004)^2 - 2.7e-7 */
+        { 0, 3 * 0.55 * 0.55 - 3e-6, -3 * 0.55, 1 },
+    };
+    static const pde_factor pairs[][2] = {
+        { { PDE_SIN, 2 }, { PDE_COS, 2 } },   /* fig. 4a's own */
+        { { PDE_SINH, 3 }, { PDE_COSH, 3 } },
+        { { PDE_EXP, 2 }, { PDE_EXP, -2 } },
+        { { PDE_POW, 0 }, { PDE_POW, 1 } },
+    };
+    for (size_t k = 0; k < sizeof zs / sizeof *zs + sizeof pairs / sizeof *pairs - 1; k++) {
+        pde_solution *sol = preset_solution("fig4a");
+        pde_wterm *zt = (pde_wterm *)&sol->comp[2].modes[0].terms[0];
+        const double *keep = zt->A;
+        assert_int_equal(zt->deg, 3);
+        if (k < sizeof zs / sizeof *zs)
+            zt->A = zs[k];
+        else   /* x, y: one mode of each factor of the pair (fig. 4a: sin, cos) */
+            for (int c = 0; c < 2; c++)
+                for (int m = 0; m < 2; m++) {
+                    pde_mode *md = &sol->comp[c].modes[m];
+                    md->v = pairs[k - sizeof zs / sizeof *zs + 1][md->v.kind == PDE_COS];
+                }
+        quad_sep sp;
+        quad_separate(sol, &sp);
+        assert_int_equal(sp.free, 1);
+        double jscale = 0.0;
+        for (int i = 0; i <= 40; i++)
+            jscale = fmax(jscale, fabs(pde_eval_detj(sol, 1.0, 0.3, i / 40.0)));
+        quad_result q;
+        const double x0[3] = { 0, 0, 0 };
+        assert_int_equal(quad_solid(sol, x0, jscale, jscale, 1, 0, NULL, &q), PDE_OK);
+        ref_props_out ref;
+        assert_int_equal(ref_props(sol, &ref), 0);
+        assert_true(ref.converged);
+        const double V = q.acc[Q_VOL], size = cbrt(fabs(V)) + 1.0, tol = 1e-10;
+        double d[3], S[3][3];
+        static const int pi[6] = { 0, 1, 2, 0, 0, 1 }, pj[6] = { 0, 1, 2, 1, 2, 2 };
+        for (int i = 0; i < 3; i++)
+            d[i] = q.acc[Q_M1 + i] / V;
+        for (int e = 0; e < 6; e++)
+            S[pi[e]][pj[e]] = S[pj[e]][pi[e]] = q.acc[Q_M2 + e] - V * d[pi[e]] * d[pj[e]];
+        print_message("case %zu: volume %.15g (reference %.15g), signed %.15g (%.15g)\n", k, V, ref.volume,
+                      q.acc[Q_SIGNED], ref.signed_volume);
+        if (!(fabs(V - ref.volume) <= tol * ref.volume && fabs(q.acc[Q_SIGNED] - ref.signed_volume) <= tol * ref.volume))
+            fail_msg("case %zu: volume %.17g, signed %.17g; reference %.17g, %.17g", k, V, q.acc[Q_SIGNED],
+                     ref.volume, ref.signed_volume);
+        for (int i = 0; i < 3; i++) {
+            if (!(fabs(d[i] - ref.centroid[i]) <= tol * size))
+                fail_msg("case %zu: centroid %d %.17g, reference %.17g", k, i, d[i], ref.centroid[i]);
+            for (int j = 0; j < 3; j++) {
+                const double in = (i == j ? S[0][0] + S[1][1] + S[2][2] : 0.0) - S[i][j];
+                if (!(fabs(in - ref.inertia[i][j]) <= tol * ref.volume * size * size))
+                    fail_msg("case %zu: inertia %d%d %.17g, reference %.17g", k, i, j, in, ref.inertia[i][j]);
+            }
+        }
+        zt->A = keep;
+        pde_solution_free(sol);
+    }
+}
+
+/* The 1-D path against the face's rows (quad_solid's separate 2), with det J's sign certified and not,
+ * on the presets of fig. 2 and 4 that the other tests compare with the cube's integrals least. */
+static void free_integrals_should_equal_the_face_rows_on_fig2_and_fig4(void **state)
+{
+    (void)state;
+    static const char *const names[] = { "fig2a", "fig2b", "fig4c", "fig4e", "fig4l", "fig4t" };
+    for (size_t k = 0; k < sizeof names / sizeof *names; k++) {
+        pde_solution *sol = preset_solution(names[k]);
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        const double x0[3] = { 0.1, -0.2, 0.7 }, jscale = fmax(fabs(p.detj_min_found), fabs(p.detj_max_found));
+        const int jsign = p.detj_min >= 0.0 ? 1 : p.detj_max <= 0.0 ? -1 : 0;
+        quad_result one, face, signed_one;
+        assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 1, 0, NULL, &one), PDE_OK);
+        assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 2, 0, NULL, &face), PDE_OK);
+        assert_int_equal(quad_solid(sol, x0, jscale, p.volume, 1, jsign, NULL, &signed_one), PDE_OK);
+        const double size = cbrt(p.volume) + 1.0;
+        for (int e = 0; e < Q_N; e++) {
+            const double scale = p.volume * (e == Q_VOL || e == Q_SIGNED ? 1.0 : e < Q_M2 ? size : size * size);
+            if (!(fabs(one.acc[e] - face.acc[e]) <= 1e-12 * scale && fabs(signed_one.acc[e] - face.acc[e]) <= 1e-12 * scale))
+                fail_msg("%s: integral %d: %.17g along w (%.17g with det J's sign %d), %.17g over the face", names[k],
+                         e, one.acc[e], signed_one.acc[e], jsign, face.acc[e]);
+        }
+        pde_solution_free(sol);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1964,6 +2066,8 @@ int main(void)
         cmocka_unit_test(harmonic_extremes_should_match_the_general_path_on_figures_2_and_4),
         cmocka_unit_test(harmonic_extremes_should_hold_a_dense_sampling_of_stress_models),
         cmocka_unit_test(harm_face_should_match_the_general_path_and_the_reference_on_presets_and_stress_models),
+        cmocka_unit_test(free_integrals_should_match_the_reference_on_folds_lobes_and_every_wronskian_pair),
+        cmocka_unit_test(free_integrals_should_equal_the_face_rows_on_fig2_and_fig4),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
