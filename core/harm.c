@@ -12,6 +12,7 @@
  * s2 = k pi (A x A' - B x B') / 2; |x_t x x_w|^2 from their dot products, nine Fourier coefficients,
  * and the flux's mean D . c0 + (A . s1 + B . c1) / 2 exactly.
  */
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
@@ -331,12 +332,15 @@ static double least_at(harm_ctx *H, double w)
     return m;
 }
 
-/* By golden section: where the element's least over theta is least in [a, b]. */
+/* By golden section: where the element's least over theta is least in [a, b]. To DIP_EPS of the interval, or
+ * a few ulps of w where the interval is too short for that (nested pieces of a dip: below about 1e-9 it never
+ * ended), and in at most DIP_STEPS steps (DIP_EPS takes 34). */
+#define DIP_STEPS 48
 static double dip_place(harm_ctx *H, double a, double b)
 {
-    const double g = 0.5 * (3.0 - sqrt(5.0)), len = b - a;
+    const double g = 0.5 * (3.0 - sqrt(5.0)), len = b - a, stop = fmax(DIP_EPS * len, 4.0 * DBL_EPSILON * fabs(b));
     double c = a + g * (b - a), d = b - g * (b - a), fc = least_at(H, c), fd = least_at(H, d);
-    while (b - a > DIP_EPS * len) {
+    for (int it = 0; b - a > stop && it < DIP_STEPS; it++) {
         if (fc < fd) {
             b = d, d = c, fd = fc;
             c = a + g * (b - a);

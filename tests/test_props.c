@@ -2025,6 +2025,31 @@ static void free_integrals_should_equal_the_face_rows_on_fig2_and_fig4(void **st
     }
 }
 
+/*
+ * A fig. 4-like solid with boundary layers (c = 0.02, 0.003, 1) whose face u = 1 dips in nested pieces of w
+ * (review): core/harm.c's golden section for a dip's place asked for 1e-7 of a piece shorter than about 1e-9,
+ * below an ulp of w, and never ended (a solver thread lost past --job-timeout and SIGTERM). Its properties
+ * now end, and match the reference.
+ */
+static void a_dip_in_a_piece_shorter_than_an_ulp_should_end(void **state)
+{
+    (void)state;
+    static const char doc[] = "{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[0.02,0.003,1]},\"boundary\":{\"x\":[{\"w0\":1,\"dw0\":-20,\"w1\":0.01,\"dw1\":30,\"u\":{\"pow\":1},\"v\":{\"sin\":2}},{\"w0\":0.01,\"dw0\":40,\"w1\":2,\"dw1\":0,\"u\":{\"pow\":1},\"v\":{\"cos\":2}}],\"y\":[{\"w0\":0.3,\"dw0\":10,\"w1\":1,\"dw1\":-50,\"u\":{\"pow\":1},\"v\":{\"cos\":2}},{\"w0\":-1,\"dw0\":0,\"w1\":0.2,\"dw1\":9,\"u\":{\"pow\":1},\"v\":{\"sin\":2}}],\"z\":[{\"w0\":0,\"dw0\":-5,\"w1\":1,\"dw1\":30}]},\"force\":{\"x\":[{\"coef\":-50000,\"u\":{\"pow\":1},\"v\":{\"cos\":2},\"w\":{\"cos\":9}}],\"y\":[{\"coef\":30000,\"u\":{\"pow\":1},\"v\":{\"sin\":2},\"w\":{\"sin\":3}}]}}";
+    api_error err;
+    api_model *m = api_model_parse(doc, sizeof doc - 1, &err);
+    assert_non_null(m);
+    pde_solution *sol = NULL;
+    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
+    api_model_free(m);
+    pde_props p;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    ref_props_out r;
+    assert_int_equal(ref_props(sol, &r), 0);
+    assert_rel(p.surface_area, r.surface_area, 1e-9, 0);
+    assert_rel(p.volume, r.volume, 1e-9, 0);
+    pde_solution_free(sol);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -2068,6 +2093,7 @@ int main(void)
         cmocka_unit_test(harm_face_should_match_the_general_path_and_the_reference_on_presets_and_stress_models),
         cmocka_unit_test(free_integrals_should_match_the_reference_on_folds_lobes_and_every_wronskian_pair),
         cmocka_unit_test(free_integrals_should_equal_the_face_rows_on_fig2_and_fig4),
+        cmocka_unit_test(a_dip_in_a_piece_shorter_than_an_ulp_should_end),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
