@@ -32,6 +32,9 @@
 #define GRADE 0.45      /* a dip in theta: pieces graded towards its least value, each this of the distance left */
 #define GRADE_LEVELS 60 /* ... this many at most, */
 #define PIECE_MAX 0.5   /* ... none wider than this (a wide dip's) */
+#define U_LEVELS 2      /* ... or, where its width is known, this many such pieces, */
+#define U_NEAR 8.0      /* ... while the distance left is above this of the width, */
+#define U_WIDTH 2.0     /* ... and the rest in panels of u (s = width sinh u) this wide */
 #define DIP 0.05        /* a panel of w that fails its halves with the element below this of its largest */
 #define DIP_EPS 1e-7    /* ... is cut at the least place, located to this of the panel, */
 #define W_GRADE 0.1     /* ... and graded towards it, each piece this of the distance left, */
@@ -151,6 +154,34 @@ static double least(const trig4 *q, double lo, double hi, double *d2)
     return x;
 }
 
+/* The element at c + t, cos c = cb and sin c = sb, |t| <= PIECE_MAX: cos and sin of t by their series */
+static double elem_off(const trig4 *q, double cb, double sb, double t)
+{
+    const double t2 = t * t;
+    const double ct = 1.0 - t2 / 2 * (1.0 - t2 / 12 * (1.0 - t2 / 30 * (1.0 - t2 / 56 * (1.0 - t2 / 90 *
+                      (1.0 - t2 / 132 * (1.0 - t2 / 182))))));
+    const double st = t * (1.0 - t2 / 6 * (1.0 - t2 / 20 * (1.0 - t2 / 42 * (1.0 - t2 / 72 * (1.0 - t2 / 110 *
+                      (1.0 - t2 / 156 * (1.0 - t2 / 210)))))));
+    return elem_cs(q, cb * ct - sb * st, sb * ct + cb * st);
+}
+
+/* [c + lo, c + d] (offsets of either sign) by the rule, in pieces no wider than PIECE_MAX (a wide
+ * dip's: the rest of theta too); one sin and cos a piece, at its start */
+static double span(const harm_opts *o, const trig4 *q, double c, double lo, double d)
+{
+    const int np = (int)ceil(fabs(d - lo) / PIECE_MAX);
+    const double len = (d - lo) / np;
+    double sum = 0.0;
+    for (int p = 0; p < np; p++) {
+        const double t0 = c + lo + len * p, cb = cos(t0), sb = sin(t0);
+        double piece = 0.0;
+        for (int i = 0; i < o->n; i++)
+            piece += o->wt[i] * elem_off(q, cb, sb, len * o->x[i]);
+        sum += fabs(len) * piece;
+    }
+    return sum;
+}
+
 /*
  * Near a least value m at c, the element is about sqrt(m^2 + kappa^2 (theta - c)^2): smooth only on
  * the scale m / kappa. So from far to c, pieces graded geometrically, each GRADE of the distance
@@ -163,28 +194,42 @@ static double toward(const harm_opts *o, const trig4 *q, double far, double c, d
     double sum = 0.0, d = far - c;
     for (int k = 0; k <= GRADE_LEVELS; k++, d *= GRADE) {
         const int last = k == GRADE_LEVELS || !(fabs(d) > fmax(0.25 * scale, 1e-7));
-        const double lo = last ? 0.0 : GRADE * d;
-        const int np = (int)ceil(fabs(d - lo) / PIECE_MAX);   /* a wide dip's pieces: the rest of theta too */
-        const double len = (d - lo) / np;
-        for (int p = 0; p < np; p++) {
-            /* cos and sin at the piece's start, and of each point's offset from it (at most PIECE_MAX)
-             * by their series: one sin and cos a piece */
-            const double t0 = c + lo + len * p, cb = cos(t0), sb = sin(t0);
-            double piece = 0.0;
-            for (int i = 0; i < o->n; i++) {
-                const double t = len * o->x[i], t2 = t * t;
-                const double ct = 1.0 - t2 / 2 * (1.0 - t2 / 12 * (1.0 - t2 / 30 * (1.0 - t2 / 56 * (1.0 - t2 / 90 *
-                                  (1.0 - t2 / 132 * (1.0 - t2 / 182))))));
-                const double st = t * (1.0 - t2 / 6 * (1.0 - t2 / 20 * (1.0 - t2 / 42 * (1.0 - t2 / 72 * (1.0 - t2 / 110 *
-                                  (1.0 - t2 / 156 * (1.0 - t2 / 210)))))));
-                piece += o->wt[i] * elem_cs(q, cb * ct - sb * st, sb * ct + cb * st);
-            }
-            sum += fabs(len) * piece;
-        }
+        sum += span(o, q, c, last ? 0.0 : GRADE * d, d);
         if (last)
             break;
     }
     return sum;
+}
+
+/*
+ * The same integral where the dip's width scale = m / kappa > 0 is known: its first U_LEVELS pieces
+ * graded as there (the element's other branch points, O(far - c) away, are left as far behind),
+ * the rest, [c, c + d], by s = scale sinh u (theta = c + s), which takes sqrt(m^2 + kappa^2 s^2) ds
+ * to m scale cosh^2 u du, entire: the element's branch points near c +- i scale go to u near
+ * +- i pi / 2, so panels of u U_WIDTH wide keep the rule's error near rho^-2n, rho = 3.4, and u runs
+ * only to asinh(|d| / scale), where the graded pieces took log(4 |d| / scale) / log(1 / GRADE) of
+ * them. One exp a point.
+ */
+static double toward_sinh(const harm_opts *o, const trig4 *q, double far, double c, double scale)
+{
+    double d = far - c, sum = 0.0;
+    for (int k = 0; k < U_LEVELS && fabs(d) > U_NEAR * scale; k++, d *= GRADE)
+        sum += span(o, q, c, GRADE * d, d);
+    if (fabs(d) > PIECE_MAX)
+        return sum + toward(o, q, c + d, c, scale);
+    const double sg = d < 0.0 ? -1.0 : 1.0, U = asinh(fabs(d) / scale), cb = cos(c), sb = sin(c);
+    const int np = (int)ceil(U / U_WIDTH);
+    double in = 0.0;
+    for (int p = 0; p < np; p++) {
+        const double lo = U * p / np, hi = U * (p + 1) / np;
+        double piece = 0.0;
+        for (int i = 0; i < o->n; i++) {
+            const double u = lo + (hi - lo) * o->x[i], e = exp(u);
+            piece += o->wt[i] * 0.5 * (e + 1.0 / e) * elem_off(q, cb, sb, sg * scale * 0.5 * (e - 1.0 / e));
+        }
+        in += (hi - lo) * piece;
+    }
+    return sum + scale * in;
 }
 
 /* The least of the samples e[0, stride, ...] is under half its neighbours: a dip narrower than
@@ -250,7 +295,8 @@ static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
         const int k = (j + 1) % ncut;
         const double a = cut[j], b = j + 1 < ncut ? cut[j + 1] : cut[0] + period, mid = 0.5 * (a + b);
         if (b > a)
-            total += toward(o, q, mid, a, scale[j]) + toward(o, q, mid, b, scale[k]);
+            total += (scale[j] > 0.0 ? toward_sinh : toward)(o, q, mid, a, scale[j]) +
+                     (scale[k] > 0.0 ? toward_sinh : toward)(o, q, mid, b, scale[k]);
     }
     return total / period;
 }
@@ -265,6 +311,24 @@ static void cross(const double a[3], const double b[3], double s, double *out)
 static double dot(const double *a, const double *b)
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* |x_t x x_w|^2's coefficients into q from x_t x x_w's, q->v */
+static void square(trig4 *q)
+{
+    const double (*v)[3] = (const double (*)[3])q->v;
+    double g[5][5];
+    for (int i = 0; i < 5; i++)
+        for (int j = i; j < 5; j++)
+            g[i][j] = dot(v[i], v[j]);
+    const double a[5] = { g[0][0] + 0.5 * (g[1][1] + g[2][2] + g[3][3] + g[4][4]), 2.0 * g[0][1] + g[1][3] + g[2][4],
+                          2.0 * g[0][3] + 0.5 * (g[1][1] - g[2][2]), g[1][3] - g[2][4], 0.5 * (g[3][3] - g[4][4]) };
+    const double b[5] = { 0.0, 2.0 * g[0][2] + g[1][4] - g[2][3], 2.0 * g[0][4] + g[1][2], g[1][4] + g[2][3], g[3][4] };
+    memcpy(q->a, a, sizeof a), memcpy(q->b, b, sizeof b);
+    /* Odd harmonics come from D' alone (c1, s1); below rounding, the period is pi. */
+    q->odd = !(fabs(a[1]) + fabs(b[1]) + fabs(a[3]) + fabs(b[3]) <= 1e-15 * a[0]);
+    if (!q->odd)
+        q->a[1] = q->b[1] = q->a[3] = q->b[3] = 0.0;
 }
 
 /* The section at w: x_t x x_w's coefficients and its square's into q; the flux's mean over theta,
@@ -285,19 +349,19 @@ static double section(harm_ctx *H, double w, trig4 *q)
     cross(A, Ap, s, v[4]), cross(B, Bp, s, t);
     for (int c = 0; c < 3; c++)
         v[4][c] -= t[c];
-    double g[5][5];
-    for (int i = 0; i < 5; i++)
-        for (int j = i; j < 5; j++)
-            g[i][j] = dot(v[i], v[j]);
-    const double a[5] = { g[0][0] + 0.5 * (g[1][1] + g[2][2] + g[3][3] + g[4][4]), 2.0 * g[0][1] + g[1][3] + g[2][4],
-                          2.0 * g[0][3] + 0.5 * (g[1][1] - g[2][2]), g[1][3] - g[2][4], 0.5 * (g[3][3] - g[4][4]) };
-    const double b[5] = { 0.0, 2.0 * g[0][2] + g[1][4] - g[2][3], 2.0 * g[0][4] + g[1][2], g[1][4] + g[2][3], g[3][4] };
-    memcpy(q->a, a, sizeof a), memcpy(q->b, b, sizeof b);
-    /* Odd harmonics come from D' alone (c1, s1); below rounding, the period is pi. */
-    q->odd = !(fabs(a[1]) + fabs(b[1]) + fabs(a[3]) + fabs(b[3]) <= 1e-15 * a[0]);
-    if (!q->odd)
-        q->a[1] = q->b[1] = q->a[3] = q->b[3] = 0.0;
+    square(q);
     return dot(D, v[0]) + 0.5 * (dot(A, v[2]) + dot(B, v[1]));
+}
+
+double harm_mean(const double v[5][3], const double *x, const double *wt, int n)
+{
+    const harm_opts o = { .x = x, .wt = wt, .n = n };
+    trig4 q;
+    double dip;
+    memcpy(q.v, v, sizeof q.v);
+    square(&q);
+    pthread_once(&trig_once, trig_init);
+    return elem_mean(&o, &q, &dip);
 }
 
 /* At w: val[0] the element's mean over theta, val[1] the flux's; the least of the element over its

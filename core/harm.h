@@ -41,4 +41,9 @@ typedef struct {
 int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, double *area, double *flux,
               size_t *nodes);
 
+/* The mean over theta of |v[0] + v[1] cos theta + v[2] sin theta + v[3] cos 2 theta + v[4] sin 2 theta|,
+ * as harm_face takes it at a point of w (x, wt: its n-point Gauss-Legendre rule on [0, 1]); for the
+ * tests. Reentrant. */
+double harm_mean(const double v[5][3], const double *x, const double *wt, int n);
+
 #endif

@@ -2050,6 +2050,102 @@ static void a_dip_in_a_piece_shorter_than_an_ulp_should_end(void **state)
     pde_solution_free(sol);
 }
 
+/*
+ * core/harm.c's mean over theta where the element dips (harm_mean, as harm_face takes it at each w):
+ * against closed forms, |m e_z + kappa sin(theta - theta0) e_x| = sqrt(m^2 + kappa^2 sin^2(theta -
+ * theta0)), whose mean is (2 / pi) M E(kappa^2 / M^2), M^2 = m^2 + kappa^2, and an ellipse's |x_theta|
+ * (two dips a period), b^2 + (a^2 - b^2) sin^2(theta - theta0), with E by the AGM here; and against a trapezoidal
+ * sum of 2^21 points (geometric: its error near exp(-2^21 m / kappa)) on an element of degree 2 whose
+ * every harmonic is there and which comes within m of 0 at theta0. m / kappa down to 1e-6; to 1e-10.
+ */
+#include "harm.h"   /* harm_mean */
+
+static double ell_e_mean(double m, double kappa)   /* the mean over theta of sqrt(m^2 + kappa^2 sin^2 theta) */
+{
+    const double M = hypot(m, kappa);
+    double a = 1.0, b = m / M, c2 = (kappa / M) * (kappa / M), sum = 0.5 * c2, p2 = 0.5;
+    for (int i = 0; i < 40 && fabs(a - b) > 1e-17 * a; i++) {
+        const double an = 0.5 * (a + b), c = 0.5 * (a - b);
+        b = sqrt(a * b), a = an, p2 *= 2.0;
+        sum += p2 * c * c;
+    }
+    /* K = pi / (2 agm), E = K (1 - sum); the mean is (2 / pi) M E */
+    return M * (1.0 - sum) / a;
+}
+
+static void gauss_legendre_01(int n, double *x, double *wt)
+{
+    for (int i = 0; i < n; i++) {
+        double t = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1.0;
+        for (int it = 0; it < 100; it++) {
+            double p0 = 1.0, p1 = t;
+            for (int k = 2; k <= n; k++) {
+                const double p = ((2 * k - 1) * t * p1 - (k - 1) * p0) / k;
+                p0 = p1, p1 = p;
+            }
+            dp = n * (t * p1 - p0) / (t * t - 1.0);
+            const double dt = p1 / dp;
+            t -= dt;
+            if (fabs(dt) < 1e-16)
+                break;
+        }
+        x[i] = 0.5 * (1.0 - t), wt[i] = 1.0 / ((1.0 - t * t) * dp * dp);
+    }
+}
+
+static double harm_vec_norm(const double v[5][3], double th)
+{
+    double c[3];
+    for (int k = 0; k < 3; k++)
+        c[k] = v[0][k] + v[1][k] * cos(th) + v[2][k] * sin(th) + v[3][k] * cos(2 * th) + v[4][k] * sin(2 * th);
+    return sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+}
+
+static void harm_mean_should_match_closed_forms_and_a_dense_sum_on_narrow_dips(void **state)
+{
+    (void)state;
+    double x[10], wt[10];
+    gauss_legendre_01(10, x, wt);
+    static const double ms[] = { 0.3, 1e-2, 1e-4, 1e-6 }, th0s[] = { 0.0, 0.3, 1.2345678, 2.9, 4.4 };
+    double worst = 0.0;
+    for (size_t i = 0; i < sizeof ms / sizeof *ms; i++)
+        for (size_t j = 0; j < sizeof th0s / sizeof *th0s; j++) {
+            const double kappa = 3.0, m = ms[i] * kappa, t0 = th0s[j];
+            double v[5][3] = { { 0, 0, m }, { -kappa * sin(t0), 0, 0 }, { kappa * cos(t0), 0, 0 } };
+            const double exact = ell_e_mean(m, kappa), got = harm_mean((const double (*)[3])v, x, wt, 10);
+            /* the ellipse x = a cos(theta - t0), y = b sin(theta - t0): |x_theta|, dips at t0 and t0 + pi */
+            const double a = 2.0, b = a * ms[i];
+            double e[5][3] = { { 0 }, { a * sin(t0), b * cos(t0), 0 }, { -a * cos(t0), b * sin(t0), 0 } };
+            const double ex = ell_e_mean(b, sqrt(a * a - b * b)), ge = harm_mean((const double (*)[3])e, x, wt, 10);
+            worst = fmax(worst, fmax(fabs(got - exact) / exact, fabs(ge - ex) / ex));
+            if (!(fabs(got - exact) <= 1e-10 * exact && fabs(ge - ex) <= 1e-10 * ex))
+                fail_msg("m / kappa %g, theta0 %g: %.17g against %.17g (%.3g), the ellipse %.17g against %.17g (%.3g)",
+                         ms[i], t0, got, exact, (got - exact) / exact, ge, ex, (ge - ex) / ex);
+        }
+    /* every harmonic, within m of 0 at t0 */
+    static const double w[4][3] = { { 1.0, 0.3, -0.2 }, { -0.4, 0.9, 0.5 }, { 0.25, -0.35, 0.6 }, { 0.1, 0.45, -0.3 } };
+    for (size_t i = 0; i < sizeof ms / sizeof *ms; i++)
+        for (size_t j = 1; j < sizeof th0s / sizeof *th0s; j++) {
+            const double t0 = th0s[j], f[4] = { cos(t0), sin(t0), cos(2 * t0), sin(2 * t0) };
+            double v[5][3];
+            for (int k = 0; k < 3; k++) {
+                v[0][k] = (k == 2 ? ms[i] : 0.0);
+                for (int h = 0; h < 4; h++)
+                    v[h + 1][k] = w[h][k], v[0][k] -= f[h] * w[h][k];
+            }
+            const int N = 1 << 21;
+            double sum = 0.0;
+            for (int p = 0; p < N; p++)
+                sum += harm_vec_norm((const double (*)[3])v, 2.0 * M_PI * p / N);
+            const double dense = sum / N, got = harm_mean((const double (*)[3])v, x, wt, 10);
+            worst = fmax(worst, fabs(got - dense) / dense);
+            if (!(fabs(got - dense) <= 1e-10 * dense))
+                fail_msg("every harmonic, m %g, theta0 %g: %.17g against the dense sum's %.17g (%.3g)", ms[i], t0, got,
+                         dense, (got - dense) / dense);
+        }
+    print_message("harm_mean: %.3g off at most\n", worst);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -2094,6 +2190,7 @@ int main(void)
         cmocka_unit_test(free_integrals_should_match_the_reference_on_folds_lobes_and_every_wronskian_pair),
         cmocka_unit_test(free_integrals_should_equal_the_face_rows_on_fig2_and_fig4),
         cmocka_unit_test(a_dip_in_a_piece_shorter_than_an_ulp_should_end),
+        cmocka_unit_test(harm_mean_should_match_closed_forms_and_a_dense_sum_on_narrow_dips),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
