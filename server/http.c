@@ -92,6 +92,7 @@ static void make_key(srv_req *r)
 /* What a connection carries from request to request. */
 typedef struct {
     int nul;         /* the request's path or query held %00 */
+    int authority;   /* the target, in absolute form, has an authority with userinfo (@) or %-escapes */
     int over;        /* opened beyond --max-conns: its requests are answered 503 */
     size_t target;   /* the current request's target, in bytes as sent */
 } conn_state;
@@ -215,17 +216,21 @@ static int admit(srv_req *r, const char *method)
     if (!r->host)
         r->host = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_HOST);
     /* libmicrohttpd's strict mode refuses these with an HTML page; pdesolidd refuses them with a problem. */
-    if (h.bad || (h.hosts != 1 && !strcmp(r->version, MHD_HTTP_VERSION_1_1)) || (r->host && !*r->host)) {
-        r->close = r->decided = 1;
-        srv_problem(r, 400, NULL, "%s",
-                    h.bad                                                     ? h.bad
-                    : r->host == r->target_host                                ? "the request target's host is empty"
-                    : h.hosts != 1 && !strcmp(r->version, MHD_HTTP_VERSION_1_1) ? "an HTTP/1.1 request needs exactly one Host header"
-                                                                               : "the Host header is empty; it names the server the request is for (RFC 9110 7.2)");
-        return 1;
-    }
     const union MHD_ConnectionInfo *ci = MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
     conn_state *cs = ci ? ci->socket_context : NULL;
+    const int target = r->host == r->target_host, hosts = h.hosts != 1 && !strcmp(r->version, MHD_HTTP_VERSION_1_1);
+    const char *bad = h.bad  ? h.bad
+                      : hosts ? "an HTTP/1.1 request needs exactly one Host header"
+                      : target && ((cs && cs->authority) || strlen(r->host) >= sizeof r->target_host - 1)
+                          ? "the request target's host holds userinfo (@) or %-escapes, or is too long; send the host alone"
+                      : target && !*r->host ? "the request target's host is empty"
+                      : r->host && !*r->host ? "the Host header is empty; it names the server the request is for (RFC 9110 7.2)"
+                                             : NULL;
+    if (bad) {
+        r->close = r->decided = 1;
+        srv_problem(r, 400, NULL, "%s", bad);
+        return 1;
+    }
     if ((cs && cs->target > MAX_TARGET) || h.bytes > MAX_HEADERS) {
         r->decided = 1;
         if (h.bytes > MAX_HEADERS)
@@ -260,8 +265,8 @@ static int admit(srv_req *r, const char *method)
     if (!srv_host_allowed(s->cfg.allow_host, host)) {
         r->decided = 1;
         int name = (int)srv_host_name(host);
-        srv_problem(r, 403, NULL, "the Host header %.200s names neither an IP address, localhost nor a host allowed "
-                    "here (a guard against DNS rebinding)%s%.*s", host,
+        srv_problem(r, 403, NULL, "the %s %.200s names neither an IP address, localhost nor a host allowed "
+                    "here (a guard against DNS rebinding)%s%.*s", r->host == r->target_host ? "request target's host" : "Host header", host,
                     name ? "; if it is this server's name, start pdesolidd with --allow-host " : "; see --allow-host",
                     name, host);
         return 0;
@@ -337,7 +342,8 @@ static srv_req *begin(srv_server *s, struct MHD_Connection *conn, const char *ur
     size_t k = !strncasecmp(url, "http://", 7) ? 7 : !strncasecmp(url, "https://", 8) ? 8 : 0;
     if (k) {
         size_t n = strcspn(url + k, "/");
-        snprintf(r->target_host, sizeof r->target_host, "%.*s", (int)n, url + k);
+        /* one too long is kept as its first sizeof - 1 bytes and refused in admit(), never compared cut */
+        snprintf(r->target_host, sizeof r->target_host, "%.*s", (int)(n < sizeof r->target_host ? n : sizeof r->target_host), url + k);
         r->host = r->target_host;
         url = url[k + n] ? url + k + n : "/";
     }
@@ -582,8 +588,15 @@ static void *target_seen(void *cls, const char *uri, struct MHD_Connection *conn
 {
     (void)cls;
     const union MHD_ConnectionInfo *ci = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
-    if (ci && ci->socket_context)
-        ((conn_state *)ci->socket_context)->target = strlen(uri);
+    if (ci && ci->socket_context) {
+        conn_state *cs = ci->socket_context;
+        cs->target = strlen(uri);
+        /* As sent, before decoding: an absolute-form target's authority holding @ or % (begin() sees it decoded,
+         * where localhost%2f@evil.example reads as the host localhost) is refused in admit(). */
+        size_t k = !strncasecmp(uri, "http://", 7) ? 7 : !strncasecmp(uri, "https://", 8) ? 8 : 0;
+        size_t n = k ? strcspn(uri + k, "/?#") : 0;
+        cs->authority = k && (memchr(uri + k, '@', n) || memchr(uri + k, '%', n));
+    }
     return NULL;   /* the request's state is made by the handler's first call */
 }
 

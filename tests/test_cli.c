@@ -472,6 +472,11 @@ static void a_preset_s_document_should_be_printed_offline(void **state)
     assert_non_null(strstr(err, "nowhere"));
     free(out);
     free(err);
+    /* a name that is no name, through a server too: refused before it goes into a URL (review) */
+    assert_int_equal(run(0, "presets --preset '../x?y' --server http://127.0.0.1:1", &out, &err), 2);
+    assert_non_null(strstr(err, "no preset"));
+    free(out);
+    free(err);
 }
 
 /* Runs the tool and expects status st with words in stderr (or in stdout when on_out), then frees both. */

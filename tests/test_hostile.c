@@ -1324,6 +1324,27 @@ static void an_absolute_form_target_should_be_routed_and_its_host_checked(void *
     assert_int_equal(status_as(&d, "evil.example", "http://localhost/livez"), 200);
     /* Not a URI of this server's schemes: a path like any other. */
     assert_int_equal(status_as(&d, "localhost", "ftp://localhost/livez"), 404);
+    /* An authority with userinfo or %-escapes, or too long to hold whole, is refused, not cut or decoded into
+     * another host (review: 117 a's + ".localhost.evil.com" was cut to a name under .localhost, and
+     * localhost%2f@evil.com decoded to localhost). */
+    char longhost[300];
+    memset(longhost, 'a', 117);
+    snprintf(longhost + 117, sizeof longhost - 117, ".localhost.evil.com");
+    char lt[400];
+    snprintf(lt, sizeof lt, "http://%s/livez", longhost);
+    static const char *const bad[] = { "http://localhost%2f@evil.example/livez", "http://user@localhost/livez",
+                                       "http://local%68ost/livez", NULL };
+    for (int i = 0; i < 4; i++) {
+        raw_reply b = ask_host(&d, "localhost", "GET", i < 3 ? bad[i] : lt, NULL, NULL, 0, 5000);
+        expect_problem(&b, 400, NULL, "request target's host");
+        raw_reply_free(&b);
+    }
+    /* A missing Host beside an absolute target is named as such, not as an empty target host. */
+    char req[256];
+    snprintf(req, sizeof req, "GET http://localhost:%d/livez HTTP/1.1\r\nConnection: close\r\n\r\n", d.port);
+    r = raw_request(d.port, req, strlen(req), 5000);
+    expect_problem(&r, 400, NULL, "exactly one Host header");
+    raw_reply_free(&r);
     stop(&d);
 }
 

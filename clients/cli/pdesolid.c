@@ -593,9 +593,11 @@ static int cmd_presets(const options *o)
         const api_preset *p = api_preset_find(o->preset);
         char *catalog = NULL;
         int rc = 0;
-        if (o->server)
+        /* a name is letters, digits, - and _: anything else names no preset (and would not go into a URL as is) */
+        const int named = o->preset[0] && !o->preset[strspn(o->preset, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_")];
+        if (named && o->server)
             rc = remote_preset(o->server, o->preset, &catalog);
-        else if (!(catalog = p ? api_preset_json(p) : api_loft_preset_json(o->preset))) {
+        else if (!named || !(catalog = p ? api_preset_json(p) : api_loft_preset_json(o->preset))) {
             fprintf(stderr, "pdesolid: presets: no preset \"%s\"; `pdesolid presets` lists them\n", o->preset);
             rc = 2;
         }
