@@ -1401,8 +1401,7 @@ static void rp_free(rp_eval *e)
     free(e->E);
 }
 
-/* Gauss-Legendre nodes and weights on [0, 1], by Newton on the three-term recurrence. */
-static void rp_gauss_legendre(int n, double *x, double *w)
+void ref_gauss_legendre(int n, double *x, double *w)
 {
     for (int i = 0; i < n; i++) {
         double t = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1;
@@ -1482,7 +1481,7 @@ static int rp_init(rp_eval *e, const pde_solution *s)
         /* A moment multiplies five factors; GL20 on a piece where they turn by 20 radians is exact. */
         e->lmax[a] = fmin(0.25, 20.0 / (5 * e->rate[a] + 1));
     }
-    rp_gauss_legendre(20, e->gl_x, e->gl_w);
+    ref_gauss_legendre(20, e->gl_x, e->gl_w);
     return 0;
 }
 

@@ -238,6 +238,9 @@ typedef struct {
  * sanitisers: 0.01 s (fig1), 0.2-0.5 s (fig2, fig4), 3 s (fig3a), 15-31 s (fig3b-d). */
 int ref_props(const pde_solution *s, ref_props_out *out);
 
+/* Gauss-Legendre nodes and weights of n points on [0, 1], by Newton on the three-term recurrence (ref_props'). */
+void ref_gauss_legendre(int n, double *x, double *w);
+
 /* Eigenvalues of a symmetric 3 x 3 matrix, ascending, and unit eigenvectors as rows of a right-handed
  * frame (cyclic Jacobi). */
 void sym3_eigen(const double (*a)[3], double *val, double (*vec)[3]);

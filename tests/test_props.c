@@ -2073,26 +2073,6 @@ static double ell_e_mean(double m, double kappa)   /* the mean over theta of sqr
     return M * (1.0 - sum) / a;
 }
 
-static void gauss_legendre_01(int n, double *x, double *wt)
-{
-    for (int i = 0; i < n; i++) {
-        double t = cos(M_PI * (i + 0.75) / (n + 0.5)), dp = 1.0;
-        for (int it = 0; it < 100; it++) {
-            double p0 = 1.0, p1 = t;
-            for (int k = 2; k <= n; k++) {
-                const double p = ((2 * k - 1) * t * p1 - (k - 1) * p0) / k;
-                p0 = p1, p1 = p;
-            }
-            dp = n * (t * p1 - p0) / (t * t - 1.0);
-            const double dt = p1 / dp;
-            t -= dt;
-            if (fabs(dt) < 1e-16)
-                break;
-        }
-        x[i] = 0.5 * (1.0 - t), wt[i] = 1.0 / ((1.0 - t * t) * dp * dp);
-    }
-}
-
 static double harm_vec_norm(const double v[5][3], double th)
 {
     double c[3];
@@ -2105,7 +2085,7 @@ static void harm_mean_should_match_closed_forms_and_a_dense_sum_on_narrow_dips(v
 {
     (void)state;
     double x[10], wt[10];
-    gauss_legendre_01(10, x, wt);
+    ref_gauss_legendre(10, x, wt);
     static const double ms[] = { 0.3, 1e-2, 1e-4, 1e-6 }, th0s[] = { 0.0, 0.3, 1.2345678, 2.9, 4.4 };
     double worst = 0.0;
     for (size_t i = 0; i < sizeof ms / sizeof *ms; i++)
