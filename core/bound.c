@@ -37,7 +37,7 @@ typedef struct {
  * axes not split, so most of a box's factors were evaluated for its parent (core/bound.c's
  * bb_minimise). Direct-mapped by the interval; only for solutions of at most JC_MODES modes.
  */
-enum { JC_N = 256, JC_MODES = 64, JC_D = 6 };   /* derivatives 0..5; at most 3 * 256 * 6 * 64 doubles, 2.4 MB */
+enum { JC_N = 256, JC_MODES = 128, JC_D = 6 };   /* derivatives 0..5; at most 3 * 256 * 6 * 128 doubles, 4.7 MB */
 
 typedef struct {
     double lo, hi;
@@ -685,6 +685,12 @@ static int reduce_box(const obj_model *m, double sign, double target, pbox *b)
 pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], const pbox *within,
                        double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
 {
+    return bb_minimise_floor(s, what, sign, start, within, INFINITY, tol, budget, cancel, out);
+}
+
+pde_status bb_minimise_floor(const pde_solution *s, int what, double sign, const double start[3], const pbox *within,
+                             double floor, double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
+{
     bb_result r = { .lower = DBL_MAX, .boxes = 0 };
     pbox p0 = { { start[0], start[1], start[2] }, { start[0], start[1], start[2] } };
     obj_model m0;
@@ -722,7 +728,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
     pde_status st = PDE_OK;
     unsigned iterations = 0;
     while (h.n) {
-        if (bb_heap_min(&h) >= r.best - tol || r.boxes >= budget)
+        if (bb_heap_min(&h) >= fmin(r.best, floor) - tol || r.boxes >= budget)
             break;
         if ((++iterations & 7) == 0 && pde_stopped(cancel)) {   /* every 16 boxes */
             st = PDE_ERR_CANCELLED;
@@ -748,8 +754,8 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
             if (val < r.best)
                 r.best = val, r.at[0] = at[0], r.at[1] = at[1], r.at[2] = at[2];
             /* Cut off what is certified above best - tol / 2: the gap stays within tol. */
-            for (int pass = 0; pass < 2 && c.lb < r.best - tol; pass++) {
-                const double cut = r.best - 0.5 * tol;
+            for (int pass = 0; pass < 2 && c.lb < fmin(r.best, floor) - tol; pass++) {
+                const double cut = fmin(r.best, floor) - 0.5 * tol;
                 const int red = reduce_box(&m, sign, cut, &c.b);
                 if (red == 0)
                     break;
@@ -765,7 +771,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
             }
             c.axis = split_axis(&m, &c.b);
             c.lb = fmax(c.lb, top.lb);   /* a child's minimum is at least its parent's bound */
-            if (c.lb < r.best - tol) {
+            if (c.lb < fmin(r.best, floor) - tol) {
                 if (bb_heap_push(&h, &c)) {
                     st = PDE_ERR_NOMEM;
                     break;
