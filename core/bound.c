@@ -37,16 +37,41 @@ typedef struct {
  * axes not split, so most of a box's factors were evaluated for its parent (core/bound.c's
  * bb_minimise). Direct-mapped by the interval; only for solutions of at most JC_MODES modes.
  */
-enum { JC_N = 256, JC_MODES = 64, JC_D = 6 };   /* derivatives 0..5; at most 3 * 256 * 6 * 64 doubles, 2.4 MB */
+enum { JC_N = 256, JC_MODES = 128, JC_D = 6 };   /* derivatives 0..5; at most 3 * 256 * 6 * 128 doubles, 4.7 MB */
 
 typedef struct {
     double lo, hi;
     int order, bound;   /* order -1: empty */
 } jc_key;
 
+/*
+ * The jet's indices q < n whose u and v orders are at most du and dv: a factor t^p has no derivative
+ * of order above p, so a mode's products there are 0 (a loft's centre, 1 along u and v, has 6 of 56;
+ * its profile, t along u, 36). The lists are built as they are first asked for, once per branch and bound (in its memo; no
+ * static state: solutions are bounded from several threads).
+ */
+typedef struct {
+    signed char len[JC_D][JC_D][JC_D];   /* by the jet's order, du, dv; -1: not built yet */
+    unsigned char q[JC_D][JC_D][JC_D][MIN];
+} jet_lists;
+
+static const unsigned char *jet_list(jet_lists *L, int order, int du, int dv, int *len)
+{
+    if (L->len[order][du][dv] < 0) {
+        int k = 0;
+        for (int q = 0; q < mi_count[order]; q++)
+            if (mi_u[q] <= du && mi_v[q] <= dv)
+                L->q[order][du][dv][k++] = (unsigned char)q;
+        L->len[order][du][dv] = (signed char)k;
+    }
+    *len = L->len[order][du][dv];
+    return L->q[order][du][dv];
+}
+
 typedef struct jet_cache {
     size_t mt;
     int only;   /* the one component a coordinate's branch and bound needs, or -1: all three */
+    jet_lists lists;
     jc_key key[3][JC_N];
     double val[];   /* axis a, slot i: val + (a * JC_N + i) * JC_D mt */
 } jet_cache;
@@ -61,6 +86,7 @@ static jet_cache *jet_cache_new(const pde_solution *s, int what)
         return NULL;   /* no memo: slower, not wrong */
     jc->mt = mt;
     jc->only = what < 3 ? what : -1;
+    memset(jc->lists.len, -1, sizeof jc->lists.len);
     for (int a = 0; a < 3; a++)
         for (int i = 0; i < JC_N; i++)
             jc->key[a][i].order = -1;
@@ -138,10 +164,19 @@ static const double *axis_factors(const pde_solution *s, jet_cache *jc, int a, d
     return out;
 }
 
-/* Adds one mode's products of factors fu, fv, h (derivatives or bounds) to component c of j. */
-static void jet_add(xjet *j, int c, int n, const double *fu, const double *fv, const double *h)
+/* The highest order of f's derivatives that may not vanish, at most order. */
+static int factor_top(pde_factor f, int order)
 {
-    for (int q = 0; q < n; q++) {
+    return f.kind == PDE_POW && f.p >= 0.0 && f.p == floor(f.p) && f.p < order ? (int)f.p : order;
+}
+
+/* Adds one mode's products of factors fu, fv, h (derivatives or bounds) to component c of j, over the
+ * indices qs (the others' products are 0). */
+static void jet_add(xjet *j, int c, const unsigned char *qs, int len, const double *fu, const double *fv,
+                    const double *h)
+{
+    for (int i = 0; i < len; i++) {
+        const int q = qs[i];
         /* A factor that is exactly 0 makes the term 0, even beside an overflowed bound. */
         double p = fu[mi_u[q]], r = fv[mi_v[q]], e = h[mi_w[q]];
         j->d[c][q] += (p == 0.0 || r == 0.0 || e == 0.0) ? 0.0 : p * r * e;
@@ -155,6 +190,11 @@ static void jet_add(xjet *j, int c, int n, const double *fu, const double *fv, c
 static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, int only, jet_cache *jc, xjet *j)
 {
     const int n = mi_count[order];
+    /* without a memo (a single model: obj_magnitude), every index: no lists to build */
+    static const unsigned char every[MIN] = { 0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  10, 11, 12, 13,
+                                              14, 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26, 27,
+                                              28, 29, 30, 31, 32, 33, 34, 35, 36, 37, 38, 39, 40, 41,
+                                              42, 43, 44, 45, 46, 47, 48, 49, 50, 51, 52, 53, 54, 55 };
     const double *F[3] = { NULL, NULL, NULL };
     if (jc)
         for (int a = 0; a < 3; a++)
@@ -169,11 +209,14 @@ static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound
         for (int q = 0; q < n; q++)
             j->d[c][q] = 0.0;
         for (size_t m = 0; m < cs->nmodes; m++, o++) {
+            const pde_mode *md = &cs->modes[m];
+            int len = n;
+            const unsigned char *qs =
+                jc ? jet_list(&jc->lists, order, factor_top(md->u, order), factor_top(md->v, order), &len) : every;
             if (jc) {
-                jet_add(j, c, n, F[0] + JC_D * o, F[1] + JC_D * o, F[2] + JC_D * o);
+                jet_add(j, c, qs, len, F[0] + JC_D * o, F[1] + JC_D * o, F[2] + JC_D * o);
                 continue;
             }
-            const pde_mode *md = &cs->modes[m];
             double fu[JC_D], fv[JC_D], h[JC_D];
             if (bound) {
                 factor_bounds(md->u, b->lo[0], b->hi[0], order, fu);
@@ -184,7 +227,7 @@ static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound
                 factor_derivs(md->v, b->lo[1], order, fv);
                 mode_h_derivs(md, b->lo[2], order, h);
             }
-            jet_add(j, c, n, fu, fv, h);
+            jet_add(j, c, qs, len, fu, fv, h);
         }
     }
 }
@@ -685,6 +728,19 @@ static int reduce_box(const obj_model *m, double sign, double target, pbox *b)
 pde_status bb_minimise(const pde_solution *s, int what, double sign, const double start[3], const pbox *within,
                        double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
 {
+    return bb_minimise_floor(s, what, sign, start, within, INFINITY, 0.0, tol, budget, cancel, out);
+}
+
+/* What an open box's bound must reach to close: best - tol, or floor - ftol below it. */
+static double bb_target(double best, double floor, double ftol, double tol)
+{
+    return fmin(best - tol, floor - ftol);
+}
+
+pde_status bb_minimise_floor(const pde_solution *s, int what, double sign, const double start[3], const pbox *within,
+                             double floor, double ftol, double tol, size_t budget, const pde_cancel *cancel,
+                             bb_result *out)
+{
     bb_result r = { .lower = DBL_MAX, .boxes = 0 };
     pbox p0 = { { start[0], start[1], start[2] }, { start[0], start[1], start[2] } };
     obj_model m0;
@@ -722,7 +778,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
     pde_status st = PDE_OK;
     unsigned iterations = 0;
     while (h.n) {
-        if (bb_heap_min(&h) >= r.best - tol || r.boxes >= budget)
+        if (bb_heap_min(&h) >= bb_target(r.best, floor, ftol, tol) || r.boxes >= budget)
             break;
         if ((++iterations & 7) == 0 && pde_stopped(cancel)) {   /* every 16 boxes */
             st = PDE_ERR_CANCELLED;
@@ -748,8 +804,8 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
             if (val < r.best)
                 r.best = val, r.at[0] = at[0], r.at[1] = at[1], r.at[2] = at[2];
             /* Cut off what is certified above best - tol / 2: the gap stays within tol. */
-            for (int pass = 0; pass < 2 && c.lb < r.best - tol; pass++) {
-                const double cut = r.best - 0.5 * tol;
+            for (int pass = 0; pass < 2 && c.lb < bb_target(r.best, floor, ftol, tol); pass++) {
+                const double cut = bb_target(r.best, floor, 0.5 * ftol, 0.5 * tol);
                 const int red = reduce_box(&m, sign, cut, &c.b);
                 if (red == 0)
                     break;
@@ -765,7 +821,7 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
             }
             c.axis = split_axis(&m, &c.b);
             c.lb = fmax(c.lb, top.lb);   /* a child's minimum is at least its parent's bound */
-            if (c.lb < r.best - tol) {
+            if (c.lb < bb_target(r.best, floor, ftol, tol)) {
                 if (bb_heap_push(&h, &c)) {
                     st = PDE_ERR_NOMEM;
                     break;

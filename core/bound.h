@@ -78,6 +78,15 @@ pde_status bb_minimise(const pde_solution *s, int what, double sign, const doubl
                        double tol, size_t budget, const pde_cancel *cancel, bb_result *out);
 
 /*
+ * bb_minimise where only min(sign * f, floor) is wanted (a loft's det J = t^p D1 over the face t = 1,
+ * whose minimum over the cube is min(D1's, 0)): the search ends once every open box is certified
+ * above best - tol or above floor - ftol, so that best - lower may exceed tol where best > floor.
+ */
+pde_status bb_minimise_floor(const pde_solution *s, int what, double sign, const double start[3], const pbox *within,
+                             double floor, double ftol, double tol, size_t budget, const pde_cancel *cancel,
+                             bb_result *out);
+
+/*
  * props.c's extremes of a harmonic component c, x_c = t^n (alpha(w) sin k pi s + beta(w) cos k pi s)
  * with (t, s) = (u, v) or (v, u), k >= 2 (docs/MATH.md, "Harmonic components"): max_w sqrt(alpha^2 +
  * beta^2) by a branch and bound over w from start, to tol, within budget intervals. bound: certified

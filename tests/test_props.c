@@ -23,6 +23,7 @@
 #include "quad.h"       /* the separable integrals against the cube's */
 #include "poly.h"       /* polynomial solids' Bernstein bounds */
 #include "bound.h"      /* the 1-D extremes against the general branch and bound */
+#include "loft.h"
 #include "model.h"
 #include "support.h"
 #include "template.h"
@@ -2126,6 +2127,85 @@ static void harm_mean_should_match_closed_forms_and_a_dense_sum_on_narrow_dips(v
     print_message("harm_mean: %.3g off at most\n", worst);
 }
 
+/*
+ * The extremes of lofts of many harmonics (tower: 32 per section, 99 modes; blade: 64 modes), x_c =
+ * C_c(w) + u P_c(v, w), z = Z(w): certified with gaps below the tolerances (the bbox's 1e-12 of the
+ * size with the pad, det J's 1e-9 of its scale), around a dense sample, and each bound within 1e-9 of
+ * the size of what a sampling refined locally reaches: a grid's best points of each objective (the 8
+ * best, that a second basin near the best is refined too), each polished by a compass search.
+ */
+enum { LX_KEEP = 8 };
+
+static void lx_keep(double *val, double (*at)[3], double f, const double p[3])
+{
+    int worst = 0;
+    for (int i = 1; i < LX_KEEP; i++)
+        if (val[i] > val[worst])
+            worst = i;
+    if (f < val[worst])
+        val[worst] = f, at[worst][0] = p[0], at[worst][1] = p[1], at[worst][2] = p[2];
+}
+
+static void lofts_extremes_should_be_certified_and_match_a_refined_dense_sampling(void **state)
+{
+    (void)state;
+    static const char *const names[] = { "tower", "blade" };
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
+        cJSON *doc = api_loft_preset_tree(names[i]);
+        assert_non_null(doc);
+        api_error err;
+        api_loft *l = api_loft_parse(cJSON_GetObjectItemCaseSensitive(doc, "loft"), "/loft", &err);
+        assert_non_null(l);
+        pde_solution *sol = NULL;
+        assert_int_equal(api_loft_solve(l, "/loft", NULL, &sol, &err), 0);
+        pde_props p;
+        assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+        double size = 0.0;
+        for (int c = 0; c < 3; c++)
+            size = fmax(size, p.bbox_max[c] - p.bbox_min[c]);
+        const double jscale = fmax(fabs(p.detj_min), fabs(p.detj_max));
+        if (!(p.bbox_gap <= 1e-11 * size && p.detj_gap <= 1e-9 * jscale))
+            fail_msg("%s: gaps %.3g (%.3g of the size), det J %.3g (%.3g of its scale)", names[i], p.bbox_gap,
+                     p.bbox_gap / size, p.detj_gap, p.detj_gap / jscale);
+        expect_bounds_contain_samples(names[i], sol, 5, 129, 65, 5000);
+        /* objective o: sign * (x, y, z, det J), o = 2 what + (sign < 0) */
+        double val[8][LX_KEEP], at[8][LX_KEEP][3];
+        for (int o = 0; o < 8; o++)
+            for (int k = 0; k < LX_KEEP; k++)
+                val[o][k] = INFINITY;
+        const size_t nu = 3, nv = 193, nw = 97;
+        for (size_t a = 0; a < nu; a++)
+            for (size_t b = 0; b < nv; b++)
+                for (size_t c = 0; c < nw; c++) {
+                    const double q[3] = { (double)a / (double)(nu - 1), (double)b / (double)(nv - 1),
+                                          0.5 * (1 - cos(M_PI * (double)c / (double)(nw - 1))) };
+                    double x[3], xu[3], xv[3], xw[3];
+                    pde_eval_d(sol, q[0], q[1], q[2], x, xu, xv, xw);
+                    const double f[4] = { x[0], x[1], x[2], det_cols(xu, xv, xw) };
+                    for (int o = 0; o < 8; o++)
+                        lx_keep(val[o], at[o], (o & 1 ? -1 : 1) * f[o / 2], q);
+                }
+        const double blo[4] = { p.bbox_min[0], p.bbox_min[1], p.bbox_min[2], p.detj_min };
+        const double bhi[4] = { p.bbox_max[0], p.bbox_max[1], p.bbox_max[2], p.detj_max };
+        for (int o = 0; o < 8; o++) {
+            const int what = o / 2;
+            const double sign = o & 1 ? -1.0 : 1.0, bound = o & 1 ? bhi[what] : blo[what];
+            double best = INFINITY;
+            for (int k = 0; k < LX_KEEP; k++)
+                best = fmin(best, sign * compass(sol, what, sign, at[o][k], sign * val[o][k]));
+            const double off = best - sign * bound, tol = 1e-9 * (what < 3 ? size : jscale);
+            if (!(off >= 0.0 && off <= tol))
+                fail_msg("%s: %s's %s: refined sampling %.17g, bound %.17g (%.3g off, tolerance %.3g)", names[i],
+                         what < 3 ? pde_comp_name[what] : "det J", o & 1 ? "max" : "min", sign * best, bound, off, tol);
+        }
+        print_message("%s: bbox gap %.3g, det J [%.17g, %.17g] gap %.3g\n", names[i], p.bbox_gap, p.detj_min,
+                      p.detj_max, p.detj_gap);
+        pde_solution_free(sol);
+        api_loft_free(l);
+        cJSON_Delete(doc);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -2171,6 +2251,7 @@ int main(void)
         cmocka_unit_test(free_integrals_should_equal_the_face_rows_on_fig2_and_fig4),
         cmocka_unit_test(a_dip_in_a_piece_shorter_than_an_ulp_should_end),
         cmocka_unit_test(harm_mean_should_match_closed_forms_and_a_dense_sum_on_narrow_dips),
+        cmocka_unit_test(lofts_extremes_should_be_certified_and_match_a_refined_dense_sampling),
     };
     test_filter_from_env();
     return cmocka_run_group_tests_name("props", tests, NULL, NULL);
