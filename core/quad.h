@@ -59,7 +59,12 @@ void quad_separate(const pde_solution *s, quad_sep *sep);
  * by the face's 2-D panels where it does not; where it does not separate, along a polynomial axis
  * (quad.c's poly_line); 2: the face by rows, even where det J does not depend on its other parameter
  * or the face has no period (tests); 3: the same over the whole face, no period used (tests); 0: over
- * the cube, lines along the axis that crosses det J's zero set most often, in 3-D (tests). */
+ * the cube, lines along the axis that crosses det J's zero set most often, in 3-D (tests).
+ * Where det J does not separate and every factor along v is 1 or a whole harmonic of 2 pi v (lofts),
+ * with lines along u where jsign is 0, v takes one uniform rule over the period, exact where det J
+ * keeps its sign (checked on the lines, else the path above), and out->err is the a-posteriori
+ * estimate of w's rules instead (their rows' Legendre tails), large where the work's bound stopped
+ * their refinement. */
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
                       int jsign, const pde_cancel *cancel, quad_result *out);
 
