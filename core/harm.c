@@ -43,6 +43,8 @@
 #define MAX_SPLITS 32   /* cuts at dips of w in a face, at most: a cut inside a graded piece may cut
                          * again (a stiff model's valley of dips cut 30 deep, each deeper) */
 #define MAX_NODES 40000 /* points of w in a face, at most (fig. 2c: 2400), else the panels */
+#define MANY_WORK 2e6   /* a face of many harmonics (below): its points of theta, at most, else the panels
+                         * (tower 2e5, blade 1.6e5) */
 
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
@@ -80,6 +82,8 @@ typedef struct {
     double *cf;                /* per such entry: x's 3 components, then x_w's */
     double *e;                 /* the samples of the element on MT points */
     double big;                /* the largest sample at the w being integrated */
+    double work;               /* points of theta so far */
+    int fold;                  /* the element met 0 at a point of theta: a fold's cuspidal edge */
 } harm_ctx;
 
 typedef void (*harm_fn)(void *arg, double t, double *val);
@@ -460,7 +464,7 @@ static int outer(harm_ctx *H, double a, double b, const double *coarse, int dept
         H->next_poll = H->nodes + H->poll_every;
         H->stopped |= pde_stopped(H->o->cancel);
     }
-    if (H->stopped || H->nodes > H->max_nodes)
+    if (H->stopped || H->nodes > H->max_nodes || H->work > MANY_WORK || H->fold)
         return 0;   /* the panels then, which bound their work */
     H->dip = INFINITY;
     rule(H->o, H->many ? many_at_w : at_w, H, a, m, 2, l);
@@ -529,9 +533,14 @@ static int harm_form(const pde_solution *s, int axis, double *k)
  */
 #define MT 4096          /* points of theta per 2 pi on the finest level; a power of 2 */
 #define MANY_MAX 512     /* harmonics at most (N0 <= MT / 2) */
+#define MANY_MIN 4       /* ... and at least: with 2 or 3 (fig. 3, its skin's element dips along curves of
+                          * (t, w), where the mean over theta is rough in w) the general path's panels took
+                          * 0.3 to 30 times the instructions (fig. 3a 58 M, here 1.8 G) */
 #define MANY_DEEP 0.05   /* a narrow dip below this of the largest sample goes to the cuts */
 #define MANY_CUT 0.2     /* ... which are at the least samples below this of the largest, */
 #define MANY_CUTS 64     /* ... this many at most */
+#define MANY_FOLD 1e-6  /* a least value below this of the largest: a fold, which the general path locates
+                          * (fig. 3a, 3b, 3d: 3 to 30 times its instructions here) */
 #define MANY_TOL 1e-13   /* the cuts' adaptive rule, absolute on the mean over the largest */
 #define MANY_DEPTH 24    /* ... and its halvings of a panel of u at most */
 #define MANY_NODES 6000  /* points of w in a face, at most (tower 600, blade 900), else the panels */
@@ -547,8 +556,9 @@ static void mtrig_init(void)
 }
 
 /* The element over 2 pi, |g|, at theta = 2 pi idx / MT; x . g into *flux where flux is not NULL. */
-static double many_sample(const harm_ctx *H, int idx, double *flux)
+static double many_sample(harm_ctx *H, int idx, double *flux)
 {
+    H->work += 1.0;
     const double *cf = H->cf;
     double xt[3] = { 0, 0, 0 }, xw[3] = { cf[3], cf[4], cf[5] }, x[3] = { cf[0], cf[1], cf[2] };
     for (int h = 0; h < H->nh; h++) {
@@ -570,8 +580,9 @@ static double many_sample(const harm_ctx *H, int idx, double *flux)
 }
 
 /* g = x_theta x x_w at theta, and with nd = 2 its first two derivatives in theta (d[1], d[2]). */
-static void many_g(const harm_ctx *H, double th, int nd, double d[3][3])
+static void many_g(harm_ctx *H, double th, int nd, double d[3][3])
 {
+    H->work += 1.0;
     const double *cf = H->cf, c1 = cos(th), s1 = sin(th);
     double xt[3][3] = { { 0 } }, xw[3][3] = { { cf[3], cf[4], cf[5] }, { 0 }, { 0 } };   /* [order][comp] */
     double c = 1.0, sn = 0.0;
@@ -605,7 +616,7 @@ static void many_g(const harm_ctx *H, double th, int nd, double d[3][3])
 
 /* |g|^2's least in [lo, hi], by Newton on its derivative kept in the bracket (least's); the element's
  * width scale there, |g| / sqrt(|g|^2'' / 2), into *scale. */
-static double many_least(const harm_ctx *H, double lo, double hi, double *scale)
+static double many_least(harm_ctx *H, double lo, double hi, double *scale)
 {
     double x = 0.5 * (lo + hi), d[3][3], f2 = 0.0;
     for (int it = 0; it < 60; it++) {
@@ -627,12 +638,14 @@ static double many_least(const harm_ctx *H, double lo, double hi, double *scale)
     }
     many_g(H, x, 2, d);
     f2 = 2.0 * (dot(d[1], d[1]) + dot(d[0], d[2]));
-    *scale = f2 > 0.0 ? sqrt(dot(d[0], d[0])) / sqrt(0.5 * f2) : 0.0;
+    const double m = sqrt(dot(d[0], d[0]));
+    *scale = f2 > 0.0 ? m / sqrt(0.5 * f2) : 0.0;
+    H->fold |= !(m > MANY_FOLD * H->big);
     return x;
 }
 
 typedef struct {
-    const harm_ctx *H;
+    harm_ctx *H;
     double c, sg, scale, tol;   /* theta = c + sg scale sinh u; tol per unit of u */
 } many_half;
 
@@ -657,7 +670,7 @@ static double many_adapt(const many_half *f, double lo, double hi, double coarse
 }
 
 /* The integral of |g| over [c, c + sg d], d > 0, graded towards c (a least value, its width scale) */
-static double many_toward(const harm_ctx *H, double c, double sg, double d, double scale)
+static double many_toward(harm_ctx *H, double c, double sg, double d, double scale)
 {
     scale = fmax(scale, 1e-14);
     const double U = asinh(d / scale);
@@ -766,7 +779,7 @@ static int many_form(const pde_solution *s, int axis, harm_ctx *H)
     for (int j = 1; j <= MANY_MAX; j++)
         if (seen[j])
             idx[j] = H->nh++;
-    if (!H->nh)
+    if (H->nh < MANY_MIN)
         return 0;
     H->hj = malloc(H->nh * sizeof *H->hj);
     H->mslot = malloc(H->nm * sizeof *H->mslot);
@@ -871,6 +884,8 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
         rule(o, H.many ? many_at_w : at_w, &H, o->edge[i], o->edge[i + 1], 2, coarse);
         ok = outer(&H, o->edge[i], o->edge[i + 1], coarse, 0, 2, sum);
     }
+    if (H.fold || H.work > MANY_WORK)
+        ok = 0;
     if (H.stopped)
         ok = -1;
     free(H.wt);

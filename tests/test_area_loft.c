@@ -268,17 +268,21 @@ static void loft_area_should_match_an_independent_quadrature(void **state)
 
 /*
  * A model of fig. 4's form, x = u (a(w) sin 2 pi v + ...), y = u (b(w) cos 2 pi v + ...), z = z(w),
- * with second harmonics of amplitude eps (sin 4 pi v in x, cos 6 pi v in y): eps = 0 is a face of one
- * harmonic (harm.c's first path), any other the many path.
+ * with further harmonics of amplitude eps (sin 4 pi v and sin 8 pi v in x, cos 6 pi v in y): eps = 0 is
+ * a face of one harmonic (harm.c's first path), any other the many path (4 harmonics: its least).
  */
 static pde_solution *wavy_model(double eps)
 {
-    static pde_bterm bx[2], by[2], bz[1];
-    pde_model m = { { { 1, 1, -1, bx, 2, NULL, 0 }, { 1, 1, -1, by, 2, NULL, 0 }, { 1, 1, -1, bz, 1, NULL, 0 } } };
+    static pde_bterm bx[3], by[2], bz[1];
+    /* b = 1e-3: h'''' = 1e-3 (2 pi j)^4 h, near a cubic, keeps the ellipse's axes in [0.5, 1] (with b = 1
+     * one passes 0 at w = 0.18: a section that is a segment, where the many path leaves the face to the
+     * panels) */
+    pde_model m = { { { 1, 1e-3, -1, bx, 3, NULL, 0 }, { 1, 1e-3, -1, by, 2, NULL, 0 }, { 1, 1, -1, bz, 1, NULL, 0 } } };
     bx[0] = (pde_bterm){ F_pow(1), F_sin(2), 0.5, 0, 1, 0 }, by[0] = (pde_bterm){ F_pow(1), F_cos(2), 1, 0, 0.5, 0 };
     bx[1] = (pde_bterm){ F_pow(1), F_sin(4), 0.12 * eps, 0, 0.05 * eps, 0 };
+    bx[2] = (pde_bterm){ F_pow(1), F_sin(8), 0.02 * eps, 0, 0.04 * eps, 0 };
     by[1] = (pde_bterm){ F_pow(1), F_cos(6), 0.03 * eps, 0, 0.1 * eps, 0 };
-    bz[0] = (pde_bterm){ F_pow(0), F_pow(0), 0, 1, 2, 0 };
+    bz[0] = (pde_bterm){ F_pow(0), F_pow(0), 0, 1, 2, 1 };   /* z' >= 1: the element keeps away from 0 */
     if (eps == 0.0)
         m.comp[0].nbterms = m.comp[1].nbterms = 1;
     pde_solution *sol = NULL;
@@ -287,7 +291,7 @@ static pde_solution *wavy_model(double eps)
 }
 
 /*
- * The many path on models: with eps = 1e-12 it agrees with the one-harmonic path on eps = 0 to 1e-11;
+ * The many path on models (4 harmonics along v): with eps = 1e-12 it agrees with the one-harmonic path on eps = 0 to 1e-11;
  * with eps = 1 with the reference quadrature (ref_props) and the general path (QUAD_GENERAL) to 1e-9,
  * the area and the signed volume from the faces' flux.
  */
