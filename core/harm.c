@@ -433,13 +433,22 @@ static double dip_place(harm_ctx *H, double a, double b)
 
 static int outer(harm_ctx *H, double a, double b, const double *coarse, int depth, int split, double *out);
 
+/* The rule over [a, b] of the means at w (one harmonic's, or many's), each fn a constant for the compiler */
+static void rule_w(harm_ctx *H, double a, double b, double *sum)
+{
+    if (H->many)
+        rule(H->o, many_at_w, H, a, b, 2, sum);
+    else
+        rule(H->o, at_w, H, a, b, 2, sum);
+}
+
 /* [c, c + d] (d < 0: [c + d, c]) graded towards c, each piece with outer. */
 static int outer_toward(harm_ctx *H, double c, double d, int depth, double *out)
 {
     for (int k = 0; k <= W_LEVELS; k++, d *= W_GRADE) {
         const double lo = k < W_LEVELS ? c + W_GRADE * d : c, hi = c + d, a = fmin(lo, hi), b = fmax(lo, hi);
         double coarse[2];
-        rule(H->o, H->many ? many_at_w : at_w, H, a, b, 2, coarse);
+        rule_w(H, a, b, coarse);
         if (!outer(H, a, b, coarse, depth, 1, out))
             return 0;
     }
@@ -467,8 +476,8 @@ static int outer(harm_ctx *H, double a, double b, const double *coarse, int dept
     if (H->stopped || H->nodes > H->max_nodes || H->work > MANY_WORK || H->fold)
         return 0;   /* the panels then, which bound their work */
     H->dip = INFINITY;
-    rule(H->o, H->many ? many_at_w : at_w, H, a, m, 2, l);
-    rule(H->o, H->many ? many_at_w : at_w, H, m, b, 2, r);
+    rule_w(H, a, m, l);
+    rule_w(H, m, b, r);
     int ok = 1;
     for (int k = 0; k < 2; k++) {
         const double fine = l[k] + r[k];
@@ -881,7 +890,7 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
     }
     for (int i = 0; i < o->np && ok == 1 && axis < 2; i++) {
         double coarse[2];
-        rule(o, H.many ? many_at_w : at_w, &H, o->edge[i], o->edge[i + 1], 2, coarse);
+        rule_w(&H, o->edge[i], o->edge[i + 1], coarse);
         ok = outer(&H, o->edge[i], o->edge[i + 1], coarse, 0, 2, sum);
     }
     if (H.fold || H.work > MANY_WORK)
