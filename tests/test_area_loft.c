@@ -1,7 +1,7 @@
 /*
  * test_area_loft.c: the surface area of faces of many harmonics (core/harm.c's many path): a loft's
- * skin u = 1, x = C(w) + P(v, w), z = Z(w), its end caps w = 0, 1, x = C + u P(v), and models of two
- * or three harmonics along v, against quadratures written here.
+ * skin u = 1, x = C(w) + P(v, w), z = Z(w), its end caps w = 0, 1, x = C + u P(v), and a model of four
+ * harmonics along v, against quadratures written here.
  *
  * The reference of a loft: the skin by Gauss-Legendre panels along w graded geometrically towards
  * every section (each mode's w-terms exp(+-beta (w - shift)), beta up to 150, make a layer there) and,
