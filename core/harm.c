@@ -43,6 +43,8 @@
 #define MAX_SPLITS 32   /* cuts at dips of w in a face, at most: a cut inside a graded piece may cut
                          * again (a stiff model's valley of dips cut 30 deep, each deeper) */
 #define MAX_NODES 40000 /* points of w in a face, at most (fig. 2c: 2400), else the panels */
+#define MANY_WORK 2e6   /* a face of many harmonics (below): its points of theta, at most, else the panels
+                         * (tower 2e5, blade 1.6e5) */
 
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
@@ -73,6 +75,15 @@ typedef struct {
     size_t nodes, next_poll;
     int splits;                /* cuts at a dip of w left */
     int stopped;               /* o->cancel asked to stop */
+    size_t poll_every, max_nodes;
+    /* Many harmonics (the section below): */
+    int many, nh;              /* the harmonics along t are hj[0..nh - 1] */
+    int *hj, *mslot;           /* per mode: (0: D, 1 + 2 h: sin of hj[h], 2 + 2 h: cos) * 3 + c */
+    double *cf;                /* per such entry: x's 3 components, then x_w's */
+    double *e;                 /* the samples of the element on MT points */
+    double big;                /* the largest sample at the w being integrated */
+    double work;               /* points of theta so far */
+    int fold;                  /* the element met 0 at a point of theta: a fold's cuspidal edge */
 } harm_ctx;
 
 typedef void (*harm_fn)(void *arg, double t, double *val);
@@ -366,6 +377,8 @@ double harm_mean(const double v[5][3], const double *x, const double *wt, int n)
 
 /* At w: val[0] the element's mean over theta, val[1] the flux's; the least of the element over its
  * largest kept in H->dip, where it is at in H->dip_at. */
+static void many_at_w(void *arg, double w, double *val);
+
 static void at_w(void *arg, double w, double *val)
 {
     harm_ctx *H = arg;
@@ -420,13 +433,22 @@ static double dip_place(harm_ctx *H, double a, double b)
 
 static int outer(harm_ctx *H, double a, double b, const double *coarse, int depth, int split, double *out);
 
+/* The rule over [a, b] of the means at w (one harmonic's, or many's), each fn a constant for the compiler */
+static void rule_w(harm_ctx *H, double a, double b, double *sum)
+{
+    if (H->many)
+        rule(H->o, many_at_w, H, a, b, 2, sum);
+    else
+        rule(H->o, at_w, H, a, b, 2, sum);
+}
+
 /* [c, c + d] (d < 0: [c + d, c]) graded towards c, each piece with outer. */
 static int outer_toward(harm_ctx *H, double c, double d, int depth, double *out)
 {
     for (int k = 0; k <= W_LEVELS; k++, d *= W_GRADE) {
         const double lo = k < W_LEVELS ? c + W_GRADE * d : c, hi = c + d, a = fmin(lo, hi), b = fmax(lo, hi);
         double coarse[2];
-        rule(H->o, at_w, H, a, b, 2, coarse);
+        rule_w(H, a, b, coarse);
         if (!outer(H, a, b, coarse, depth, 1, out))
             return 0;
     }
@@ -448,14 +470,14 @@ static int outer(harm_ctx *H, double a, double b, const double *coarse, int dept
     const double m = 0.5 * (a + b);
     double l[2], r[2];
     if (H->nodes >= H->next_poll) {   /* a dip's points of w may take a few ms */
-        H->next_poll = H->nodes + POLL_NODES;
+        H->next_poll = H->nodes + H->poll_every;
         H->stopped |= pde_stopped(H->o->cancel);
     }
-    if (H->stopped || H->nodes > MAX_NODES)
+    if (H->stopped || H->nodes > H->max_nodes || H->work > MANY_WORK || H->fold)
         return 0;   /* the panels then, which bound their work */
     H->dip = INFINITY;
-    rule(H->o, at_w, H, a, m, 2, l);
-    rule(H->o, at_w, H, m, b, 2, r);
+    rule_w(H, a, m, l);
+    rule_w(H, m, b, r);
     int ok = 1;
     for (int k = 0; k < 2; k++) {
         const double fine = l[k] + r[k];
@@ -502,48 +524,388 @@ static int harm_form(const pde_solution *s, int axis, double *k)
     return *k != 0.0;
 }
 
-int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, double *area, double *flux,
-              size_t *nodes)
+/*
+ * Many harmonics (a loft's face u = 1: its profile's Fourier series, k = 1..32). Where every mode's
+ * factor along t is 1 or sin, cos of 2 pi j t for whole j, each coordinate is at each w
+ *
+ *     x_c(theta, w) = D_c(w) + sum_j S_cj(w) sin j theta + C_cj(w) cos j theta,    theta = 2 pi t,
+ *
+ * and the element |x_t x x_w| = 2 pi |g|, g = x_theta x x_w, is the root of a trigonometric
+ * polynomial of degree 4 M (M the largest j), positive where the section is regular: the trapezoidal
+ * rule on N = 2^n points of theta converges geometrically, and is exact for the flux x . (x_t x x_w)
+ * (degree 3 M) once N > 3 M. So: x_theta and x_w sampled at N0 > 3 M points from the coefficients
+ * (a table of 2 pi i / MT), then N doubled until two levels agree to TRAP_TOL. Where they do not by
+ * MT, or the samples show a narrow dip (a profile's sharp corner, say an airfoil's trailing edge:
+ * blade, 1e-3 of the largest over 1e-3 of the period), the period is cut at its deep least values
+ * (located by Newton on |g|^2), and each side of each cut integrated in s = scale sinh u as
+ * toward_sinh does, adaptively in u (far from the cut the harmonics, not the dip, set the scale).
+ */
+#define MT 4096          /* points of theta per 2 pi on the finest level; a power of 2 */
+#define MANY_MAX 512     /* harmonics at most (N0 <= MT / 2) */
+#define MANY_MIN 4       /* ... and at least: with 2 or 3 (fig. 3, its skin's element dips along curves of
+                          * (t, w), where the mean over theta is rough in w) the general path's panels took
+                          * 0.3 to 30 times the instructions (fig. 3a 58 M, here 1.8 G) */
+#define MANY_DEEP 0.05   /* a narrow dip below this of the largest sample goes to the cuts */
+#define MANY_CUT 0.2     /* ... which are at the least samples below this of the largest, */
+#define MANY_CUTS 64     /* ... this many at most */
+#define MANY_FOLD 1e-6  /* a least value below this of the largest: a fold, which the general path locates
+                          * (fig. 3a, 3b, 3d: 3 to 30 times its instructions here) */
+#define MANY_TOL 1e-13   /* the cuts' adaptive rule, absolute on the mean over the largest */
+#define MANY_DEPTH 24    /* ... and its halvings of a panel of u at most */
+#define MANY_NODES 6000  /* points of w in a face, at most (tower 600, blade 900), else the panels */
+#define MANY_POLL 32     /* ... between polls of the caller's stop() (up to 100 us each) */
+
+static double mtrig[MT][2];   /* cos, sin of 2 pi i / MT */
+static pthread_once_t mtrig_once = PTHREAD_ONCE_INIT;
+
+static void mtrig_init(void)
 {
-    double k;
-    if (axis > 1 || !harm_form(s, axis, &k))
-        return 0;
-    harm_ctx H = { .o = o, .s = s, .kpi = k * M_PI, .splits = MAX_SPLITS };
-    for (int c = 0; c < 3; c++)
-        H.nm += s->comp[c].nmodes;
-    H.wt = malloc(3 * H.nm * sizeof *H.wt);
-    H.slot = malloc(H.nm);
-    if (!H.wt || !H.slot) {
-        free(H.wt);
-        free(H.slot);
-        return 0;
+    for (int i = 0; i < MT; i++)
+        mtrig[i][0] = cos(2.0 * M_PI * i / MT), mtrig[i][1] = sin(2.0 * M_PI * i / MT);
+}
+
+/* The element over 2 pi, |g|, at theta = 2 pi idx / MT; x . g into *flux where flux is not NULL. */
+static double many_sample(harm_ctx *H, int idx, double *flux)
+{
+    H->work += 1.0;
+    const double *cf = H->cf;
+    double xt[3] = { 0, 0, 0 }, xw[3] = { cf[3], cf[4], cf[5] }, x[3] = { cf[0], cf[1], cf[2] };
+    for (int h = 0; h < H->nh; h++) {
+        const int j = H->hj[h], k = (int)(((long)idx * j) & (MT - 1));
+        const double c = mtrig[k][0], sn = mtrig[k][1], *S = cf + 6 * (1 + 2 * h), *C = S + 6;
+        for (int q = 0; q < 3; q++) {
+            xt[q] += j * (S[q] * c - C[q] * sn);
+            xw[q] += S[3 + q] * sn + C[3 + q] * c;
+        }
+        if (flux)
+            for (int q = 0; q < 3; q++)
+                x[q] += S[q] * sn + C[q] * c;
     }
-    H.h = H.wt + H.nm, H.dh = H.h + H.nm;
+    double g[3];
+    cross(xt, xw, 1.0, g);
+    if (flux)
+        *flux = dot(x, g);
+    return sqrt(dot(g, g));
+}
+
+/* g = x_theta x x_w at theta, and with nd = 2 its first two derivatives in theta (d[1], d[2]). */
+static void many_g(harm_ctx *H, double th, int nd, double d[3][3])
+{
+    H->work += 1.0;
+    const double *cf = H->cf, c1 = cos(th), s1 = sin(th);
+    double xt[3][3] = { { 0 } }, xw[3][3] = { { cf[3], cf[4], cf[5] }, { 0 }, { 0 } };   /* [order][comp] */
+    double c = 1.0, sn = 0.0;
+    for (int h = 0, j = 0; h < H->nh; h++) {
+        for (; j < H->hj[h]; j++) {   /* cos, sin of j theta by rotation */
+            const double t = c * c1 - sn * s1;
+            sn = sn * c1 + c * s1, c = t;
+        }
+        const double *S = cf + 6 * (1 + 2 * h), *C = S + 6, jj = j, j2 = jj * jj;
+        for (int q = 0; q < 3; q++) {
+            const double a = S[q] * c - C[q] * sn, b = S[q] * sn + C[q] * c;   /* d/dtheta b = j a, of a = -j b */
+            const double aw = S[3 + q] * c - C[3 + q] * sn, bw = S[3 + q] * sn + C[3 + q] * c;
+            xt[0][q] += jj * a, xt[1][q] -= j2 * b, xt[2][q] -= j2 * jj * a;
+            xw[0][q] += bw, xw[1][q] += jj * aw, xw[2][q] -= j2 * bw;
+        }
+    }
+    double t[3];
+    cross(xt[0], xw[0], 1.0, d[0]);
+    if (nd < 2)
+        return;
+    cross(xt[1], xw[0], 1.0, d[1]), cross(xt[0], xw[1], 1.0, t);
+    for (int q = 0; q < 3; q++)
+        d[1][q] += t[q];
+    cross(xt[2], xw[0], 1.0, d[2]), cross(xt[0], xw[2], 1.0, t);
+    for (int q = 0; q < 3; q++)
+        d[2][q] += t[q];
+    cross(xt[1], xw[1], 2.0, t);
+    for (int q = 0; q < 3; q++)
+        d[2][q] += t[q];
+}
+
+/* |g|^2's least in [lo, hi], by Newton on its derivative kept in the bracket (least's); the element's
+ * width scale there, |g| / sqrt(|g|^2'' / 2), into *scale. */
+static double many_least(harm_ctx *H, double lo, double hi, double *scale)
+{
+    double x = 0.5 * (lo + hi), d[3][3], f2 = 0.0;
+    for (int it = 0; it < 60; it++) {
+        many_g(H, x, 2, d);
+        const double f1 = 2.0 * dot(d[0], d[1]);
+        f2 = 2.0 * (dot(d[1], d[1]) + dot(d[0], d[2]));
+        if (f1 < 0.0)
+            lo = x;
+        else
+            hi = x;
+        double nx = f2 > 0.0 ? x - f1 / f2 : NAN;
+        if (!(nx > lo && nx < hi))
+            nx = 0.5 * (lo + hi);
+        if (fabs(nx - x) <= 1e-15 * (1.0 + fabs(x))) {
+            x = nx;
+            break;
+        }
+        x = nx;
+    }
+    many_g(H, x, 2, d);
+    f2 = 2.0 * (dot(d[1], d[1]) + dot(d[0], d[2]));
+    const double m = sqrt(dot(d[0], d[0]));
+    *scale = f2 > 0.0 ? m / sqrt(0.5 * f2) : 0.0;
+    H->fold |= !(m > MANY_FOLD * H->big);
+    return x;
+}
+
+typedef struct {
+    harm_ctx *H;
+    double c, sg, scale, tol;   /* theta = c + sg scale sinh u; tol per unit of u */
+} many_half;
+
+static double many_rule(const many_half *f, double lo, double hi)
+{
+    const harm_opts *o = f->H->o;
+    double sum = 0.0, d[3][3];
+    for (int i = 0; i < o->n; i++) {
+        const double u = lo + (hi - lo) * o->x[i], e = exp(u);
+        many_g(f->H, f->c + f->sg * f->scale * 0.5 * (e - 1.0 / e), 1, d);
+        sum += o->wt[i] * 0.5 * (e + 1.0 / e) * sqrt(dot(d[0], d[0]));
+    }
+    return (hi - lo) * f->scale * sum;
+}
+
+static double many_adapt(const many_half *f, double lo, double hi, double coarse, int depth)
+{
+    const double m = 0.5 * (lo + hi), l = many_rule(f, lo, m), r = many_rule(f, m, hi);
+    if (!(fabs(l + r - coarse) > f->tol * (hi - lo)) || depth >= MANY_DEPTH)
+        return l + r;
+    return many_adapt(f, lo, m, l, depth + 1) + many_adapt(f, m, hi, r, depth + 1);
+}
+
+/* The integral of |g| over [c, c + sg d], d > 0, graded towards c (a least value, its width scale) */
+static double many_toward(harm_ctx *H, double c, double sg, double d, double scale)
+{
+    scale = fmax(scale, 1e-14);
+    const double U = asinh(d / scale);
+    const int np = (int)ceil(U / U_WIDTH);
+    const many_half f = { H, c, sg, scale, MANY_TOL * H->big / U };
+    double sum = 0.0;
+    for (int p = 0; p < np; p++) {
+        const double lo = U * p / np, hi = U * (p + 1) / np;
+        sum += many_adapt(&f, lo, hi, many_rule(&f, lo, hi), 0);
+    }
+    return sum;
+}
+
+/* The mean over t of the element |x_t x x_w| (val[0]) and of the flux (val[1]) at the w of H->cf. */
+static void many_mean(harm_ctx *H, double *val)
+{
+    int n = 32;
+    while (n <= 3 * H->hj[H->nh - 1])
+        n *= 2;
+    int stride = MT / n;
+    double *e = H->e, sum = 0.0, fsum = 0.0, lo = INFINITY, big = 0.0, mean;
+    for (int i = 0; i < MT; i += stride) {
+        double fl;
+        sum += e[i] = many_sample(H, i, &fl);
+        fsum += fl;
+        lo = fmin(lo, e[i]), big = fmax(big, e[i]);
+    }
+    val[1] = 2.0 * M_PI * fsum / n;
+    mean = 2.0 * M_PI * sum / n;
+    H->big = big;
+    H->dip = fmin(H->dip, big > 0.0 ? lo / big : 1.0);
+    while (stride > 1) {
+        const int half = stride / 2;
+        for (int i = half; i < MT; i += stride) {
+            sum += e[i] = many_sample(H, i, NULL);
+            lo = fmin(lo, e[i]), big = fmax(big, e[i]);
+        }
+        stride = half;
+        const double next = 2.0 * M_PI * sum * stride / MT;
+        if (fabs(next - mean) <= TRAP_TOL * next) {
+            val[0] = next;
+            return;
+        }
+        mean = next;
+        if (lo < MANY_DEEP * big && stride <= MT / 256 && narrow(e, MT, stride))
+            break;
+    }
+    H->big = big;
+    /* the cuts: the least samples below MANY_CUT of the largest, and the least of all */
+    const double dt = 2.0 * M_PI * stride / MT;
+    const int ns = MT / stride;
+    double cut[MANY_CUTS], scale[MANY_CUTS];
+    int ncut = 0, at = 0;
+    for (int j = 0; j < ns; j++) {
+        const double ej = e[j * stride], l = e[(j + ns - 1) % ns * stride], r = e[(j + 1) % ns * stride];
+        if (ej < e[at * stride])
+            at = j;
+        if (ej < l && ej <= r && ej < MANY_CUT * big && ncut < MANY_CUTS)
+            cut[ncut] = many_least(H, (j - 1) * dt, (j + 1) * dt, &scale[ncut]), ncut++;
+    }
+    if (!ncut)
+        cut[ncut] = many_least(H, (at - 1) * dt, (at + 1) * dt, &scale[ncut]), ncut++;
+    double total = 0.0;
+    for (int j = 0; j < ncut; j++) {
+        const int k = (j + 1) % ncut;
+        const double a = cut[j], b = j + 1 < ncut ? cut[j + 1] : cut[0] + 2.0 * M_PI, mid = 0.5 * (a + b);
+        if (b > a)
+            total += many_toward(H, a, 1.0, mid - a, scale[j]) + many_toward(H, b, -1.0, b - mid, scale[k]);
+    }
+    val[0] = total;   /* the mean over t of 2 pi |g| */
+}
+
+static void many_at_w(void *arg, double w, double *val)
+{
+    harm_ctx *H = arg;
+    double *cf = H->cf;
+    memset(cf, 0, 6 * (2 * (size_t)H->nh + 1) * sizeof *cf);
+    solution_factors(H->s, 2, w, H->h, H->dh);
+    for (size_t m = 0; m < H->nm; m++) {
+        const int sl = H->mslot[m], at = 6 * (sl / 3) + sl % 3;
+        cf[at] += H->wt[m] * H->h[m], cf[at + 3] += H->wt[m] * H->dh[m];
+    }
+    H->nodes++;
+    many_mean(H, val);
+}
+
+/* The face's modes: 1 where each has the factor 1 or sin, cos of 2 pi j t, j whole and at most
+ * MANY_MAX, along the face's other parameter; the distinct j ascending into H->hj, H->nh, and each
+ * mode's entry into H->mslot. 0 otherwise or out of memory. */
+static int many_form(const pde_solution *s, int axis, harm_ctx *H)
+{
+    unsigned char seen[MANY_MAX + 1] = { 0 };
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
+            const pde_factor f = axis == 0 ? s->comp[c].modes[m].v : s->comp[c].modes[m].u;
+            const double p = fabs(f.p);
+            if (f.kind == PDE_POW && f.p == 0.0)
+                continue;
+            if (!((f.kind == PDE_SIN || f.kind == PDE_COS) && p >= 2.0 && p <= 2.0 * MANY_MAX &&
+                  p == 2.0 * floor(0.5 * p)))
+                return 0;
+            seen[(int)(0.5 * p)] = 1;
+        }
+    int idx[MANY_MAX + 1];
+    H->nh = 0;
+    for (int j = 1; j <= MANY_MAX; j++)
+        if (seen[j])
+            idx[j] = H->nh++;
+    if (H->nh < MANY_MIN)
+        return 0;
+    H->hj = malloc(H->nh * sizeof *H->hj);
+    H->mslot = malloc(H->nm * sizeof *H->mslot);
+    H->cf = malloc(6 * (2 * (size_t)H->nh + 1) * sizeof *H->cf);
+    H->e = malloc(MT * sizeof *H->e);
+    if (!H->hj || !H->mslot || !H->cf || !H->e)
+        return 0;
+    for (int j = 1; j <= MANY_MAX; j++)
+        if (seen[j])
+            H->hj[idx[j]] = j;
+    for (int c = 0, m = 0; c < 3; c++)
+        for (size_t i = 0; i < s->comp[c].nmodes; i++, m++) {
+            const pde_factor f = axis == 0 ? s->comp[c].modes[i].v : s->comp[c].modes[i].u;
+            const int ent = f.kind == PDE_SIN ? 1 + 2 * idx[(int)(0.5 * fabs(f.p))]
+                            : f.kind == PDE_COS ? 2 + 2 * idx[(int)(0.5 * fabs(f.p))] : 0;
+            H->mslot[m] = 3 * ent + c;
+        }
+    pthread_once(&mtrig_once, mtrig_init);
+    return 1;
+}
+
+/*
+ * The face w = side (axis 2) of a loft: x = C + u P(v), C constant along v and u, P of many
+ * harmonics along v (the modes' factors of u are 1 where those of v are, else u). Its element
+ * x_u x x_v = u (P x P_v) is linear in u, so the face's area is half the mean over v of |P x P_v|
+ * (many_mean, with P in x_w's place: exact where P x P_v keeps its sign, the cuts where it does
+ * not), and its flux x . (x_u x x_v) = u C . (P x P_v) half the mean of -(x . (P_v x P)) at u = 1.
+ * Returns 0 where the face is not of that form.
+ */
+static int many_cap(harm_ctx *H, int side, double *area, double *flux)
+{
+    const pde_solution *s = H->s;
     for (int c = 0, m = 0; c < 3; c++)
         for (size_t i = 0; i < s->comp[c].nmodes; i++, m++) {
             const pde_mode *md = &s->comp[c].modes[i];
-            const pde_factor f = axis == 0 ? md->v : md->u;
-            double der;
-            factor_eval(axis == 0 ? md->u : md->v, side, &H.wt[m], &der);
-            const int part = f.kind == PDE_SIN ? 0 : f.kind == PDE_COS ? 1 : 2;
-            if (f.kind == PDE_SIN && f.p < 0.0)
-                H.wt[m] = -H.wt[m];
-            H.slot[m] = (unsigned char)(3 * part + c);
+            const int cst = md->v.kind == PDE_POW && md->v.p == 0.0;
+            if (md->u.kind != PDE_POW || md->u.p != (cst ? 0.0 : 1.0))
+                return 0;
         }
-    pthread_once(&trig_once, trig_init);
-    H.tol[0] = o->tol, H.tol[1] = o->tol * o->size;
+    double *cf = H->cf, val[2];
+    memset(cf, 0, 6 * (2 * (size_t)H->nh + 1) * sizeof *cf);
+    solution_factors(s, 2, side, H->h, H->dh);
+    for (int c = 0, m = 0; c < 3; c++)
+        for (size_t i = 0; i < s->comp[c].nmodes; i++, m++) {
+            const int sl = H->mslot[m], at = 6 * (sl / 3) + sl % 3;
+            double fu, du;
+            factor_eval(s->comp[c].modes[i].u, 1.0, &fu, &du);
+            cf[at] += H->h[m] * fu, cf[at + 3] += H->h[m] * du;
+        }
+    H->nodes++;
+    H->dip = INFINITY;
+    many_mean(H, val);
+    *area = 0.5 * val[0];
+    *flux = -0.5 * val[1];
+    return 1;
+}
+
+int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, double *area, double *flux,
+              size_t *nodes)
+{
+    double k = 0.0;
+    harm_ctx H = { .o = o, .s = s, .splits = MAX_SPLITS, .poll_every = POLL_NODES, .max_nodes = MAX_NODES };
+    for (int c = 0; c < 3; c++)
+        H.nm += s->comp[c].nmodes;
+    H.many = !harm_form(s, axis > 1 ? 0 : axis, &k);
+    if (axis > 1 && !H.many)
+        return 0;   /* a cap of one harmonic: the general path's line is cheaper (fig. 2a, 4a) */
+    H.kpi = k * M_PI;
+    H.wt = malloc(3 * H.nm * sizeof *H.wt);
+    H.slot = malloc(H.nm);
+    int ok = H.wt && H.slot && (!H.many || many_form(s, axis == 1, &H));
+    if (H.many)   /* no cuts of w at dips: least_at's one harmonic */
+        H.splits = 0, H.poll_every = MANY_POLL, H.max_nodes = MANY_NODES;
+    if (ok) {
+        H.h = H.wt + H.nm, H.dh = H.h + H.nm;
+        for (int c = 0, m = 0; c < 3; c++)
+            for (size_t i = 0; i < s->comp[c].nmodes; i++, m++) {
+                const pde_mode *md = &s->comp[c].modes[i];
+                const pde_factor f = axis == 0 ? md->v : md->u;
+                double der;
+                factor_eval(axis == 0 ? md->u : md->v, side, &H.wt[m], &der);
+                const int part = f.kind == PDE_SIN ? 0 : f.kind == PDE_COS ? 1 : 2;
+                if (f.kind == PDE_SIN && f.p < 0.0)
+                    H.wt[m] = -H.wt[m];
+                H.slot[m] = (unsigned char)(3 * part + c);
+            }
+        pthread_once(&trig_once, trig_init);
+        H.tol[0] = o->tol, H.tol[1] = o->tol * o->size;
+    }
     double sum[2] = { 0.0, 0.0 };
-    int ok = 1;
-    for (int i = 0; i < o->np && ok == 1; i++) {
+    if (ok && axis > 1)
+        ok = many_cap(&H, side, &sum[0], &sum[1]);
+    else if (ok && H.many) {   /* every harmonic's factor 0 on the face: a curve (u = 0), nothing */
+        int flat = 1;
+        for (size_t m = 0; m < H.nm && flat; m++)
+            flat = H.mslot[m] < 3 || H.wt[m] == 0.0;
+        if (flat)
+            ok = 2;
+    }
+    for (int i = 0; i < o->np && ok == 1 && axis < 2; i++) {
         double coarse[2];
-        rule(o, at_w, &H, o->edge[i], o->edge[i + 1], 2, coarse);
+        rule_w(&H, o->edge[i], o->edge[i + 1], coarse);
         ok = outer(&H, o->edge[i], o->edge[i + 1], coarse, 0, 2, sum);
     }
+    if (H.fold || H.work > MANY_WORK)
+        ok = 0;
     if (H.stopped)
         ok = -1;
     free(H.wt);
     free(H.slot);
+    free(H.hj);
+    free(H.mslot);
+    free(H.cf);
+    free(H.e);
     *nodes += H.nodes;
+    if (ok == 2)
+        ok = 1;
     if (ok == 1)
         *area = sum[0], *flux = sum[1];
     return ok;

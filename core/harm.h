@@ -13,6 +13,11 @@
  * least values where it dips), and its flux x . (x_t x x_w) the integral of a mean known exactly from
  * the coefficients. A, B, D and their w-derivatives come from every mode's h(w) once per point of w;
  * a point of theta costs a dozen flops (docs/MATH.md, "A face of one harmonic").
+ *
+ * Faces of 4 or more harmonics along t (a loft's skin u = 1: its profile's Fourier series) the same
+ * way, the mean over theta by the trapezoidal rule on 2^n points from the coefficients at each w, cut
+ * and graded at narrow dips; and a loft's end caps w = 0, 1 (x = C + u P(v)) as half the mean of
+ * |P x P_v| (harm.c, "Many harmonics").
  */
 #ifndef PDE_HARM_H
 #define PDE_HARM_H
@@ -32,7 +37,7 @@ typedef struct {
 } harm_opts;
 
 /*
- * The face (axis, side), axis 0 or 1, when it has that form: returns 1 with its area in *area, the
+ * The face (axis, side), axis 0 or 1 (or 2: a cap of many harmonics), when it has that form: returns 1 with its area in *area, the
  * integral of x . (x_a x x_b) over it in *flux (a, b its parameters in axis order) and the points of w
  * evaluated added to *nodes; 0, nothing set, where the face is not of that form, memory ran out, or
  * the integration did not converge within its depth (the general path then); -1 where o->cancel
