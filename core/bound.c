@@ -183,11 +183,63 @@ static void jet_add(xjet *j, int c, const unsigned char *qs, int len, const doub
     }
 }
 
+/*
+ * Component c's jet where the box is flat along axis f (a face of the branch and bound: a loft's t =
+ * 1, or a segment): the modes whose factors along f have equal derivatives there fall in a group, and
+ * x's partial at orders (i_f, i_p, i_q) is sum over groups of f's i_f-th derivative times the sum over
+ * the group's modes of the p- and q-factors' product. That sum is a dense outer product a mode, which
+ * the compiler vectorises, where jet_add gathers each index's three factors: a loft's 99 modes fall
+ * in two groups (its centre and its profile, t^n), and a face's jets cost a tenth. Returns 0 (j's
+ * component unset) where the modes make more than JG_MAX groups, or a product is NaN (0 times an
+ * overflowed bound, which jet_add counts as 0): then jet_add's way.
+ */
+enum { JG_MAX = 4 };
+
+static int jet_grouped(const pde_solution *s, int c, size_t o, int f, int order, const double *const F[3], xjet *j)
+{
+    static const unsigned char *const mia[3] = { mi_u, mi_v, mi_w };
+    const int p = f == 0 ? 1 : 0, q = f == 2 ? 1 : 2, d = order + 1;
+    double acc[JG_MAX][JC_D][JC_D];
+    const double *rep[JG_MAX];
+    int ng = 0;
+    const comp_solution *cs = &s->comp[c];
+    for (size_t m = 0; m < cs->nmodes; m++, o++) {
+        const double *ft = F[f] + JC_D * o, *fp = F[p] + JC_D * o, *fq = F[q] + JC_D * o;
+        int g = 0;
+        while (g < ng && memcmp(rep[g], ft, (size_t)d * sizeof *ft) != 0)
+            g++;
+        if (g == ng) {
+            if (ng == JG_MAX)
+                return 0;
+            rep[ng++] = ft;
+            memset(acc[g], 0, sizeof acc[g]);
+        }
+        for (int i = 0; i < JC_D; i++)
+            for (int k = 0; k < JC_D; k++)
+                acc[g][i][k] += fp[i] * fq[k];
+    }
+    for (int g = 0; g < ng; g++)
+        for (int i = 0; i < d; i++)
+            for (int k = 0; k + i < d; k++)
+                if (acc[g][i][k] != acc[g][i][k])
+                    return 0;
+    for (int r = 0; r < mi_count[order]; r++) {
+        double t = 0.0;
+        for (int g = 0; g < ng; g++) {
+            const double e = rep[g][mia[f][r]];
+            t += e == 0.0 ? 0.0 : e * acc[g][mia[p][r]][mia[q][r]];
+        }
+        j->d[c][r] = t;
+    }
+    return 1;
+}
+
 /* bound = 0: x's partials up to order at the point b->lo; 1: bounds of their magnitudes over b; 2:
  * the same from the sums of the magnitudes of h's terms (mode_h_bounds), the scale of their rounding.
  * jc: a branch and bound's memo, or NULL. only: the one component wanted (the others are left
- * unset), or -1. */
-static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, int only, jet_cache *jc, xjet *j)
+ * unset), or -1. flat: an axis along which the box (not only the point) is flat, or -1 (jet_grouped). */
+static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, int only, jet_cache *jc, int flat,
+                      xjet *j)
 {
     const int n = mi_count[order];
     /* without a memo (a single model: obj_magnitude), every index: no lists to build */
@@ -203,6 +255,10 @@ static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound
     for (int c = 0; c < 3; c++) {
         const comp_solution *cs = &s->comp[c];
         if (only >= 0 && c != only) {
+            o += cs->nmodes;
+            continue;
+        }
+        if (jc && flat >= 0 && jet_grouped(s, c, o, flat, order, F, j)) {
             o += cs->nmodes;
             continue;
         }
@@ -364,8 +420,10 @@ static void model_at(const pde_solution *s, int what, const pbox *b, jet_cache *
     const int order = what < 3 ? 2 : high ? 4 : 3;
     xjet pt, mx;
     const int only = what < 3 ? what : -1;
-    xjet_fill(s, &c, order, 0, only, jc, &pt);
-    xjet_fill(s, b, order + 1, 1, only, jc, &mx);
+    /* the box's flat axis, u or v first (a loft's t: two groups of modes), for jet_grouped */
+    const int flat = r[0] == 0.0 ? 0 : r[1] == 0.0 ? 1 : r[2] == 0.0 ? 2 : -1;
+    xjet_fill(s, &c, order, 0, only, jc, flat, &pt);
+    xjet_fill(s, b, order + 1, 1, only, jc, flat, &mx);
     /* Taylor coefficients: the value, the gradient, the Hessian at the centre, the third-order bound;
      * for det J the cubic terms at the centre and the fourth-order bounds too (m->rest). */
     double tp[MI4], tb[MI4];
@@ -433,7 +491,7 @@ double obj_magnitude(const pde_solution *s, int what)
 {
     const pbox cube = { { 0, 0, 0 }, { 1, 1, 1 } };
     xjet mx;
-    xjet_fill(s, &cube, 1, 2, what < 3 ? what : -1, NULL, &mx);
+    xjet_fill(s, &cube, 1, 2, what < 3 ? what : -1, NULL, -1, &mx);
     if (what < 3)
         return mx.d[what][0];
     double t[MI3];
@@ -445,7 +503,7 @@ void pde_solution_magnitudes(const pde_solution *s, double mag[3][4])
 {
     const pbox cube = { { 0, 0, 0 }, { 1, 1, 1 } };
     xjet mx;
-    xjet_fill(s, &cube, 1, 1, -1, NULL, &mx);
+    xjet_fill(s, &cube, 1, 1, -1, NULL, -1, &mx);
     for (int c = 0; c < 3; c++)
         for (int q = 0; q < 4; q++)   /* the jets' order: x, x_u, x_v, x_w */
             mag[c][q] = mx.d[c][q];
