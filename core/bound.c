@@ -37,7 +37,7 @@ typedef struct {
  * axes not split, so most of a box's factors were evaluated for its parent (core/bound.c's
  * bb_minimise). Direct-mapped by the interval; only for solutions of at most JC_MODES modes.
  */
-enum { JC_N = 256, JC_MODES = 128, JC_D = 6 };   /* derivatives 0..5; at most 3 * 256 * 6 * 128 doubles, 4.7 MB */
+enum { JC_N = 1024, JC_MODES = 128, JC_D = 6 };   /* derivatives 0..5; at most 3 * 256 * 6 * 128 doubles, 4.7 MB */
 
 typedef struct {
     double lo, hi;
@@ -68,9 +68,14 @@ static const unsigned char *jet_list(jet_lists *L, int order, int du, int dv, in
     return L->q[order][du][dv];
 }
 
+enum { JG_MAX = 4 };   /* jet_grouped's groups a component */
+
 typedef struct jet_cache {
     size_t mt;
     int only;   /* the one component a coordinate's branch and bound needs, or -1: all three */
+    /* jet_grouped's groups along u and v: a mode's group, the first mode of each (whose factor's
+     * derivatives stand for the group's), and their count a component, JG_MAX + 1 where more */
+    unsigned char grp[2][JC_MODES], first[2][3][JG_MAX], ngrp[2][3];
     jet_lists lists;
     jc_key key[3][JC_N];
     double val[];   /* axis a, slot i: val + (a * JC_N + i) * JC_D mt */
@@ -86,6 +91,30 @@ static jet_cache *jet_cache_new(const pde_solution *s, int what)
         return NULL;   /* no memo: slower, not wrong */
     jc->mt = mt;
     jc->only = what < 3 ? what : -1;
+    /* Modes of one component with the same factor along an axis (kind and rate) have the same
+     * derivatives there: a loft's t^n profile modes and its centre's 1. */
+    for (int a = 0; a < 2; a++)
+        for (size_t c = 0, o = 0; c < 3; c++) {
+            int ng = 0;
+            for (size_t m = 0; m < s->comp[c].nmodes; m++, o++) {
+                const pde_factor f = a ? s->comp[c].modes[m].v : s->comp[c].modes[m].u;
+                int g = 0;
+                while (g < ng && g < JG_MAX) {
+                    const pde_mode *r = &s->comp[c].modes[jc->first[a][c][g]];
+                    const pde_factor e = a ? r->v : r->u;
+                    if (e.kind == f.kind && e.p == f.p)
+                        break;
+                    g++;
+                }
+                if (g == ng && ng <= JG_MAX) {
+                    if (ng < JG_MAX)
+                        jc->first[a][c][ng] = (unsigned char)m;
+                    ng++;
+                }
+                jc->grp[a][o] = (unsigned char)(g < JG_MAX ? g : 0);
+            }
+            jc->ngrp[a][c] = (unsigned char)ng;
+        }
     memset(jc->lists.len, -1, sizeof jc->lists.len);
     for (int a = 0; a < 3; a++)
         for (int i = 0; i < JC_N; i++)
@@ -142,7 +171,7 @@ static const double *axis_factors(const pde_solution *s, jet_cache *jc, int a, d
     memcpy(&kl, &lo, sizeof kl);
     memcpy(&kh, &hi, sizeof kh);
     const uint64_t hsh = (kl * 0x9E3779B97F4A7C15u) ^ (kh * 0xC2B2AE3D27D4EB4Fu) ^ (uint64_t)(order * 2 + bound);
-    const size_t slot = (size_t)(hsh >> 56);   /* JC_N = 256 */
+    const size_t slot = (size_t)(hsh >> 54);   /* JC_N = 1024 */
     jc_key *k = &jc->key[a][slot];
     double *out = jc->val + ((size_t)a * JC_N + slot) * JC_D * jc->mt;
     if (k->order == order && k->bound == bound && k->lo == lo && k->hi == hi)
@@ -184,39 +213,44 @@ static void jet_add(xjet *j, int c, const unsigned char *qs, int len, const doub
 }
 
 /*
- * Component c's jet where the box is flat along axis f (a face of the branch and bound: a loft's t =
- * 1, or a segment): the modes whose factors along f have equal derivatives there fall in a group, and
- * x's partial at orders (i_f, i_p, i_q) is sum over groups of f's i_f-th derivative times the sum over
- * the group's modes of the p- and q-factors' product. That sum is a dense outer product a mode, which
- * the compiler vectorises, where jet_add gathers each index's three factors: a loft's 99 modes fall
- * in two groups (its centre and its profile, t^n), and a face's jets cost a tenth. Returns 0 (j's
- * component unset) where the modes make more than JG_MAX groups, or a product is NaN (0 times an
- * overflowed bound, which jet_add counts as 0): then jet_add's way.
+ * Component c's jet where the box is flat along axis f, u or v (a loft's face t = 1, or a segment):
+ * modes with the same factor along f fall in a group (jet_cache's grp), and x's partial at orders
+ * (i_f, i_p, i_q) is sum over groups of f's i_f-th derivative times the sum over the group's modes of
+ * the p- and q-factors' product. That sum is a dense outer product a mode, which the compiler
+ * vectorises, where jet_add gathers each index's three factors: a loft's 99 modes fall in two groups
+ * (its centre and its profile, t^n), and a face's jets cost a quarter. Returns 0 (j's component
+ * unset) where the modes make more than JG_MAX groups, or a product is NaN (0 times an overflowed
+ * bound, which jet_add counts as 0): then jet_add's way.
  */
-enum { JG_MAX = 4 };
+static inline __attribute__((always_inline)) void outer_add(double acc[][JC_D], const double *fp, const double *fq,
+                                                            int d)
+{
+    for (int i = 0; i < d; i++)
+        for (int k = 0; k < d; k++)
+            acc[i][k] += fp[i] * fq[k];
+}
 
-static int jet_grouped(const pde_solution *s, int c, size_t o, int f, int order, const double *const F[3], xjet *j)
+static int jet_grouped(const pde_solution *s, const jet_cache *jc, int c, size_t o, int f, int order,
+                       const double *const F[3], xjet *j)
 {
     static const unsigned char *const mia[3] = { mi_u, mi_v, mi_w };
-    const int p = f == 0 ? 1 : 0, q = f == 2 ? 1 : 2, d = order + 1;
+    const int ng = jc->ngrp[f][c];
+    if (ng > JG_MAX)
+        return 0;
+    const int p = f == 0 ? 1 : 0, q = 2, d = order + 1;
     double acc[JG_MAX][JC_D][JC_D];
-    const double *rep[JG_MAX];
-    int ng = 0;
-    const comp_solution *cs = &s->comp[c];
-    for (size_t m = 0; m < cs->nmodes; m++, o++) {
-        const double *ft = F[f] + JC_D * o, *fp = F[p] + JC_D * o, *fq = F[q] + JC_D * o;
-        int g = 0;
-        while (g < ng && memcmp(rep[g], ft, (size_t)d * sizeof *ft) != 0)
-            g++;
-        if (g == ng) {
-            if (ng == JG_MAX)
-                return 0;
-            rep[ng++] = ft;
-            memset(acc[g], 0, sizeof acc[g]);
-        }
-        for (int i = 0; i < JC_D; i++)
-            for (int k = 0; k < JC_D; k++)
-                acc[g][i][k] += fp[i] * fq[k];
+    memset(acc, 0, sizeof acc);
+    const size_t o0 = o, nm = s->comp[c].nmodes;
+    /* constant sizes, so that each loop unrolls and vectorises */
+    for (size_t m = 0; m < nm; m++, o++) {
+        const double *fp = F[p] + JC_D * o, *fq = F[q] + JC_D * o;
+        double(*a)[JC_D] = acc[jc->grp[f][o]];
+        if (d == 5)
+            outer_add(a, fp, fq, 5);
+        else if (d == 6)
+            outer_add(a, fp, fq, 6);
+        else
+            outer_add(a, fp, fq, d);
     }
     for (int g = 0; g < ng; g++)
         for (int i = 0; i < d; i++)
@@ -226,7 +260,7 @@ static int jet_grouped(const pde_solution *s, int c, size_t o, int f, int order,
     for (int r = 0; r < mi_count[order]; r++) {
         double t = 0.0;
         for (int g = 0; g < ng; g++) {
-            const double e = rep[g][mia[f][r]];
+            const double e = F[f][JC_D * (o0 + jc->first[f][c][g]) + mia[f][r]];
             t += e == 0.0 ? 0.0 : e * acc[g][mia[p][r]][mia[q][r]];
         }
         j->d[c][r] = t;
@@ -258,7 +292,7 @@ static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound
             o += cs->nmodes;
             continue;
         }
-        if (jc && flat >= 0 && jet_grouped(s, c, o, flat, order, F, j)) {
+        if (jc && flat >= 0 && jet_grouped(s, jc, c, o, flat, order, F, j)) {
             o += cs->nmodes;
             continue;
         }
@@ -420,8 +454,8 @@ static void model_at(const pde_solution *s, int what, const pbox *b, jet_cache *
     const int order = what < 3 ? 2 : high ? 4 : 3;
     xjet pt, mx;
     const int only = what < 3 ? what : -1;
-    /* the box's flat axis, u or v first (a loft's t: two groups of modes), for jet_grouped */
-    const int flat = r[0] == 0.0 ? 0 : r[1] == 0.0 ? 1 : r[2] == 0.0 ? 2 : -1;
+    /* the box's flat axis, u or v (a loft's t: two groups of modes), for jet_grouped */
+    const int flat = r[0] == 0.0 ? 0 : r[1] == 0.0 ? 1 : -1;
     xjet_fill(s, &c, order, 0, only, jc, flat, &pt);
     xjet_fill(s, b, order + 1, 1, only, jc, flat, &mx);
     /* Taylor coefficients: the value, the gradient, the Hessian at the centre, the third-order bound;
