@@ -35,9 +35,12 @@ typedef struct {
  * A branch and bound's memo of every mode's factor derivatives (at a point) or their bounds (over
  * an interval) along each axis: a box's two halves share its intervals and centres along the two
  * axes not split, so most of a box's factors were evaluated for its parent (core/bound.c's
- * bb_minimise). Direct-mapped by the interval; only for solutions of at most JC_MODES modes.
+ * bb_minimise). Direct-mapped by the interval; only for solutions of at most JC_MODES modes. Slots:
+ * a power of 2 up to JC_N, as many as JC_BYTES hold (a loft's face meets more s-intervals than 256
+ * slots held: the tower's extremes took 12% more instructions), at least JC_N_MIN.
  */
-enum { JC_N = 1024, JC_MODES = 128, JC_D = 6 };   /* derivatives 0..5; at most 3 * 256 * 6 * 128 doubles, 4.7 MB */
+enum { JC_N = 1024, JC_N_MIN = 256, JC_MODES = 256, JC_D = 6 };   /* derivatives 0..5 */
+#define JC_BYTES (16u << 20)   /* 1024 slots for 99 modes (tower), 512 for 129 (blade); 9.4 MB for 256 modes */
 
 typedef struct {
     double lo, hi;
@@ -71,14 +74,15 @@ static const unsigned char *jet_list(jet_lists *L, int order, int du, int dv, in
 enum { JG_MAX = 4 };   /* jet_grouped's groups a component */
 
 typedef struct jet_cache {
-    size_t mt;
+    size_t mt, nslot;
+    int shift;  /* the hash's top bits, log2 nslot, pick the slot */
     int only;   /* the one component a coordinate's branch and bound needs, or -1: all three */
     /* jet_grouped's groups along u and v: a mode's group, the first mode of each (whose factor's
      * derivatives stand for the group's), and their count a component, JG_MAX + 1 where more */
     unsigned char grp[2][JC_MODES], first[2][3][JG_MAX], ngrp[2][3];
     jet_lists lists;
     jc_key key[3][JC_N];
-    double val[];   /* axis a, slot i: val + (a * JC_N + i) * JC_D mt */
+    double val[];   /* axis a, slot i: val + (a * nslot + i) * JC_D mt */
 } jet_cache;
 
 static jet_cache *jet_cache_new(const pde_solution *s, int what)
@@ -86,10 +90,16 @@ static jet_cache *jet_cache_new(const pde_solution *s, int what)
     size_t mt = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes;
     if (mt > JC_MODES)
         return NULL;
-    jet_cache *jc = malloc(sizeof *jc + 3 * JC_N * JC_D * mt * sizeof *jc->val);
+    size_t nslot = JC_N;
+    int bits = 10;   /* log2 JC_N */
+    while (nslot > JC_N_MIN && 3 * nslot * JC_D * mt * sizeof(double) > JC_BYTES)
+        nslot /= 2, bits--;
+    jet_cache *jc = malloc(sizeof *jc + 3 * nslot * JC_D * mt * sizeof *jc->val);
     if (!jc)
         return NULL;   /* no memo: slower, not wrong */
     jc->mt = mt;
+    jc->nslot = nslot;
+    jc->shift = 64 - bits;
     jc->only = what < 3 ? what : -1;
     /* Modes of one component with the same factor along an axis (kind and rate) have the same
      * derivatives there: a loft's t^n profile modes and its centre's 1. */
@@ -117,7 +127,7 @@ static jet_cache *jet_cache_new(const pde_solution *s, int what)
         }
     memset(jc->lists.len, -1, sizeof jc->lists.len);
     for (int a = 0; a < 3; a++)
-        for (int i = 0; i < JC_N; i++)
+        for (size_t i = 0; i < nslot; i++)
             jc->key[a][i].order = -1;
     return jc;
 }
@@ -171,9 +181,9 @@ static const double *axis_factors(const pde_solution *s, jet_cache *jc, int a, d
     memcpy(&kl, &lo, sizeof kl);
     memcpy(&kh, &hi, sizeof kh);
     const uint64_t hsh = (kl * 0x9E3779B97F4A7C15u) ^ (kh * 0xC2B2AE3D27D4EB4Fu) ^ (uint64_t)(order * 2 + bound);
-    const size_t slot = (size_t)(hsh >> 54);   /* JC_N = 1024 */
+    const size_t slot = (size_t)(hsh >> jc->shift);
     jc_key *k = &jc->key[a][slot];
-    double *out = jc->val + ((size_t)a * JC_N + slot) * JC_D * jc->mt;
+    double *out = jc->val + ((size_t)a * jc->nslot + slot) * JC_D * jc->mt;
     if (k->order == order && k->bound == bound && k->lo == lo && k->hi == hi)
         return out;
     *k = (jc_key){ lo, hi, order, bound };
