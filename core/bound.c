@@ -35,9 +35,12 @@ typedef struct {
  * A branch and bound's memo of every mode's factor derivatives (at a point) or their bounds (over
  * an interval) along each axis: a box's two halves share its intervals and centres along the two
  * axes not split, so most of a box's factors were evaluated for its parent (core/bound.c's
- * bb_minimise). Direct-mapped by the interval; only for solutions of at most JC_MODES modes.
+ * bb_minimise). Direct-mapped by the interval; only for solutions of at most JC_MODES modes. Slots:
+ * a power of 2 up to JC_N, as many as JC_BYTES hold (a loft's face meets more s-intervals than 256
+ * slots held: the tower's extremes took 12% more instructions), at least JC_N_MIN.
  */
-enum { JC_N = 256, JC_MODES = 128, JC_D = 6 };   /* derivatives 0..5; at most 3 * 256 * 6 * 128 doubles, 4.7 MB */
+enum { JC_N = 1024, JC_N_MIN = 256, JC_MODES = 256, JC_D = 6 };   /* derivatives 0..5 */
+#define JC_BYTES (16u << 20)   /* 1024 slots for 99 modes (tower), 512 for 129 (blade); 9.4 MB for 256 modes */
 
 typedef struct {
     double lo, hi;
@@ -68,12 +71,18 @@ static const unsigned char *jet_list(jet_lists *L, int order, int du, int dv, in
     return L->q[order][du][dv];
 }
 
+enum { JG_MAX = 4 };   /* jet_grouped's groups a component */
+
 typedef struct jet_cache {
-    size_t mt;
+    size_t mt, nslot;
+    int shift;  /* the hash's top bits, log2 nslot, pick the slot */
     int only;   /* the one component a coordinate's branch and bound needs, or -1: all three */
+    /* jet_grouped's groups along u and v: a mode's group, the first mode of each (whose factor's
+     * derivatives stand for the group's), and their count a component, JG_MAX + 1 where more */
+    unsigned char grp[2][JC_MODES], first[2][3][JG_MAX], ngrp[2][3];
     jet_lists lists;
     jc_key key[3][JC_N];
-    double val[];   /* axis a, slot i: val + (a * JC_N + i) * JC_D mt */
+    double val[];   /* axis a, slot i: val + (a * nslot + i) * JC_D mt */
 } jet_cache;
 
 static jet_cache *jet_cache_new(const pde_solution *s, int what)
@@ -81,14 +90,44 @@ static jet_cache *jet_cache_new(const pde_solution *s, int what)
     size_t mt = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes;
     if (mt > JC_MODES)
         return NULL;
-    jet_cache *jc = malloc(sizeof *jc + 3 * JC_N * JC_D * mt * sizeof *jc->val);
+    size_t nslot = JC_N;
+    int bits = 10;   /* log2 JC_N */
+    while (nslot > JC_N_MIN && 3 * nslot * JC_D * mt * sizeof(double) > JC_BYTES)
+        nslot /= 2, bits--;
+    jet_cache *jc = malloc(sizeof *jc + 3 * nslot * JC_D * mt * sizeof *jc->val);
     if (!jc)
         return NULL;   /* no memo: slower, not wrong */
     jc->mt = mt;
+    jc->nslot = nslot;
+    jc->shift = 64 - bits;
     jc->only = what < 3 ? what : -1;
+    /* Modes of one component with the same factor along an axis (kind and rate) have the same
+     * derivatives there: a loft's t^n profile modes and its centre's 1. */
+    for (int a = 0; a < 2; a++)
+        for (size_t c = 0, o = 0; c < 3; c++) {
+            int ng = 0;
+            for (size_t m = 0; m < s->comp[c].nmodes; m++, o++) {
+                const pde_factor f = a ? s->comp[c].modes[m].v : s->comp[c].modes[m].u;
+                int g = 0;
+                while (g < ng && g < JG_MAX) {
+                    const pde_mode *r = &s->comp[c].modes[jc->first[a][c][g]];
+                    const pde_factor e = a ? r->v : r->u;
+                    if (e.kind == f.kind && e.p == f.p)
+                        break;
+                    g++;
+                }
+                if (g == ng && ng <= JG_MAX) {
+                    if (ng < JG_MAX)
+                        jc->first[a][c][ng] = (unsigned char)m;
+                    ng++;
+                }
+                jc->grp[a][o] = (unsigned char)(g < JG_MAX ? g : 0);
+            }
+            jc->ngrp[a][c] = (unsigned char)ng;
+        }
     memset(jc->lists.len, -1, sizeof jc->lists.len);
     for (int a = 0; a < 3; a++)
-        for (int i = 0; i < JC_N; i++)
+        for (size_t i = 0; i < nslot; i++)
             jc->key[a][i].order = -1;
     return jc;
 }
@@ -142,9 +181,9 @@ static const double *axis_factors(const pde_solution *s, jet_cache *jc, int a, d
     memcpy(&kl, &lo, sizeof kl);
     memcpy(&kh, &hi, sizeof kh);
     const uint64_t hsh = (kl * 0x9E3779B97F4A7C15u) ^ (kh * 0xC2B2AE3D27D4EB4Fu) ^ (uint64_t)(order * 2 + bound);
-    const size_t slot = (size_t)(hsh >> 56);   /* JC_N = 256 */
+    const size_t slot = (size_t)(hsh >> jc->shift);
     jc_key *k = &jc->key[a][slot];
-    double *out = jc->val + ((size_t)a * JC_N + slot) * JC_D * jc->mt;
+    double *out = jc->val + ((size_t)a * jc->nslot + slot) * JC_D * jc->mt;
     if (k->order == order && k->bound == bound && k->lo == lo && k->hi == hi)
         return out;
     *k = (jc_key){ lo, hi, order, bound };
@@ -183,11 +222,68 @@ static void jet_add(xjet *j, int c, const unsigned char *qs, int len, const doub
     }
 }
 
+/*
+ * Component c's jet where the box is flat along axis f, u or v (a loft's face t = 1, or a segment):
+ * modes with the same factor along f fall in a group (jet_cache's grp), and x's partial at orders
+ * (i_f, i_p, i_q) is sum over groups of f's i_f-th derivative times the sum over the group's modes of
+ * the p- and q-factors' product. That sum is a dense outer product a mode, which the compiler
+ * vectorises, where jet_add gathers each index's three factors: a loft's 99 modes fall in two groups
+ * (its centre and its profile, t^n), and a face's jets cost a quarter. Returns 0 (j's component
+ * unset) where the modes make more than JG_MAX groups, or a product is NaN (0 times an overflowed
+ * bound, which jet_add counts as 0): then jet_add's way.
+ */
+static inline __attribute__((always_inline)) void outer_add(double acc[][JC_D], const double *fp, const double *fq,
+                                                            int d)
+{
+    for (int i = 0; i < d; i++)
+        for (int k = 0; k < d; k++)
+            acc[i][k] += fp[i] * fq[k];
+}
+
+static int jet_grouped(const pde_solution *s, const jet_cache *jc, int c, size_t o, int f, int order,
+                       const double *const F[3], xjet *j)
+{
+    static const unsigned char *const mia[3] = { mi_u, mi_v, mi_w };
+    const int ng = jc->ngrp[f][c];
+    if (ng > JG_MAX)
+        return 0;
+    const int p = f == 0 ? 1 : 0, q = 2, d = order + 1;
+    double acc[JG_MAX][JC_D][JC_D];
+    memset(acc, 0, sizeof acc);
+    const size_t o0 = o, nm = s->comp[c].nmodes;
+    /* constant sizes, so that each loop unrolls and vectorises */
+    for (size_t m = 0; m < nm; m++, o++) {
+        const double *fp = F[p] + JC_D * o, *fq = F[q] + JC_D * o;
+        double(*a)[JC_D] = acc[jc->grp[f][o]];
+        if (d == 5)
+            outer_add(a, fp, fq, 5);
+        else if (d == 6)
+            outer_add(a, fp, fq, 6);
+        else
+            outer_add(a, fp, fq, d);
+    }
+    for (int g = 0; g < ng; g++)
+        for (int i = 0; i < d; i++)
+            for (int k = 0; k + i < d; k++)
+                if (acc[g][i][k] != acc[g][i][k])
+                    return 0;
+    for (int r = 0; r < mi_count[order]; r++) {
+        double t = 0.0;
+        for (int g = 0; g < ng; g++) {
+            const double e = F[f][JC_D * (o0 + jc->first[f][c][g]) + mia[f][r]];
+            t += e == 0.0 ? 0.0 : e * acc[g][mia[p][r]][mia[q][r]];
+        }
+        j->d[c][r] = t;
+    }
+    return 1;
+}
+
 /* bound = 0: x's partials up to order at the point b->lo; 1: bounds of their magnitudes over b; 2:
  * the same from the sums of the magnitudes of h's terms (mode_h_bounds), the scale of their rounding.
  * jc: a branch and bound's memo, or NULL. only: the one component wanted (the others are left
- * unset), or -1. */
-static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, int only, jet_cache *jc, xjet *j)
+ * unset), or -1. flat: an axis along which the box (not only the point) is flat, or -1 (jet_grouped). */
+static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound, int only, jet_cache *jc, int flat,
+                      xjet *j)
 {
     const int n = mi_count[order];
     /* without a memo (a single model: obj_magnitude), every index: no lists to build */
@@ -203,6 +299,10 @@ static void xjet_fill(const pde_solution *s, const pbox *b, int order, int bound
     for (int c = 0; c < 3; c++) {
         const comp_solution *cs = &s->comp[c];
         if (only >= 0 && c != only) {
+            o += cs->nmodes;
+            continue;
+        }
+        if (jc && flat >= 0 && jet_grouped(s, jc, c, o, flat, order, F, j)) {
             o += cs->nmodes;
             continue;
         }
@@ -364,8 +464,10 @@ static void model_at(const pde_solution *s, int what, const pbox *b, jet_cache *
     const int order = what < 3 ? 2 : high ? 4 : 3;
     xjet pt, mx;
     const int only = what < 3 ? what : -1;
-    xjet_fill(s, &c, order, 0, only, jc, &pt);
-    xjet_fill(s, b, order + 1, 1, only, jc, &mx);
+    /* the box's flat axis, u or v (a loft's t: two groups of modes), for jet_grouped */
+    const int flat = r[0] == 0.0 ? 0 : r[1] == 0.0 ? 1 : -1;
+    xjet_fill(s, &c, order, 0, only, jc, flat, &pt);
+    xjet_fill(s, b, order + 1, 1, only, jc, flat, &mx);
     /* Taylor coefficients: the value, the gradient, the Hessian at the centre, the third-order bound;
      * for det J the cubic terms at the centre and the fourth-order bounds too (m->rest). */
     double tp[MI4], tb[MI4];
@@ -433,7 +535,7 @@ double obj_magnitude(const pde_solution *s, int what)
 {
     const pbox cube = { { 0, 0, 0 }, { 1, 1, 1 } };
     xjet mx;
-    xjet_fill(s, &cube, 1, 2, what < 3 ? what : -1, NULL, &mx);
+    xjet_fill(s, &cube, 1, 2, what < 3 ? what : -1, NULL, -1, &mx);
     if (what < 3)
         return mx.d[what][0];
     double t[MI3];
@@ -445,7 +547,7 @@ void pde_solution_magnitudes(const pde_solution *s, double mag[3][4])
 {
     const pbox cube = { { 0, 0, 0 }, { 1, 1, 1 } };
     xjet mx;
-    xjet_fill(s, &cube, 1, 1, -1, NULL, &mx);
+    xjet_fill(s, &cube, 1, 1, -1, NULL, -1, &mx);
     for (int c = 0; c < 3; c++)
         for (int q = 0; q < 4; q++)   /* the jets' order: x, x_u, x_v, x_w */
             mag[c][q] = mx.d[c][q];
