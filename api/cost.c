@@ -279,9 +279,9 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
         w += rres * rres * rres * (st[i].d4 + 2.0 * st[i].d0 + 3.0 * (st[i].fu + st[i].fv));
     c->work = w;
     /* core/quad.c's factor tables: each axis's values and derivatives at up to 26 points per mode;
-     * core/bound.c's memo of factors (3 axes x 256 slots x 6 doubles per mode, up to 64 modes). */
+     * core/bound.c's memo of factors (up to 16 MB, for up to 256 modes). */
     c->bytes = grid_bytes(st, res, res) + 64.0 * (PDE_PROPS_BOXES + jboxes) + 64.0 * modes + 65536.0 +
-               8.0 * (6.0 * 26.0 + 5.0) * (modes + 1.0) + (modes <= 64.0 ? 3.0 * 256.0 * 6.0 * 8.0 * modes : 0.0);
+               8.0 * (6.0 * 26.0 + 5.0) * (modes + 1.0) + (double)pde_properties_memo_bytes(sol);
 }
 
 /* ---- outputs ---- */

@@ -85,15 +85,33 @@ typedef struct jet_cache {
     double val[];   /* axis a, slot i: val + (a * nslot + i) * JC_D mt */
 } jet_cache;
 
+/* The memo's slots an axis for mt modes (into *bits, their log2), 0 where it has none. */
+static size_t jc_slots(size_t mt, int *bits)
+{
+    size_t nslot = JC_N;
+    *bits = 10;   /* log2 JC_N */
+    if (mt > JC_MODES)
+        return 0;
+    while (nslot > JC_N_MIN && 3 * nslot * JC_D * mt * sizeof(double) > JC_BYTES)
+        nslot /= 2, (*bits)--;
+    return nslot;
+}
+
+size_t pde_properties_memo_bytes(const pde_solution *s)
+{
+    const size_t mt = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes;
+    int bits;
+    const size_t nslot = jc_slots(mt, &bits);
+    return nslot ? sizeof(jet_cache) + 3 * nslot * JC_D * mt * sizeof(double) : 0;
+}
+
 static jet_cache *jet_cache_new(const pde_solution *s, int what)
 {
     size_t mt = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes;
-    if (mt > JC_MODES)
+    int bits;
+    const size_t nslot = jc_slots(mt, &bits);
+    if (!nslot)
         return NULL;
-    size_t nslot = JC_N;
-    int bits = 10;   /* log2 JC_N */
-    while (nslot > JC_N_MIN && 3 * nslot * JC_D * mt * sizeof(double) > JC_BYTES)
-        nslot /= 2, bits--;
     jet_cache *jc = malloc(sizeof *jc + 3 * nslot * JC_D * mt * sizeof *jc->val);
     if (!jc)
         return NULL;   /* no memo: slower, not wrong */

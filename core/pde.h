@@ -352,6 +352,10 @@ int pde_properties_flat_axis(const pde_solution *sol);
  * rate up to PDE_PROPS_BOXES_J_MAX (for api/cost.h). */
 size_t pde_properties_detj_boxes(const pde_solution *sol);
 
+/* The bytes of the branch and bound's memo of factors (core/bound.c), 0 for a solution of too many
+ * modes to have one (for api/cost.h). */
+size_t pde_properties_memo_bytes(const pde_solution *sol);
+
 /* Where det J also does not depend on that face's other parameter (docs/MATH.md, "det J constant
  * along the face"): that parameter (0: u, 1: v), so that det J's bounds and the integrals' roots
  * are 1-D along w; else -1 (for api/cost.h). */
