@@ -14,7 +14,7 @@
  *   bench_core                    the tables for docs/BENCHMARKS.md
  *   bench_core --solve NAME N     only N solves of the preset NAME, for instruction counts:
  *     valgrind --tool=callgrind build/bench/bench_core --solve fig4a 1000
- *   bench_core --props NAME N     N calls of pde_properties() on NAME's solution, then its
+ *   bench_core --props NAME N     N calls of pde_properties() on NAME's solution (a figure or a loft preset), then its
  *                                 properties in 17 digits, the median time of the calls:
  *     valgrind --tool=callgrind --toggle-collect=pde_properties build/bench/bench_core --props fig4a 1
  */
@@ -24,6 +24,7 @@
 #include <time.h>
 
 #include "bench.h"
+#include "loft.h"
 #include "model.h"
 #include "pde.h"
 #include "template.h"
@@ -166,12 +167,28 @@ static void bench_sample(const char *name, size_t n)
     api_model_free(m);
 }
 
-/* bench_core --props NAME N */
+/* A loft preset's solution (api/loft_presets.c), or NULL. */
+static pde_solution *loft_solution(const char *name)
+{
+    cJSON *doc = api_loft_preset_tree(name);
+    api_error err;
+    api_loft *l = doc ? api_loft_parse(cJSON_GetObjectItemCaseSensitive(doc, "loft"), "/loft", &err) : NULL;
+    pde_solution *s = NULL;
+    if (l && api_loft_solve(l, "/loft", NULL, &s, &err) != 0)
+        s = NULL;
+    api_loft_free(l);
+    cJSON_Delete(doc);
+    return s;
+}
+
+/* bench_core --props NAME N: NAME a paper figure's preset or a loft's */
 static int props_one(const char *name, long n)
 {
-    api_model *m = load(name);
-    pde_solution *s;
-    if (!m || n < 1 || n > 1000 || pde_solve(api_model_get(m), &s, NULL) != PDE_OK)
+    api_model *m = api_preset_find(name) ? load(name) : NULL;
+    pde_solution *s = m ? NULL : loft_solution(name);
+    if (!m && !s)
+        fprintf(stderr, "no preset or loft preset %s\n", name);
+    if ((!m && !s) || n < 1 || n > 1000 || (m && pde_solve(api_model_get(m), &s, NULL) != PDE_OK))
         return 1;
     double t[1000];
     pde_props p;
@@ -189,7 +206,8 @@ static int props_one(const char *name, long n)
            p.inertia[1][2], p.detj_min, p.detj_max, p.detj_min_found, p.detj_max_found, p.detj_gap, p.folds,
            p.integral_error);
     pde_solution_free(s);
-    api_model_free(m);
+    if (m)
+        api_model_free(m);
     return 0;
 }
 
