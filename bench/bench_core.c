@@ -24,23 +24,20 @@
 #include <time.h>
 
 #include "bench.h"
-#include "loft.h"
 #include "model.h"
 #include "pde.h"
-#include "template.h"
 
 
+/* A preset's model, as a client's {"preset": name} gives it: a paper figure's or a loft's */
 static api_model *load(const char *name)
 {
-    const api_preset *ps = api_preset_find(name);
-    if (!ps) {
-        fprintf(stderr, "no preset %s\n", name);
-        return NULL;
-    }
-    api_params p;
+    char doc[200];
+    snprintf(doc, sizeof doc, "{\"preset\": \"%s\"}", name);
     api_error err;
-    api_preset_params(ps, &p);
-    return api_template_expand(api_preset_template(ps), &p, &err);
+    api_model *m = api_model_parse(doc, strlen(doc), &err);
+    if (!m)
+        fprintf(stderr, "%s: %s\n", name, err.message);
+    return m;
 }
 
 static volatile double sink;
@@ -167,28 +164,12 @@ static void bench_sample(const char *name, size_t n)
     api_model_free(m);
 }
 
-/* A loft preset's solution (api/loft_presets.c), or NULL. */
-static pde_solution *loft_solution(const char *name)
-{
-    cJSON *doc = api_loft_preset_tree(name);
-    api_error err;
-    api_loft *l = doc ? api_loft_parse(cJSON_GetObjectItemCaseSensitive(doc, "loft"), "/loft", &err) : NULL;
-    pde_solution *s = NULL;
-    if (l && api_loft_solve(l, "/loft", NULL, &s, &err) != 0)
-        s = NULL;
-    api_loft_free(l);
-    cJSON_Delete(doc);
-    return s;
-}
-
 /* bench_core --props NAME N: NAME a paper figure's preset or a loft's */
 static int props_one(const char *name, long n)
 {
-    api_model *m = api_preset_find(name) ? load(name) : NULL;
-    pde_solution *s = m ? NULL : loft_solution(name);
-    if (!m && !s)
-        fprintf(stderr, "no preset or loft preset %s\n", name);
-    if ((!m && !s) || n < 1 || n > 1000 || (m && pde_solve(api_model_get(m), &s, NULL) != PDE_OK))
+    api_model *m = load(name);
+    pde_solution *s = NULL;
+    if (!m || n < 1 || n > 1000 || api_solve(m, &s, NULL) != 0)
         return 1;
     double t[1000];
     pde_props p;
@@ -206,8 +187,7 @@ static int props_one(const char *name, long n)
            p.inertia[1][2], p.detj_min, p.detj_max, p.detj_min_found, p.detj_max_found, p.detj_gap, p.folds,
            p.integral_error);
     pde_solution_free(s);
-    if (m)
-        api_model_free(m);
+    api_model_free(m);
     return 0;
 }
 

@@ -84,13 +84,15 @@ size_t paper_figure_count(void);
 const char *paper_figure_name(size_t i);
 void paper_figure_model(size_t i, pde_model *m);
 
-/* A preset's model with its default parameters (api_model_free it); fails the test if there is none. */
+/* A preset's model, as a client's {"preset": name} gives it: a paper figure's with its default parameters
+ * or a loft preset's (api_model_free it); fails the test if there is none. */
 struct api_model *preset_model(const char *name);
 
 /* 16 cosine modes in u per component (x, y; z = w), folding: a model past the properties' work bound
  * (tests/test_cost.c, test_props.c). b holds its terms, which *m points into. */
 void sixteen_mode_model(pde_bterm b[3][16], pde_model *m);
-/* The solution of a preset (a test failure if it does not solve); free with pde_solution_free(). */
+/* The solution of a preset, a figure's or a loft's (a test failure if it does not solve); free with
+ * pde_solution_free(). */
 struct pde_solution *preset_solution(const char *name);
 
 /* Reads a whole file into a NUL-terminated buffer; NULL on failure. */

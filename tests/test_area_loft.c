@@ -19,8 +19,6 @@
 #include <string.h>
 #include <cmocka.h>
 
-#include "cJSON.h"
-#include "loft.h"
 #include "pde.h"
 #include "quad.h"
 #include "support.h"
@@ -189,20 +187,6 @@ static double ref_area(const pde_solution *s, int levels, double grade, int ng, 
     return skin + caps[0] + caps[1];
 }
 
-static pde_solution *loft_preset(const char *name)
-{
-    cJSON *doc = api_loft_preset_tree(name);
-    assert_non_null(doc);
-    api_error err;
-    api_loft *l = api_loft_parse(cJSON_GetObjectItemCaseSensitive(doc, "loft"), "/loft", &err);
-    assert_non_null(l);
-    pde_solution *sol = NULL;
-    assert_int_equal(api_loft_solve(l, "/loft", NULL, &sol, &err), 0);
-    api_loft_free(l);
-    cJSON_Delete(doc);
-    return sol;
-}
-
 /* The largest extent of the solid over a grid of its points: quad_area's scale */
 static double solid_size(const pde_solution *s)
 {
@@ -229,7 +213,7 @@ static void loft_area_should_match_an_independent_quadrature(void **state)
     (void)state;
     static const char *const names[] = { "tower", "blade" };
     for (size_t k = 0; k < sizeof names / sizeof *names; k++) {
-        pde_solution *sol = loft_preset(names[k]);
+        pde_solution *sol = preset_solution(names[k]);
         section q;
         for (int i = 0; i < 7; i++) {   /* the reference's x_v, x_w against the library's */
             const double v = 0.137 * i + 0.01, w = 0.15 * i + 0.02;

@@ -491,16 +491,14 @@ static void every_loft_preset_should_load_in_the_browser_within_the_default_budg
     static const char *const page_formats[] = { "json", "f32", "glb" };
     for (size_t i = 0; i < api_loft_preset_count(); i++) {
         const char *name = api_loft_preset_name(i, NULL);
-        cJSON *doc = api_loft_preset_tree(name);
-        assert_non_null(doc);
+        api_model *m = preset_model(name);
+        assert_non_null(api_model_loft(m));
         api_error err;
-        api_loft *l = api_loft_parse(cJSON_GetObjectItemCaseSensitive(doc, "loft"), "/loft", &err);
-        assert_non_null(l);
         api_cost total = { 0, 0 }, part;
-        api_cost_loft(api_loft_get(l), &part);
+        api_cost_loft(api_model_loft(m), &part);
         api_cost_add(&total, &part);
         pde_solution *sol = NULL;
-        assert_int_equal(api_loft_solve(l, "/loft", NULL, &sol, &err), 0);
+        assert_int_equal(api_solve(m, &sol, &err), 0);
         api_cost_props(sol, &part);
         api_cost_add(&total, &part);
         for (size_t k = 0; k < sizeof page_formats / sizeof *page_formats; k++) {
@@ -515,8 +513,7 @@ static void every_loft_preset_should_load_in_the_browser_within_the_default_budg
                 fail_msg("%s %s: %.3g units, %.3g bytes", name, page_formats[k], c.work, c.bytes);
         }
         pde_solution_free(sol);
-        api_loft_free(l);
-        cJSON_Delete(doc);
+        api_model_free(m);
     }
 }
 

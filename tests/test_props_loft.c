@@ -132,21 +132,6 @@ static double ref_misfit(const double a[11], const double b[11], double size)
     return worst;
 }
 
-/* A loft preset's solution (free with pde_solution_free). */
-static pde_solution *loft_preset(const char *name)
-{
-    cJSON *doc = api_loft_preset_tree(name);
-    assert_non_null(doc);
-    api_error err;
-    api_loft *l = api_loft_parse(cJSON_GetObjectItemCaseSensitive(doc, "loft"), "/loft", &err);
-    assert_non_null(l);
-    pde_solution *sol = NULL;
-    assert_int_equal(api_loft_solve(l, "/loft", NULL, &sol, &err), 0);
-    api_loft_free(l);
-    cJSON_Delete(doc);
-    return sol;
-}
-
 /* The reference with 1.5 times `panels` panels of w per slab of 20 points, checked against `panels`
  * of 16 to tol. */
 static void converged_ref(const pde_solution *sol, int nv, int panels, double tol, loft_ref *r)
@@ -162,7 +147,7 @@ static void converged_ref(const pde_solution *sol, int nv, int panels, double to
 
 static void check_loft(const char *name)
 {
-    pde_solution *sol = loft_preset(name);
+    pde_solution *sol = preset_solution(name);
     loft_ref ref;
     converged_ref(sol, 136, 16, 1e-12, &ref);   /* the presets' 32 harmonics: integrands of degree 128 in 2 pi v */
     /* det J keeps its sign (u Z'(w) g(v, w)): the rule along v is exact */
