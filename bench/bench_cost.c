@@ -12,6 +12,7 @@
  *   bench_cost            the table for docs/BENCHMARKS.md
  *   bench_cost --quick    one run per case, presets fig1a and fig4a only
  *   bench_cost --heavy    the synthetic models only
+ *   bench_cost --lofts    the loft presets only
  *   bench_cost --example3 the properties of fig. 3a's solid (example3) at n_xy = 10, 15, .., 100
  */
 #include <malloc.h>
@@ -25,6 +26,7 @@
 
 #include "bench.h"
 #include "cost.h"
+#include "loft.h"
 #include "model.h"
 #include "output.h"
 #include "pde.h"
@@ -45,7 +47,7 @@ typedef enum { JOB_SOLVE, JOB_PROPS, JOB_OUTPUT, JOB_EVAL } job_kind;
 
 typedef struct {
     job_kind kind;
-    const pde_model *model;
+    const api_model *model;
     const pde_solution *sol;
     const pde_props *props;
     api_format fmt;
@@ -61,7 +63,7 @@ static void run(const job *j)
     switch (j->kind) {
     case JOB_SOLVE: {
         pde_solution *s = NULL;
-        if (pde_solve(j->model, &s, NULL) == PDE_OK)
+        if (api_solve(j->model, &s, NULL) == 0)
             sink += (double)pde_solution_bytes(s);
         pde_solution_free(s);
         return;
@@ -106,7 +108,7 @@ static api_cost estimate(const job *j)
 {
     api_cost c = { 0, 0 };
     switch (j->kind) {
-    case JOB_SOLVE: api_cost_solve(j->model, &c); break;
+    case JOB_SOLVE: api_cost_model(j->model, &c); break;
     case JOB_PROPS: api_cost_props(j->sol, &c); break;
     case JOB_OUTPUT: api_cost_output(j->sol, j->fmt, j->res, &c); break;
     case JOB_EVAL: api_cost_eval(j->sol, j->npoints, j->derivs, &c); break;
@@ -232,13 +234,16 @@ static void report(const char *name, const job *j)
 
 /* ---- models ---- */
 
+/* A preset's model, as a client's {"preset": name} gives it: a paper figure's or a loft's */
 static api_model *preset(const char *name)
 {
-    const api_preset *ps = api_preset_find(name);
-    api_params p;
+    char doc[200];
+    snprintf(doc, sizeof doc, "{\"preset\": \"%s\"}", name);
     api_error err;
-    api_preset_params(ps, &p);
-    return api_template_expand(api_preset_template(ps), &p, &err);
+    api_model *m = api_model_parse(doc, strlen(doc), &err);
+    if (!m)
+        fprintf(stderr, "%s: %s\n", name, err.message);
+    return m;
 }
 
 /* A solid x = u, y = v, z = w-ish, to which the heavy terms are added. */
@@ -288,7 +293,7 @@ static void heavy_free(heavy *h)
 }
 
 /* Every case of one solution: its solve, properties, the formats at res, eval. */
-static void cases(const char *name, const pde_model *m, const unsigned *res_grid, const unsigned *res_mesh,
+static void cases(const char *name, const api_model *m, const unsigned *res_grid, const unsigned *res_mesh,
                   const size_t *npts, int neval, int do_props, int do_json)
 {
     char label[96];
@@ -296,7 +301,7 @@ static void cases(const char *name, const pde_model *m, const unsigned *res_grid
     snprintf(label, sizeof label, "%s solve", name);
     report(label, &j);
     pde_solution *sol;
-    if (pde_solve(m, &sol, NULL) != PDE_OK) {
+    if (api_solve(m, &sol, NULL) != 0) {
         printf("| %s does not solve |\n", name);
         return;
     }
@@ -367,20 +372,28 @@ int main(int argc, char **argv)
         printf("\nratio estimate/measured: %.2f to %.2f\n", worst_lo, worst_hi);
         return 0;
     }
-    int quick = argc > 1 && !strcmp(argv[1], "--quick"), heavy_only = argc > 1 && !strcmp(argv[1], "--heavy");
+    int quick = argc > 1 && !strcmp(argv[1], "--quick"), heavy_only = argc > 1 && !strcmp(argv[1], "--heavy"),
+        lofts_only = argc > 1 && !strcmp(argv[1], "--lofts");
     if (quick)
         runs = 1;
     printf("| case | estimate ms | measured ms | ratio | est. MB | heap peak MB |\n");
     printf("|---|---:|---:|---:|---:|---:|\n");
     static const unsigned g33[3] = { 33, 33, 33 }, m64[3] = { 64, 64, 64 };
     static const size_t pts[3] = { 1000, 10000, 100000 };
-    for (size_t i = 0; i < api_preset_count() && !heavy_only; i++) {
+    for (size_t i = 0; i < api_preset_count() && !heavy_only && !lofts_only; i++) {
         const char *name = api_preset_at(i)->name;
         if (quick && strcmp(name, "fig1a") && strcmp(name, "fig4a"))
             continue;
         api_model *m = preset(name);
         int eval = !strcmp(name, "fig4a") || !strcmp(name, "fig3a");
-        cases(name, api_model_get(m), g33, m64, pts, eval ? 3 : 0, 1, 1);
+        cases(name, m, g33, m64, pts, eval ? 3 : 0, 1, 1);
+        api_model_free(m);
+    }
+    /* The gallery's lofts (api/loft_presets.c): sections of many harmonics, their own paths */
+    for (size_t i = 0; i < api_loft_preset_count() && !heavy_only && !quick; i++) {
+        api_model *m = preset(api_loft_preset_name(i, NULL));
+        if (m)
+            cases(api_loft_preset_name(i, NULL), m, g33, m64, pts, 0, 1, 1);
         api_model_free(m);
     }
     /* Heavy synthetic models, scaled so that each case takes seconds, not minutes. */
@@ -398,11 +411,14 @@ int main(int argc, char **argv)
         { "pow4", 2, 4, { 64, 64, 64 }, { 64, 64, 64 }, 1000 },
     };
     for (size_t i = 0; i < sizeof heavies / sizeof *heavies; i++) {
-        if (quick && i > 0)
+        if ((quick && i > 0) || lofts_only)
             break;
         heavy h;
         heavy_make(&h, heavies[i].kind, heavies[i].n);
-        cases(heavies[i].name, &h.m, heavies[i].grid, heavies[i].mesh, &heavies[i].npts, 1, 1, 1);
+        api_model *m = api_model_build(&h.m, 0, NULL);
+        if (m)
+            cases(heavies[i].name, m, heavies[i].grid, heavies[i].mesh, &heavies[i].npts, 1, 1, 1);
+        api_model_free(m);
         heavy_free(&h);
     }
     printf("\nratio estimate/measured over the cases above 0.2 ms: %.2f to %.2f\n", worst_lo, worst_hi);
