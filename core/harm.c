@@ -12,6 +12,7 @@
  * s2 = k pi (A x A' - B x B') / 2; |x_t x x_w|^2 from their dot products, nine Fourier coefficients,
  * and the flux's mean D . c0 + (A . s1 + B . c1) / 2 exactly.
  */
+#include <complex.h>
 #include <float.h>
 #include <math.h>
 #include <pthread.h>
@@ -46,8 +47,18 @@
 #define MANY_WORK 2e6   /* a face of many harmonics (below): its points of theta, at most, else the panels
                          * (tower 2e5, blade 1.6e5) */
 
+#define EV_N 256        /* the cut's rule (even_mean): intervals of beta on [0, pi] on its finest level */
+#define EV_N0 8         /* ... on its first */
+#define EV_MAP 0.05     /* ... alpha(beta) where a root lies within this of the circle, else alpha = beta */
+#define EV_SWITCH 1e-3  /* the trapezoidal rule's levels, from N0 points over pi, differ by more than this
+                         * relative: even_mean instead of its next levels */
+#define EV_GUARD 1e-10  /* the roots reproduce the element's square at the samples to this of its largest */
+
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
+/* cos alpha(beta_i) and the trapezoidal rule's weight, alpha'(beta_i) (half at the ends), at beta_i = pi i / EV_N:
+ * [0] alpha = beta, [1] alpha = beta - sin(2 beta) / 2 */
+static double evt[2][EV_N + 1][2];
 static pthread_once_t trig_once = PTHREAD_ONCE_INIT;
 
 static void trig_init(void)
@@ -55,6 +66,11 @@ static void trig_init(void)
     for (int i = 0; i < NT; i++)
         for (int j = 1; j <= 4; j++)
             trig[i][j - 1] = cos(2.0 * M_PI * i * j / NT), trig[i][j + 3] = sin(2.0 * M_PI * i * j / NT);
+    for (int i = 0; i <= EV_N; i++) {
+        const double b = M_PI * i / EV_N;
+        evt[0][i][0] = cos(b), evt[0][i][1] = i == 0 || i == EV_N ? 0.5 : 1.0;
+        evt[1][i][0] = cos(b - 0.5 * sin(2.0 * b)), evt[1][i][1] = 1.0 - cos(2.0 * b);
+    }
 }
 
 /* x_t x x_w = v[0] + v[1] cos theta + v[2] sin theta + v[3] cos 2 theta + v[4] sin 2 theta, and its
@@ -262,30 +278,210 @@ static int narrow(const double *e, int per, int stride)
  * graded towards both (toward); so too at once where the first samples dip below DEEP of their
  * largest. *dip: the least sample over the largest.
  */
+/* |z|^2, |z| without hypot's care for overflow (the coefficients are O(1)) */
+static double norm2(double complex z)
+{
+    return creal(z) * creal(z) + cimag(z) * cimag(z);
+}
+
+static double mag(double complex z)
+{
+    return sqrt(norm2(z));
+}
+
+/* The principal square root, without cancellation (libm's csqrt takes care of infinities too, at 5 times the cost) */
+static double complex root2(double complex w)
+{
+    const double x = creal(w), y = cimag(w), r = sqrt(x * x + y * y);
+    if (r == 0.0)
+        return 0.0;
+    if (x >= 0.0) {
+        const double sr = sqrt(0.5 * (r + x));
+        return sr + I * (0.5 * y / sr);
+    }
+    const double si = copysign(sqrt(0.5 * (r - x)), y);
+    return 0.5 * y / si + I * si;
+}
+
+/* The roots of y^2 + B y + C into y[0], y[1], the larger first (no cancellation). */
+static void quad_roots(double complex B, double complex C, double complex *y)
+{
+    const double complex d = root2(B * B - 4.0 * C), t = mag(-B - d) >= mag(-B + d) ? -B - d : -B + d;
+    y[0] = 0.5 * t;
+    y[1] = y[0] != 0.0 ? C / y[0] : 0.0;
+}
+
+/* The roots of z^4 + b z^3 + c z^2 + d z + e into r: Ferrari's (the resolvent cubic's largest root by
+ * Cardano), each polished by Newton while that lowers |f|: the roots of a pair about to coincide come
+ * out to their separation's share of the rounding, which is all the factors below need. */
+static void quartic_roots(double complex b, double complex c, double complex d, double complex e, double complex *r)
+{
+    const double complex b2 = b * b, p = c - 0.375 * b2, q = d - 0.5 * b * c + 0.125 * b2 * b,
+                         s = e - 0.25 * b * d + b2 * c / 16.0 - 3.0 * b2 * b2 / 256.0;
+    /* m^3 + p m^2 + (p^2 / 4 - s) m - q^2 / 8 = 0, as t^3 + P t + Q = 0 with m = t - p / 3 */
+    const double complex B = 0.25 * p * p - s, P = B - p * p / 3.0, Q = 2.0 * p * p * p / 27.0 - p * B / 3.0 - 0.125 * q * q,
+                         D = root2(0.25 * Q * Q + P * P * P / 27.0);
+    const double complex u3 = mag(-0.5 * Q - D) > mag(-0.5 * Q + D) ? -0.5 * Q - D : -0.5 * Q + D;
+    double complex m = -p / 3.0;
+    if (u3 != 0.0) {
+        const double complex w = -0.5 + 0.5 * sqrt(3.0) * I;
+        const double ang = carg(u3) / 3.0;
+        double complex u = cbrt(mag(u3)) * (cos(ang) + I * sin(ang));
+        m = 0.0;
+        for (int k = 0; k < 3; k++, u *= w) {
+            const double complex mk = u - P / (3.0 * u) - p / 3.0;
+            if (mag(mk) > mag(m))
+                m = mk;
+        }
+    }
+    double complex y[4];
+    if (m == 0.0) {   /* q = 0: y^4 + p y^2 + s */
+        quad_roots(p, s, y);
+        y[2] = -(y[0] = root2(y[0])), y[3] = -(y[1] = root2(y[1]));
+    } else {
+        const double complex sq = root2(2.0 * m);
+        quad_roots(-sq, 0.5 * p + m + q / (2.0 * sq), y);
+        quad_roots(sq, 0.5 * p + m - q / (2.0 * sq), y + 2);
+    }
+    for (int k = 0; k < 4; k++) {
+        double complex z = y[k] - 0.25 * b, f = (((z + b) * z + c) * z + d) * z + e;
+        for (int it = 0; it < 4 && f != 0.0; it++) {
+            const double complex fp = ((4.0 * z + 3.0 * b) * z + 2.0 * c) * z + d, nz = z - f / fp,
+                                 nf = (((nz + b) * nz + c) * nz + d) * nz + e;
+            if (!(mag(nf) < mag(f)))
+                break;
+            z = nz, f = nf;
+        }
+        r[k] = z;
+    }
+}
+
+/*
+ * The mean over theta of the element where its square has no odd harmonics (so in phi = 2 theta, the
+ * sections of fig. 2 and 4: D' normal to A, B and their derivatives), without sampling the dips:
+ *
+ *     P(phi) = p0 + c1 z + conj(c1 z) + c2 z^2 + conj(c2 z^2),    z = e^(i phi),
+ *
+ * and the mean of sqrt(P) is that of P / sqrt(P), p0 m0 + 2 Re(c1 m1 + c2 m2) with m_j the mean of
+ * z^j / sqrt(P) = (1 / 2 pi i) times the integral of z^j dz / sqrt(Q(z)) round the circle, Q = z^2 P a
+ * quartic whose roots pair as zeta, 1 / conj(zeta): the two inside, z1 and z2, joined by a cut, to
+ * which the contour shrinks (no pole inside for j >= 0). On the cut, z = M + H cos alpha (M, H their
+ * mid-point and half-difference), the roots' square roots cancel dz's, and
+ *
+ *     m_j = +-(1 / pi) int_0^pi z^j dalpha / sqrt(C0 (1 - z conj(z1)) (1 - z conj(z2))),   C0 = c2 / conj(z1 z2),
+ *
+ * analytic but where z meets the outside roots, near the ends when a dip is deep (a root near the
+ * circle: alpha about 2i sqrt of its distance); alpha = beta - sin(2 beta) / 2 (alpha near beta^3 at
+ * the ends) takes that to about its cube root, and the trapezoidal rule in beta, the integrand even
+ * and periodic, converges geometrically: EV_N0, 2 EV_N0, ... points until two levels agree. The sign
+ * is m0's: positive. Returns 0 (the sampled path then) where c2 is small (a root near 0 or infinity),
+ * a root lies on the circle (the element meets 0), the roots do not reproduce P at the samples to
+ * EV_GUARD, or the rule did not converge. *dip: the least over the largest of the element.
+ */
+static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
+{
+    const double p0 = q->a[0];
+    const double complex c1 = 0.5 * (q->a[2] - I * q->b[2]), c2 = 0.5 * (q->a[4] - I * q->b[4]);
+    if (!(mag(c2) > 1e-6 * p0))
+        return 0;
+    double e2[N0], lo = INFINITY, big = 0.0;
+    const int stride = NT / 2 / N0;   /* N0 points over pi */
+    for (int i = 0; i < N0; i++) {
+        e2[i] = e[stride * i] * e[stride * i];
+        lo = e2[i] < lo ? e2[i] : lo;
+        big = big > e2[i] ? big : e2[i];
+    }
+    if (!(lo > 0.0))
+        return 0;
+    double complex r[4], z1, z2;
+    quartic_roots(c1 / c2, p0 / c2, conj(c1) / c2, conj(c2) / c2, r);
+    /* the two inside */
+    for (int i = 1; i < 4; i++)
+        for (int j = i; j > 0 && mag(r[j]) < mag(r[j - 1]); j--) {
+            const double complex t = r[j];
+            r[j] = r[j - 1], r[j - 1] = t;
+        }
+    z1 = r[0], z2 = r[1];
+    if (!(mag(z2) < 1.0 && mag(r[2]) > 1.0))
+        return 0;
+    const double K = mag(c2) / (mag(z1) * mag(z2));
+    for (int i = 0; i < N0; i++) {
+        const double complex z = trig[stride * i][1] + I * trig[stride * i][5];
+        const double d1 = mag(z - z1), d2 = mag(z - z2);
+        if (!(fabs(K * d1 * d1 * d2 * d2 - e2[i]) <= EV_GUARD * big))
+            return 0;
+    }
+    const double complex M = 0.5 * (z1 + z2), H = 0.5 * (z1 - z2), sc = conj(z1) + conj(z2), pr = conj(z1) * conj(z2),
+                         R0 = root2(c2 / pr);
+    const double (*tab)[2] = evt[1.0 - mag(z2) < EV_MAP];
+    double complex S[3] = { 0.0, 0.0, 0.0 };
+    double prev = NAN;
+    for (int st = EV_N / EV_N0, first = 1; st >= 1; st /= 2, first = 0) {
+        for (int i = first ? 0 : st; i <= EV_N; i += first ? st : 2 * st) {
+            const double complex z = M + H * tab[i][0], w = 1.0 - z * (sc - z * pr);
+            /* 1 / sqrt(w) = conj(sqrt(w)) / |w|, sqrt(w) without cancellation */
+            const double x = creal(w), y = cimag(w), rw = sqrt(x * x + y * y);
+            double sr, si;
+            if (x >= 0.0)
+                sr = sqrt(0.5 * (rw + x)), si = 0.5 * y / sr;
+            else
+                si = copysign(sqrt(0.5 * (rw - x)), y), sr = 0.5 * y / si;
+            const double complex u = (sr - I * si) * (tab[i][1] / rw), uz = u * z;
+            S[0] += u, S[1] += uz, S[2] += uz * z;
+        }
+        const double complex f = 1.0 / ((double)(EV_N / st) * R0), m0 = S[0] * f;
+        const double sg = creal(m0) > 0.0 ? 1.0 : -1.0,
+                     cur = sg * (p0 * creal(m0) + 2.0 * creal(c1 * S[1] * f + c2 * S[2] * f));
+        if (fabs(cur - prev) <= TRAP_TOL * cur) {
+            if (!(fabs(cimag(m0)) <= 1e-10 * fabs(creal(m0))))
+                return 0;
+            *mean = cur;
+            /* the least of P also where a root is nearest the circle (a narrow dip between samples) */
+            for (int k = 0; k < 2; k++) {
+                const double complex z = k ? z2 : z1, c = z / mag(z);
+                const double d1 = mag(c - z1), d2 = mag(c - z2), pk = K * d1 * d1 * d2 * d2;
+                lo = pk < lo ? pk : lo;
+            }
+            *dip = sqrt(lo / big);
+            return 1;
+        }
+        prev = cur;
+    }
+    return 0;
+}
+
 static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
 {
+    double ev;
     const int per = q->odd ? NT : NT / 2;
     double e[NT], sum = 0.0, mean, lo = INFINITY, big = 0.0;
     int stride = NT / N0;
     for (int i = 0; i < per; i += stride) {
-        sum += e[i] = sqrt(fmax(q_at(q, trig[i]), 0.0));
-        lo = fmin(lo, e[i]), big = fmax(big, e[i]);
+        const double p = q_at(q, trig[i]);
+        sum += e[i] = p > 0.0 ? sqrt(p) : 0.0;
+        lo = e[i] < lo ? e[i] : lo, big = e[i] > big ? e[i] : big;
     }
     mean = sum * stride / per;
     *dip = big > 0.0 ? lo / big : 1.0;
     while (stride > 1 && !(stride <= NT / 64 && *dip < DEEP && narrow(e, per, stride))) {
         const int half = stride / 2;
         for (int i = half; i < per; i += stride) {
-            sum += e[i] = sqrt(fmax(q_at(q, trig[i]), 0.0));
-            lo = fmin(lo, e[i]), big = fmax(big, e[i]);
+            const double p = q_at(q, trig[i]);
+            sum += e[i] = p > 0.0 ? sqrt(p) : 0.0;
+            lo = e[i] < lo ? e[i] : lo, big = e[i] > big ? e[i] : big;
         }
         stride = half;
         const double next = sum * stride / per;
         *dip = big > 0.0 ? lo / big : 1.0;
         if (fabs(next - mean) <= TRAP_TOL * next)
             return next;
+        /* slow to converge: a dip, which even_mean takes at a fixed cost */
+        if (!q->odd && stride <= NT / 2 / N0 && fabs(next - mean) > EV_SWITCH * next && even_mean(q, e, &ev, dip))
+            return ev;
         mean = next;
     }
+    if (!q->odd && stride <= NT / 2 / N0 && even_mean(q, e, &ev, dip))
+        return ev;
     const double dt = stride * 2.0 * M_PI / NT, period = per * (2.0 * M_PI / NT);
     const int ns = per / stride;
     double cut[NT], scale[NT];
