@@ -312,8 +312,7 @@ static void quad_roots(double complex B, double complex C, double complex *y)
 }
 
 /* The roots of z^4 + b z^3 + c z^2 + d z + e into r: Ferrari's (the resolvent cubic's largest root by
- * Cardano), each polished by Newton while that lowers |f|: the roots of a pair about to coincide come
- * out to their separation's share of the rounding, which is all the factors below need. */
+ * Cardano), unpolished. */
 static void quartic_roots(double complex b, double complex c, double complex d, double complex e, double complex *r)
 {
     const double complex b2 = b * b, p = c - 0.375 * b2, q = d - 0.5 * b * c + 0.125 * b2 * b,
@@ -343,17 +342,23 @@ static void quartic_roots(double complex b, double complex c, double complex d, 
         quad_roots(-sq, 0.5 * p + m + q / (2.0 * sq), y);
         quad_roots(sq, 0.5 * p + m - q / (2.0 * sq), y + 2);
     }
-    for (int k = 0; k < 4; k++) {
-        double complex z = y[k] - 0.25 * b, f = (((z + b) * z + c) * z + d) * z + e;
-        for (int it = 0; it < 4 && f != 0.0; it++) {
-            const double complex fp = ((4.0 * z + 3.0 * b) * z + 2.0 * c) * z + d, nz = z - f / fp,
-                                 nf = (((nz + b) * nz + c) * nz + d) * nz + e;
-            if (!(mag(nf) < mag(f)))
-                break;
-            z = nz, f = nf;
-        }
-        r[k] = z;
+    for (int k = 0; k < 4; k++)
+        r[k] = y[k] - 0.25 * b;
+}
+
+/* A root z of z^4 + b z^3 + c z^2 + d z + e polished by Newton while that lowers |f| (a root of a pair
+ * about to coincide comes out to their separation's share of the rounding, all the factors need). */
+static double complex polish(double complex b, double complex c, double complex d, double complex e, double complex z)
+{
+    double complex f = (((z + b) * z + c) * z + d) * z + e;
+    for (int it = 0; it < 4 && f != 0.0; it++) {
+        const double complex fp = ((4.0 * z + 3.0 * b) * z + 2.0 * c) * z + d, nz = z - f / fp,
+                             nf = (((nz + b) * nz + c) * nz + d) * nz + e;
+        if (!(norm2(nf) < norm2(f)))
+            break;
+        z = nz, f = nf;
     }
+    return z;
 }
 
 /*
@@ -393,16 +398,20 @@ static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
     }
     if (!(lo > 0.0))
         return 0;
+    const double complex qb = c1 / c2, qc = p0 / c2, qd = conj(c1) / c2, qe = conj(c2) / c2;
     double complex r[4], z1, z2;
-    quartic_roots(c1 / c2, p0 / c2, conj(c1) / c2, conj(c2) / c2, r);
-    /* the two inside */
+    quartic_roots(qb, qc, qd, qe, r);
+    /* the two inside, polished (a root's mirror 1 / conj(z) is one too) */
     for (int i = 1; i < 4; i++)
-        for (int j = i; j > 0 && mag(r[j]) < mag(r[j - 1]); j--) {
+        for (int j = i; j > 0 && norm2(r[j]) < norm2(r[j - 1]); j--) {
             const double complex t = r[j];
             r[j] = r[j - 1], r[j - 1] = t;
         }
-    z1 = r[0], z2 = r[1];
-    if (!(mag(z2) < 1.0 && mag(r[2]) > 1.0))
+    for (int k = 0; k < 2; k++)
+        if (norm2(r[k] = polish(qb, qc, qd, qe, r[k])) > 1.0)
+            r[k] = 1.0 / conj(r[k]);
+    z1 = norm2(r[0]) <= norm2(r[1]) ? r[0] : r[1], z2 = norm2(r[0]) <= norm2(r[1]) ? r[1] : r[0];
+    if (!(norm2(z2) < 1.0))
         return 0;
     const double K = mag(c2) / (mag(z1) * mag(z2));
     for (int i = 0; i < N0; i++) {
@@ -414,21 +423,25 @@ static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
     const double complex M = 0.5 * (z1 + z2), H = 0.5 * (z1 - z2), sc = conj(z1) + conj(z2), pr = conj(z1) * conj(z2),
                          R0 = root2(c2 / pr);
     const double (*tab)[2] = evt[1.0 - mag(z2) < EV_MAP];
-    double complex S[3] = { 0.0, 0.0, 0.0 };
-    double prev = NAN;
+    /* in real arithmetic: z = M + H cos alpha, w = 1 - z (sc - z pr), S_j += alpha' z^j / sqrt(w) */
+    const double Mr = creal(M), Mi = cimag(M), Hr = creal(H), Hi = cimag(H), sr_ = creal(sc), si_ = cimag(sc),
+                 pr_ = creal(pr), pi_ = cimag(pr);
+    double s0r = 0.0, s0i = 0.0, s1r = 0.0, s1i = 0.0, s2r = 0.0, s2i = 0.0, prev = NAN;
     for (int st = EV_N / EV_N0, first = 1; st >= 1; st /= 2, first = 0) {
         for (int i = first ? 0 : st; i <= EV_N; i += first ? st : 2 * st) {
-            const double complex z = M + H * tab[i][0], w = 1.0 - z * (sc - z * pr);
+            const double zr = Mr + Hr * tab[i][0], zi = Mi + Hi * tab[i][0];
+            const double tr = sr_ - (zr * pr_ - zi * pi_), ti = si_ - (zr * pi_ + zi * pr_);
+            const double x = 1.0 - (zr * tr - zi * ti), y = -(zr * ti + zi * tr), rw = sqrt(x * x + y * y);
             /* 1 / sqrt(w) = conj(sqrt(w)) / |w|, sqrt(w) without cancellation */
-            const double x = creal(w), y = cimag(w), rw = sqrt(x * x + y * y);
-            double sr, si;
+            double a, b;
             if (x >= 0.0)
-                sr = sqrt(0.5 * (rw + x)), si = 0.5 * y / sr;
+                a = sqrt(0.5 * (rw + x)), b = 0.5 * y / a;
             else
-                si = copysign(sqrt(0.5 * (rw - x)), y), sr = 0.5 * y / si;
-            const double complex u = (sr - I * si) * (tab[i][1] / rw), uz = u * z;
-            S[0] += u, S[1] += uz, S[2] += uz * z;
+                b = copysign(sqrt(0.5 * (rw - x)), y), a = 0.5 * y / b;
+            const double g = tab[i][1] / rw, ur = a * g, ui = -b * g, vr = ur * zr - ui * zi, vi = ur * zi + ui * zr;
+            s0r += ur, s0i += ui, s1r += vr, s1i += vi, s2r += vr * zr - vi * zi, s2i += vr * zi + vi * zr;
         }
+        const double complex S[3] = { s0r + I * s0i, s1r + I * s1i, s2r + I * s2i };
         const double complex f = 1.0 / ((double)(EV_N / st) * R0), m0 = S[0] * f;
         const double sg = creal(m0) > 0.0 ? 1.0 : -1.0,
                      cur = sg * (p0 * creal(m0) + 2.0 * creal(c1 * S[1] * f + c2 * S[2] * f));
@@ -701,25 +714,6 @@ static int outer(harm_ctx *H, double a, double b, const double *coarse, int dept
     return outer(H, a, m, l, depth + 1, split, out) && outer(H, m, b, r, depth + 1, split, out);
 }
 
-/* The face's modes: 1 where each has the factor 1 or sin, cos of one even k along the face's other
- * parameter (k into *k), else 0. */
-static int harm_form(const pde_solution *s, int axis, double *k)
-{
-    *k = 0.0;
-    for (int c = 0; c < 3; c++)
-        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
-            const pde_factor f = axis == 0 ? s->comp[c].modes[m].v : s->comp[c].modes[m].u;
-            const double p = fabs(f.p);
-            if (f.kind == PDE_POW && f.p == 0.0)
-                continue;
-            if (!((f.kind == PDE_SIN || f.kind == PDE_COS) && p >= 2.0 && p <= PDE_MAX_FREQ &&
-                  p == 2.0 * floor(0.5 * p)) || (*k != 0.0 && p != *k))
-                return 0;
-            *k = p;
-        }
-    return *k != 0.0;
-}
-
 /*
  * Many harmonics (a loft's face u = 1: its profile's Fourier series, k = 1..32). Where every mode's
  * factor along t is 1 or sin, cos of 2 pi j t for whole j, each coordinate is at each w
@@ -962,23 +956,41 @@ static void many_at_w(void *arg, double w, double *val)
     many_mean(H, val);
 }
 
-/* The face's modes: 1 where each has the factor 1 or sin, cos of 2 pi j t, j whole and at most
- * MANY_MAX, along the face's other parameter; the distinct j ascending into H->hj, H->nh, and each
- * mode's entry into H->mslot. 0 otherwise or out of memory. */
-static int many_form(const pde_solution *s, int axis, harm_ctx *H)
+/*
+ * The face's modes along its other parameter t (axis 0: v, 1: u): 1 where each has the factor 1 or
+ * sin, cos of p pi t with p even (2 pi j t, j whole) and at most PDE_MAX_FREQ, else 0; the j's up to
+ * MANY_MAX marked in seen (*over set where one is beyond), and *k = p where all share one p (one
+ * harmonic, harm.h's form), else 0. One scan for both paths.
+ */
+static int face_form(const pde_solution *s, int axis, unsigned char seen[MANY_MAX + 1], double *k, int *over)
 {
-    unsigned char seen[MANY_MAX + 1] = { 0 };
+    int one = 1;
+    *k = 0.0, *over = 0;
+    memset(seen, 0, MANY_MAX + 1);
     for (int c = 0; c < 3; c++)
         for (size_t m = 0; m < s->comp[c].nmodes; m++) {
             const pde_factor f = axis == 0 ? s->comp[c].modes[m].v : s->comp[c].modes[m].u;
             const double p = fabs(f.p);
             if (f.kind == PDE_POW && f.p == 0.0)
                 continue;
-            if (!((f.kind == PDE_SIN || f.kind == PDE_COS) && p >= 2.0 && p <= 2.0 * MANY_MAX &&
-                  p == 2.0 * floor(0.5 * p)))
+            if (!((f.kind == PDE_SIN || f.kind == PDE_COS) && p >= 2.0 && p <= PDE_MAX_FREQ && p == 2.0 * floor(0.5 * p)))
                 return 0;
-            seen[(int)(0.5 * p)] = 1;
+            one &= *k == 0.0 || p == *k;
+            *k = p;
+            if (p <= 2.0 * MANY_MAX)
+                seen[(int)(0.5 * p)] = 1;
+            else
+                *over = 1;
         }
+    if (!one)
+        *k = 0.0;
+    return 1;
+}
+
+/* The face's many harmonics, seen (face_form's, none beyond MANY_MAX): the distinct j ascending into
+ * H->hj, H->nh, and each mode's entry into H->mslot. 0 where fewer than MANY_MIN, or out of memory. */
+static int many_form(const pde_solution *s, int axis, const unsigned char seen[MANY_MAX + 1], harm_ctx *H)
+{
     int idx[MANY_MAX + 1];
     H->nh = 0;
     for (int j = 1; j <= MANY_MAX; j++)
@@ -1045,17 +1057,21 @@ static int many_cap(harm_ctx *H, int side, double *area, double *flux)
 int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, double *area, double *flux,
               size_t *nodes)
 {
-    double k = 0.0;
+    double k;
+    unsigned char seen[MANY_MAX + 1];
+    int over;
     harm_ctx H = { .o = o, .s = s, .splits = MAX_SPLITS, .poll_every = POLL_NODES, .max_nodes = MAX_NODES };
     for (int c = 0; c < 3; c++)
         H.nm += s->comp[c].nmodes;
-    H.many = !harm_form(s, axis > 1 ? 0 : axis, &k);
+    if (!face_form(s, axis == 1, seen, &k, &over))
+        return 0;
+    H.many = k == 0.0;
     if (axis > 1 && !H.many)
         return 0;   /* a cap of one harmonic: the general path's line is cheaper (fig. 2a, 4a) */
     H.kpi = k * M_PI;
     H.wt = malloc(3 * H.nm * sizeof *H.wt);
     H.slot = malloc(H.nm);
-    int ok = H.wt && H.slot && (!H.many || many_form(s, axis == 1, &H));
+    int ok = H.wt && H.slot && (!H.many || (!over && many_form(s, axis == 1, seen, &H)));
     if (H.many)   /* no cuts of w at dips: least_at's one harmonic */
         H.splits = 0, H.poll_every = MANY_POLL, H.max_nodes = MANY_NODES;
     if (ok) {
