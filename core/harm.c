@@ -47,18 +47,18 @@
 #define MANY_WORK 2e6   /* a face of many harmonics (below): its points of theta, at most, else the panels
                          * (tower 2e5, blade 1.6e5) */
 
-#define EV_N 256        /* the cut's rule (even_mean): intervals of beta on [0, pi] on its finest level */
+#define EV_N 1024       /* the cut's rule (even_mean): intervals of beta on [0, pi] on its finest level */
 #define EV_N0 8         /* ... on its first */
 #define EV_MAP 0.05     /* ... alpha(beta) where a root lies within this of the circle, else alpha = beta */
 #define EV_SWITCH 1e-3  /* the trapezoidal rule's levels, from N0 points over pi, differ by more than this
                          * relative: even_mean instead of its next levels */
-#define EV_GUARD 1e-10  /* the roots reproduce the element's square at the samples to this of its largest */
+#define EV_GUARD 1e-8   /* the roots reproduce the element's square at the samples to this of its largest */
 
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
-/* cos alpha(beta_i) and the trapezoidal rule's weight, alpha'(beta_i) (half at the ends), at beta_i = pi i / EV_N:
- * [0] alpha = beta, [1] alpha = beta - sin(2 beta) / 2 */
-static double evt[2][EV_N + 1][2];
+/* cos alpha(beta_i), the trapezoidal rule's weight alpha'(beta_i) (half at the ends), 1 - cos alpha and
+ * 1 + cos alpha (without cancellation), at beta_i = pi i / EV_N: [0] alpha = beta, [1] alpha = beta - sin(2 beta) / 2 */
+static double evt[2][EV_N + 1][4];
 static pthread_once_t trig_once = PTHREAD_ONCE_INIT;
 
 static void trig_init(void)
@@ -68,8 +68,11 @@ static void trig_init(void)
             trig[i][j - 1] = cos(2.0 * M_PI * i * j / NT), trig[i][j + 3] = sin(2.0 * M_PI * i * j / NT);
     for (int i = 0; i <= EV_N; i++) {
         const double b = M_PI * i / EV_N;
-        evt[0][i][0] = cos(b), evt[0][i][1] = i == 0 || i == EV_N ? 0.5 : 1.0;
-        evt[1][i][0] = cos(b - 0.5 * sin(2.0 * b)), evt[1][i][1] = 1.0 - cos(2.0 * b);
+        for (int m = 0; m < 2; m++) {
+            const double a = m ? b - 0.5 * sin(2.0 * b) : b, sa = sin(0.5 * a), ca = cos(0.5 * a);
+            evt[m][i][0] = cos(a), evt[m][i][2] = 2.0 * sa * sa, evt[m][i][3] = 2.0 * ca * ca;
+            evt[m][i][1] = m ? 2.0 * sin(b) * sin(b) : i == 0 || i == EV_N ? 0.5 : 1.0;
+        }
     }
 }
 
@@ -420,18 +423,33 @@ static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
         if (!(fabs(K * d1 * d1 * d2 * d2 - e2[i]) <= EV_GUARD * big))
             return 0;
     }
-    const double complex M = 0.5 * (z1 + z2), H = 0.5 * (z1 - z2), sc = conj(z1) + conj(z2), pr = conj(z1) * conj(z2),
-                         R0 = root2(c2 / pr);
-    const double (*tab)[2] = evt[1.0 - mag(z2) < EV_MAP];
-    /* in real arithmetic: z = M + H cos alpha, w = 1 - z (sc - z pr), S_j += alpha' z^j / sqrt(w) */
-    const double Mr = creal(M), Mi = cimag(M), Hr = creal(H), Hi = cimag(H), sr_ = creal(sc), si_ = cimag(sc),
-                 pr_ = creal(pr), pi_ = cimag(pr);
+    /* P's least also where a root is nearest the circle (a narrow dip between the samples), where the
+     * roots must reproduce P to 1e-3 (the correction below is of first order) but for P's rounding */
+    for (int k = 0; k < 2; k++) {
+        const double complex z = k ? z2 : z1, c = z / mag(z);
+        const double d1 = mag(c - z1), d2 = mag(c - z2), pk = K * d1 * d1 * d2 * d2,
+                     pc = p0 + 2.0 * creal(c1 * c + c2 * c * c);
+        if (!(fabs(pc - pk) <= 1e-3 * pk + 1e-14 * big))
+            return 0;
+        lo = pk < lo ? pk : lo;
+    }
+    const double complex M = 0.5 * (z1 + z2), H = 0.5 * (z1 - z2), pr = conj(z1) * conj(z2);
+    /* The roots' P~ = K |z - z1|^2 |z - z2|^2 (C0 = K): its coefficients, p0 + dp0 and so on */
+    const double e1 = 1.0 - norm2(z1), e2_ = 1.0 - norm2(z2), A1 = 2.0 - e1, A2 = 2.0 - e2_;
+    const double dp0 = K * (A1 * A2 + 2.0 * creal(conj(z1) * z2)) - p0;
+    const double complex dc1 = -K * (A1 * conj(z2) + A2 * conj(z1)) - c1, dc2 = K * pr - c2;
+    /* w = (1 - z conj(z1)) (1 - z conj(z2)), each factor from its end, z = z1 - H (1 - cos alpha) =
+     * z2 + H (1 + cos alpha): e_k + ..., no cancellation where it is small (a root near the circle) */
+    const double complex g1 = conj(z1) * H, g2 = -conj(z2) * H;
+    const double (*tab)[4] = evt[1.0 - mag(z2) < EV_MAP];
+    const double Mr = creal(M), Mi = cimag(M), Hr = creal(H), Hi = cimag(H), g1r = creal(g1), g1i = cimag(g1),
+                 g2r = creal(g2), g2i = cimag(g2);
     double s0r = 0.0, s0i = 0.0, s1r = 0.0, s1i = 0.0, s2r = 0.0, s2i = 0.0, prev = NAN;
     for (int st = EV_N / EV_N0, first = 1; st >= 1; st /= 2, first = 0) {
         for (int i = first ? 0 : st; i <= EV_N; i += first ? st : 2 * st) {
             const double zr = Mr + Hr * tab[i][0], zi = Mi + Hi * tab[i][0];
-            const double tr = sr_ - (zr * pr_ - zi * pi_), ti = si_ - (zr * pi_ + zi * pr_);
-            const double x = 1.0 - (zr * tr - zi * ti), y = -(zr * ti + zi * tr), rw = sqrt(x * x + y * y);
+            const double f1r = e1 + g1r * tab[i][2], f1i = g1i * tab[i][2], f2r = e2_ + g2r * tab[i][3], f2i = g2i * tab[i][3];
+            const double x = f1r * f2r - f1i * f2i, y = f1r * f2i + f1i * f2r, rw = sqrt(x * x + y * y);
             /* 1 / sqrt(w) = conj(sqrt(w)) / |w|, sqrt(w) without cancellation */
             double a, b;
             if (x >= 0.0)
@@ -442,19 +460,17 @@ static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
             s0r += ur, s0i += ui, s1r += vr, s1i += vi, s2r += vr * zr - vi * zi, s2i += vr * zi + vi * zr;
         }
         const double complex S[3] = { s0r + I * s0i, s1r + I * s1i, s2r + I * s2i };
-        const double complex f = 1.0 / ((double)(EV_N / st) * R0), m0 = S[0] * f;
-        const double sg = creal(m0) > 0.0 ? 1.0 : -1.0,
-                     cur = sg * (p0 * creal(m0) + 2.0 * creal(c1 * S[1] * f + c2 * S[2] * f));
+        const double f = 1.0 / ((double)(EV_N / st) * sqrt(K)), sg = s0r > 0.0 ? f : -f;
+        const double complex m0 = sg * S[0], m1 = sg * S[1], m2 = sg * S[2];
+        /* mean sqrt(P) = mean sqrt(P~) + mean (P - P~) / (2 sqrt(P~)) to first order in P - P~, the roots'
+         * error (1e-10 of P where a pair of them nearly coincides, their mean place; P's own rounding
+         * near them): mean P / sqrt(P~) less half of mean (P - P~) / sqrt(P~) */
+        const double cur = p0 * creal(m0) + 2.0 * creal(c1 * m1 + c2 * m2) +
+                           0.5 * (dp0 * creal(m0) + 2.0 * creal(dc1 * m1 + dc2 * m2));
         if (fabs(cur - prev) <= TRAP_TOL * cur) {
             if (!(fabs(cimag(m0)) <= 1e-10 * fabs(creal(m0))))
                 return 0;
             *mean = cur;
-            /* the least of P also where a root is nearest the circle (a narrow dip between samples) */
-            for (int k = 0; k < 2; k++) {
-                const double complex z = k ? z2 : z1, c = z / mag(z);
-                const double d1 = mag(c - z1), d2 = mag(c - z2), pk = K * d1 * d1 * d2 * d2;
-                lo = pk < lo ? pk : lo;
-            }
             *dip = sqrt(lo / big);
             return 1;
         }
