@@ -11,6 +11,10 @@
  * c0 = k pi (A x B' - B x A') / 2, c1 = k pi A x D', s1 = -k pi B x D', c2 = k pi (A x B' + B x A') / 2,
  * s2 = k pi (A x A' - B x B') / 2; |x_t x x_w|^2 from their dot products, nine Fourier coefficients,
  * and the flux's mean D . c0 + (A . s1 + B . c1) / 2 exactly.
+ *
+ * Where |x_t x x_w|^2 has no odd harmonics (fig. 2 and 4: D' normal to A, B, A', B'), it is a
+ * trigonometric polynomial of degree 2 in 2 theta, and where the trapezoidal rule converges slowly (a
+ * dip) the mean comes from its roots instead (even_mean): a fixed cost, whatever the dips' depth.
  */
 #include <complex.h>
 #include <float.h>
