@@ -11,7 +11,12 @@
  * c0 = k pi (A x B' - B x A') / 2, c1 = k pi A x D', s1 = -k pi B x D', c2 = k pi (A x B' + B x A') / 2,
  * s2 = k pi (A x A' - B x B') / 2; |x_t x x_w|^2 from their dot products, nine Fourier coefficients,
  * and the flux's mean D . c0 + (A . s1 + B . c1) / 2 exactly.
+ *
+ * Where |x_t x x_w|^2 has no odd harmonics (fig. 2 and 4: D' normal to A, B, A', B'), it is a
+ * trigonometric polynomial of degree 2 in 2 theta, and where the trapezoidal rule converges slowly (a
+ * dip) the mean comes from its roots instead (even_mean): a fixed cost, whatever the dips' depth.
  */
+#include <complex.h>
 #include <float.h>
 #include <math.h>
 #include <pthread.h>
@@ -46,8 +51,18 @@
 #define MANY_WORK 2e6   /* a face of many harmonics (below): its points of theta, at most, else the panels
                          * (tower 2e5, blade 1.6e5) */
 
+#define EV_N 1024       /* the cut's rule (even_mean): intervals of beta on [0, pi] on its finest level */
+#define EV_N0 8         /* ... on its first */
+#define EV_MAP 0.05     /* ... alpha(beta) where a root lies within this of the circle, else alpha = beta */
+#define EV_SWITCH 1e-3  /* the trapezoidal rule's levels, from N0 points over pi, differ by more than this
+                         * relative: even_mean instead of its next levels */
+#define EV_GUARD 1e-8   /* the roots reproduce the element's square at the samples to this of its largest */
+
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
+/* cos alpha(beta_i), the trapezoidal rule's weight alpha'(beta_i) (half at the ends), 1 - cos alpha and
+ * 1 + cos alpha (without cancellation), at beta_i = pi i / EV_N: [0] alpha = beta, [1] alpha = beta - sin(2 beta) / 2 */
+static double evt[2][EV_N + 1][4];
 static pthread_once_t trig_once = PTHREAD_ONCE_INIT;
 
 static void trig_init(void)
@@ -55,6 +70,14 @@ static void trig_init(void)
     for (int i = 0; i < NT; i++)
         for (int j = 1; j <= 4; j++)
             trig[i][j - 1] = cos(2.0 * M_PI * i * j / NT), trig[i][j + 3] = sin(2.0 * M_PI * i * j / NT);
+    for (int i = 0; i <= EV_N; i++) {
+        const double b = M_PI * i / EV_N;
+        for (int m = 0; m < 2; m++) {
+            const double a = m ? b - 0.5 * sin(2.0 * b) : b, sa = sin(0.5 * a), ca = cos(0.5 * a);
+            evt[m][i][0] = cos(a), evt[m][i][2] = 2.0 * sa * sa, evt[m][i][3] = 2.0 * ca * ca;
+            evt[m][i][1] = m ? 2.0 * sin(b) * sin(b) : i == 0 || i == EV_N ? 0.5 : 1.0;
+        }
+    }
 }
 
 /* x_t x x_w = v[0] + v[1] cos theta + v[2] sin theta + v[3] cos 2 theta + v[4] sin 2 theta, and its
@@ -262,30 +285,236 @@ static int narrow(const double *e, int per, int stride)
  * graded towards both (toward); so too at once where the first samples dip below DEEP of their
  * largest. *dip: the least sample over the largest.
  */
+/* |z|^2, |z| without hypot's care for overflow (the coefficients are O(1)) */
+static double norm2(double complex z)
+{
+    return creal(z) * creal(z) + cimag(z) * cimag(z);
+}
+
+static double mag(double complex z)
+{
+    return sqrt(norm2(z));
+}
+
+/* The principal square root, without cancellation (libm's csqrt takes care of infinities too, at 5 times the cost) */
+static double complex root2(double complex w)
+{
+    const double x = creal(w), y = cimag(w), r = sqrt(x * x + y * y);
+    if (r == 0.0)
+        return 0.0;
+    if (x >= 0.0) {
+        const double sr = sqrt(0.5 * (r + x));
+        return sr + I * (0.5 * y / sr);
+    }
+    const double si = copysign(sqrt(0.5 * (r - x)), y);
+    return 0.5 * y / si + I * si;
+}
+
+/* The roots of y^2 + B y + C into y[0], y[1], the larger first (no cancellation). */
+static void quad_roots(double complex B, double complex C, double complex *y)
+{
+    const double complex d = root2(B * B - 4.0 * C), t = mag(-B - d) >= mag(-B + d) ? -B - d : -B + d;
+    y[0] = 0.5 * t;
+    y[1] = y[0] != 0.0 ? C / y[0] : 0.0;
+}
+
+/* The roots of z^4 + b z^3 + c z^2 + d z + e into r: Ferrari's (the resolvent cubic's largest root by
+ * Cardano), unpolished. */
+static void quartic_roots(double complex b, double complex c, double complex d, double complex e, double complex *r)
+{
+    const double complex b2 = b * b, p = c - 0.375 * b2, q = d - 0.5 * b * c + 0.125 * b2 * b,
+                         s = e - 0.25 * b * d + b2 * c / 16.0 - 3.0 * b2 * b2 / 256.0;
+    /* m^3 + p m^2 + (p^2 / 4 - s) m - q^2 / 8 = 0, as t^3 + P t + Q = 0 with m = t - p / 3 */
+    const double complex B = 0.25 * p * p - s, P = B - p * p / 3.0, Q = 2.0 * p * p * p / 27.0 - p * B / 3.0 - 0.125 * q * q,
+                         D = root2(0.25 * Q * Q + P * P * P / 27.0);
+    const double complex u3 = mag(-0.5 * Q - D) > mag(-0.5 * Q + D) ? -0.5 * Q - D : -0.5 * Q + D;
+    double complex m = -p / 3.0;
+    if (u3 != 0.0) {
+        const double complex w = -0.5 + 0.5 * sqrt(3.0) * I;
+        const double ang = carg(u3) / 3.0;
+        double complex u = cbrt(mag(u3)) * (cos(ang) + I * sin(ang));
+        m = 0.0;
+        for (int k = 0; k < 3; k++, u *= w) {
+            const double complex mk = u - P / (3.0 * u) - p / 3.0;
+            if (mag(mk) > mag(m))
+                m = mk;
+        }
+    }
+    double complex y[4];
+    if (m == 0.0) {   /* q = 0: y^4 + p y^2 + s */
+        quad_roots(p, s, y);
+        y[2] = -(y[0] = root2(y[0])), y[3] = -(y[1] = root2(y[1]));
+    } else {
+        const double complex sq = root2(2.0 * m);
+        quad_roots(-sq, 0.5 * p + m + q / (2.0 * sq), y);
+        quad_roots(sq, 0.5 * p + m - q / (2.0 * sq), y + 2);
+    }
+    for (int k = 0; k < 4; k++)
+        r[k] = y[k] - 0.25 * b;
+}
+
+/* A root z of z^4 + b z^3 + c z^2 + d z + e polished by Newton while that lowers |f| (a root of a pair
+ * about to coincide comes out to their separation's share of the rounding, all the factors need). */
+static double complex polish(double complex b, double complex c, double complex d, double complex e, double complex z)
+{
+    double complex f = (((z + b) * z + c) * z + d) * z + e;
+    for (int it = 0; it < 4 && f != 0.0; it++) {
+        const double complex fp = ((4.0 * z + 3.0 * b) * z + 2.0 * c) * z + d, nz = z - f / fp,
+                             nf = (((nz + b) * nz + c) * nz + d) * nz + e;
+        if (!(norm2(nf) < norm2(f)))
+            break;
+        z = nz, f = nf;
+    }
+    return z;
+}
+
+/*
+ * The mean over theta of the element where its square has no odd harmonics (so in phi = 2 theta, the
+ * sections of fig. 2 and 4: D' normal to A, B and their derivatives), without sampling the dips:
+ *
+ *     P(phi) = p0 + c1 z + conj(c1 z) + c2 z^2 + conj(c2 z^2),    z = e^(i phi),
+ *
+ * and the mean of sqrt(P) is that of P / sqrt(P), p0 m0 + 2 Re(c1 m1 + c2 m2) with m_j the mean of
+ * z^j / sqrt(P) = (1 / 2 pi i) times the integral of z^j dz / sqrt(Q(z)) round the circle, Q = z^2 P a
+ * quartic whose roots pair as zeta, 1 / conj(zeta): the two inside, z1 and z2, joined by a cut, to
+ * which the contour shrinks (no pole inside for j >= 0). On the cut, z = M + H cos alpha (M, H their
+ * mid-point and half-difference), the roots' square roots cancel dz's, and
+ *
+ *     m_j = +-(1 / pi) int_0^pi z^j dalpha / sqrt(C0 (1 - z conj(z1)) (1 - z conj(z2))),   C0 = c2 / conj(z1 z2),
+ *
+ * analytic but where z meets the outside roots, near the ends when a dip is deep (a root near the
+ * circle: alpha about 2i sqrt of its distance); alpha = beta - sin(2 beta) / 2 (alpha near beta^3 at
+ * the ends) takes that to about its cube root, and the trapezoidal rule in beta, the integrand even
+ * and periodic, converges geometrically: EV_N0, 2 EV_N0, ... points until two levels agree. The sign
+ * is m0's: positive. Returns 0 (the sampled path then) where c2 is small (a root near 0 or infinity),
+ * a root lies on the circle (the element meets 0), the roots do not reproduce P at the samples to
+ * EV_GUARD, or the rule did not converge. *dip: the least over the largest of the element.
+ */
+static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
+{
+    const double p0 = q->a[0];
+    const double complex c1 = 0.5 * (q->a[2] - I * q->b[2]), c2 = 0.5 * (q->a[4] - I * q->b[4]);
+    if (!(mag(c2) > 1e-6 * p0))
+        return 0;
+    double e2[N0], lo = INFINITY, big = 0.0;
+    const int stride = NT / 2 / N0;   /* N0 points over pi */
+    for (int i = 0; i < N0; i++) {
+        e2[i] = e[stride * i] * e[stride * i];
+        lo = e2[i] < lo ? e2[i] : lo;
+        big = big > e2[i] ? big : e2[i];
+    }
+    if (!(lo > 0.0))
+        return 0;
+    const double complex qb = c1 / c2, qc = p0 / c2, qd = conj(c1) / c2, qe = conj(c2) / c2;
+    double complex r[4], z1, z2;
+    quartic_roots(qb, qc, qd, qe, r);
+    /* the two inside, polished (a root's mirror 1 / conj(z) is one too) */
+    for (int i = 1; i < 4; i++)
+        for (int j = i; j > 0 && norm2(r[j]) < norm2(r[j - 1]); j--) {
+            const double complex t = r[j];
+            r[j] = r[j - 1], r[j - 1] = t;
+        }
+    for (int k = 0; k < 2; k++)
+        if (norm2(r[k] = polish(qb, qc, qd, qe, r[k])) > 1.0)
+            r[k] = 1.0 / conj(r[k]);
+    z1 = norm2(r[0]) <= norm2(r[1]) ? r[0] : r[1], z2 = norm2(r[0]) <= norm2(r[1]) ? r[1] : r[0];
+    if (!(norm2(z2) < 1.0))
+        return 0;
+    const double K = mag(c2) / (mag(z1) * mag(z2));
+    for (int i = 0; i < N0; i++) {
+        const double complex z = trig[stride * i][1] + I * trig[stride * i][5];
+        const double d1 = mag(z - z1), d2 = mag(z - z2);
+        if (!(fabs(K * d1 * d1 * d2 * d2 - e2[i]) <= EV_GUARD * big))
+            return 0;
+    }
+    /* P's least also where a root is nearest the circle (a narrow dip between the samples), where the
+     * roots must reproduce P to 1e-3 (the correction below is of first order) but for P's rounding */
+    for (int k = 0; k < 2; k++) {
+        const double complex z = k ? z2 : z1, c = z / mag(z);
+        const double d1 = mag(c - z1), d2 = mag(c - z2), pk = K * d1 * d1 * d2 * d2,
+                     pc = p0 + 2.0 * creal(c1 * c + c2 * c * c);
+        if (!(fabs(pc - pk) <= 1e-3 * pk + 1e-14 * big))
+            return 0;
+        lo = pk < lo ? pk : lo;
+    }
+    const double complex M = 0.5 * (z1 + z2), H = 0.5 * (z1 - z2), pr = conj(z1) * conj(z2);
+    /* The roots' P~ = K |z - z1|^2 |z - z2|^2 (C0 = K): its coefficients, p0 + dp0 and so on */
+    const double e1 = 1.0 - norm2(z1), e2_ = 1.0 - norm2(z2), A1 = 2.0 - e1, A2 = 2.0 - e2_;
+    const double dp0 = K * (A1 * A2 + 2.0 * creal(conj(z1) * z2)) - p0;
+    const double complex dc1 = -K * (A1 * conj(z2) + A2 * conj(z1)) - c1, dc2 = K * pr - c2;
+    /* w = (1 - z conj(z1)) (1 - z conj(z2)), each factor from its end, z = z1 - H (1 - cos alpha) =
+     * z2 + H (1 + cos alpha): e_k + ..., no cancellation where it is small (a root near the circle) */
+    const double complex g1 = conj(z1) * H, g2 = -conj(z2) * H;
+    const double (*tab)[4] = evt[1.0 - mag(z2) < EV_MAP];
+    const double Mr = creal(M), Mi = cimag(M), Hr = creal(H), Hi = cimag(H), g1r = creal(g1), g1i = cimag(g1),
+                 g2r = creal(g2), g2i = cimag(g2);
+    double s0r = 0.0, s0i = 0.0, s1r = 0.0, s1i = 0.0, s2r = 0.0, s2i = 0.0, prev = NAN;
+    for (int st = EV_N / EV_N0, first = 1; st >= 1; st /= 2, first = 0) {
+        for (int i = first ? 0 : st; i <= EV_N; i += first ? st : 2 * st) {
+            const double zr = Mr + Hr * tab[i][0], zi = Mi + Hi * tab[i][0];
+            const double f1r = e1 + g1r * tab[i][2], f1i = g1i * tab[i][2], f2r = e2_ + g2r * tab[i][3], f2i = g2i * tab[i][3];
+            const double x = f1r * f2r - f1i * f2i, y = f1r * f2i + f1i * f2r, rw = sqrt(x * x + y * y);
+            /* 1 / sqrt(w) = conj(sqrt(w)) / |w|, sqrt(w) without cancellation */
+            double a, b;
+            if (x >= 0.0)
+                a = sqrt(0.5 * (rw + x)), b = 0.5 * y / a;
+            else
+                b = copysign(sqrt(0.5 * (rw - x)), y), a = 0.5 * y / b;
+            const double g = tab[i][1] / rw, ur = a * g, ui = -b * g, vr = ur * zr - ui * zi, vi = ur * zi + ui * zr;
+            s0r += ur, s0i += ui, s1r += vr, s1i += vi, s2r += vr * zr - vi * zi, s2i += vr * zi + vi * zr;
+        }
+        const double complex S[3] = { s0r + I * s0i, s1r + I * s1i, s2r + I * s2i };
+        const double f = 1.0 / ((double)(EV_N / st) * sqrt(K)), sg = s0r > 0.0 ? f : -f;
+        const double complex m0 = sg * S[0], m1 = sg * S[1], m2 = sg * S[2];
+        /* mean sqrt(P) = mean sqrt(P~) + mean (P - P~) / (2 sqrt(P~)) to first order in P - P~, the roots'
+         * error (1e-10 of P where a pair of them nearly coincides, their mean place; P's own rounding
+         * near them): mean P / sqrt(P~) less half of mean (P - P~) / sqrt(P~) */
+        const double cur = p0 * creal(m0) + 2.0 * creal(c1 * m1 + c2 * m2) +
+                           0.5 * (dp0 * creal(m0) + 2.0 * creal(dc1 * m1 + dc2 * m2));
+        if (fabs(cur - prev) <= TRAP_TOL * cur) {
+            if (!(fabs(cimag(m0)) <= 1e-10 * fabs(creal(m0))))
+                return 0;
+            *mean = cur;
+            *dip = sqrt(lo / big);
+            return 1;
+        }
+        prev = cur;
+    }
+    return 0;
+}
+
 static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
 {
+    double ev;
     const int per = q->odd ? NT : NT / 2;
     double e[NT], sum = 0.0, mean, lo = INFINITY, big = 0.0;
     int stride = NT / N0;
     for (int i = 0; i < per; i += stride) {
-        sum += e[i] = sqrt(fmax(q_at(q, trig[i]), 0.0));
-        lo = fmin(lo, e[i]), big = fmax(big, e[i]);
+        const double p = q_at(q, trig[i]);
+        sum += e[i] = p > 0.0 ? sqrt(p) : 0.0;
+        lo = e[i] < lo ? e[i] : lo, big = e[i] > big ? e[i] : big;
     }
     mean = sum * stride / per;
     *dip = big > 0.0 ? lo / big : 1.0;
     while (stride > 1 && !(stride <= NT / 64 && *dip < DEEP && narrow(e, per, stride))) {
         const int half = stride / 2;
         for (int i = half; i < per; i += stride) {
-            sum += e[i] = sqrt(fmax(q_at(q, trig[i]), 0.0));
-            lo = fmin(lo, e[i]), big = fmax(big, e[i]);
+            const double p = q_at(q, trig[i]);
+            sum += e[i] = p > 0.0 ? sqrt(p) : 0.0;
+            lo = e[i] < lo ? e[i] : lo, big = e[i] > big ? e[i] : big;
         }
         stride = half;
         const double next = sum * stride / per;
         *dip = big > 0.0 ? lo / big : 1.0;
         if (fabs(next - mean) <= TRAP_TOL * next)
             return next;
+        /* slow to converge: a dip, which even_mean takes at a fixed cost */
+        if (!q->odd && stride <= NT / 2 / N0 && fabs(next - mean) > EV_SWITCH * next && even_mean(q, e, &ev, dip))
+            return ev;
         mean = next;
     }
+    if (!q->odd && stride <= NT / 2 / N0 && even_mean(q, e, &ev, dip))
+        return ev;
     const double dt = stride * 2.0 * M_PI / NT, period = per * (2.0 * M_PI / NT);
     const int ns = per / stride;
     double cut[NT], scale[NT];
@@ -503,25 +732,6 @@ static int outer(harm_ctx *H, double a, double b, const double *coarse, int dept
         split = 0;   /* the dip is at an end, where a cut was: halves */
     }
     return outer(H, a, m, l, depth + 1, split, out) && outer(H, m, b, r, depth + 1, split, out);
-}
-
-/* The face's modes: 1 where each has the factor 1 or sin, cos of one even k along the face's other
- * parameter (k into *k), else 0. */
-static int harm_form(const pde_solution *s, int axis, double *k)
-{
-    *k = 0.0;
-    for (int c = 0; c < 3; c++)
-        for (size_t m = 0; m < s->comp[c].nmodes; m++) {
-            const pde_factor f = axis == 0 ? s->comp[c].modes[m].v : s->comp[c].modes[m].u;
-            const double p = fabs(f.p);
-            if (f.kind == PDE_POW && f.p == 0.0)
-                continue;
-            if (!((f.kind == PDE_SIN || f.kind == PDE_COS) && p >= 2.0 && p <= PDE_MAX_FREQ &&
-                  p == 2.0 * floor(0.5 * p)) || (*k != 0.0 && p != *k))
-                return 0;
-            *k = p;
-        }
-    return *k != 0.0;
 }
 
 /*
@@ -766,23 +976,41 @@ static void many_at_w(void *arg, double w, double *val)
     many_mean(H, val);
 }
 
-/* The face's modes: 1 where each has the factor 1 or sin, cos of 2 pi j t, j whole and at most
- * MANY_MAX, along the face's other parameter; the distinct j ascending into H->hj, H->nh, and each
- * mode's entry into H->mslot. 0 otherwise or out of memory. */
-static int many_form(const pde_solution *s, int axis, harm_ctx *H)
+/*
+ * The face's modes along its other parameter t (axis 0: v, 1: u): 1 where each has the factor 1 or
+ * sin, cos of p pi t with p even (2 pi j t, j whole) and at most PDE_MAX_FREQ, else 0; the j's up to
+ * MANY_MAX marked in seen (*over set where one is beyond), and *k = p where all share one p (one
+ * harmonic, harm.h's form), else 0. One scan for both paths.
+ */
+static int face_form(const pde_solution *s, int axis, unsigned char seen[MANY_MAX + 1], double *k, int *over)
 {
-    unsigned char seen[MANY_MAX + 1] = { 0 };
+    int one = 1;
+    *k = 0.0, *over = 0;
+    memset(seen, 0, MANY_MAX + 1);
     for (int c = 0; c < 3; c++)
         for (size_t m = 0; m < s->comp[c].nmodes; m++) {
             const pde_factor f = axis == 0 ? s->comp[c].modes[m].v : s->comp[c].modes[m].u;
             const double p = fabs(f.p);
             if (f.kind == PDE_POW && f.p == 0.0)
                 continue;
-            if (!((f.kind == PDE_SIN || f.kind == PDE_COS) && p >= 2.0 && p <= 2.0 * MANY_MAX &&
-                  p == 2.0 * floor(0.5 * p)))
+            if (!((f.kind == PDE_SIN || f.kind == PDE_COS) && p >= 2.0 && p <= PDE_MAX_FREQ && p == 2.0 * floor(0.5 * p)))
                 return 0;
-            seen[(int)(0.5 * p)] = 1;
+            one &= *k == 0.0 || p == *k;
+            *k = p;
+            if (p <= 2.0 * MANY_MAX)
+                seen[(int)(0.5 * p)] = 1;
+            else
+                *over = 1;
         }
+    if (!one)
+        *k = 0.0;
+    return 1;
+}
+
+/* The face's many harmonics, seen (face_form's, none beyond MANY_MAX): the distinct j ascending into
+ * H->hj, H->nh, and each mode's entry into H->mslot. 0 where fewer than MANY_MIN, or out of memory. */
+static int many_form(const pde_solution *s, int axis, const unsigned char seen[MANY_MAX + 1], harm_ctx *H)
+{
     int idx[MANY_MAX + 1];
     H->nh = 0;
     for (int j = 1; j <= MANY_MAX; j++)
@@ -849,17 +1077,21 @@ static int many_cap(harm_ctx *H, int side, double *area, double *flux)
 int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, double *area, double *flux,
               size_t *nodes)
 {
-    double k = 0.0;
+    double k;
+    unsigned char seen[MANY_MAX + 1];
+    int over;
     harm_ctx H = { .o = o, .s = s, .splits = MAX_SPLITS, .poll_every = POLL_NODES, .max_nodes = MAX_NODES };
     for (int c = 0; c < 3; c++)
         H.nm += s->comp[c].nmodes;
-    H.many = !harm_form(s, axis > 1 ? 0 : axis, &k);
+    if (!face_form(s, axis == 1, seen, &k, &over))
+        return 0;
+    H.many = k == 0.0;
     if (axis > 1 && !H.many)
         return 0;   /* a cap of one harmonic: the general path's line is cheaper (fig. 2a, 4a) */
     H.kpi = k * M_PI;
     H.wt = malloc(3 * H.nm * sizeof *H.wt);
     H.slot = malloc(H.nm);
-    int ok = H.wt && H.slot && (!H.many || many_form(s, axis == 1, &H));
+    int ok = H.wt && H.slot && (!H.many || (!over && many_form(s, axis == 1, seen, &H)));
     if (H.many)   /* no cuts of w at dips: least_at's one harmonic */
         H.splits = 0, H.poll_every = MANY_POLL, H.max_nodes = MANY_NODES;
     if (ok) {
