@@ -2180,13 +2180,14 @@ static pde_status solid_run(const pde_solution *s, const double x0[3], double js
  * 7e-6 off (with an err of 6e-16) to within 1e-13 of an independent root-split quadrature.
  */
 #define FOLD_K 256            /* P's harmonics, at most */
-#define FOLD_SAMPLES 16       /* samples of Q per wavelength of its fastest harmonic (2K) */
+#define FOLD_SAMPLES 8        /* samples of Q per wavelength of its fastest harmonic (2K) */
 #define FOLD_RULE 16          /* Gauss points per panel of a span of w (in its own variable) */
 #define FOLD_DEPTH 30         /* halvings of a span, at most */
 #define FOLD_TOL 1e-15        /* a panel and its halves agree to this of the volume (each integral's scale) */
 #define FOLD_SPANS 512        /* spans of w (cut where the rows' root counts change), at most */
 #define FOLD_EPS 1e-12        /* a count change this close (of the span) to a cut already there is that cut */
-#define FOLD_ROWS 200000      /* rows at most: past them no span is halved, and err says so */
+#define FOLD_WORK (100 * MAX_WORK)   /* rows times samples times harmonics, at most: past it no span is
+                                      * halved, and err says so (1e-9 at least) */
 
 typedef struct {
     const pde_solution *s;
@@ -2420,7 +2421,7 @@ static int fold_adapt(fold_ctx *f, const fold_span_t *sp, double s0, double s1, 
     double diff = 0.0;
     for (int e = 0; e < Q_N; e++)
         diff = fmax(diff, fabs(half[0][e] + half[1][e] - coarse[e]) / f->scale[e]);
-    if (diff <= FOLD_TOL || depth >= FOLD_DEPTH || f->rows >= FOLD_ROWS || (f->stopped = pde_stopped(f->cancel))) {
+    if (diff <= FOLD_TOL || depth >= FOLD_DEPTH || (double)f->rows * f->N * (f->K + 1) >= FOLD_WORK || (f->stopped = pde_stopped(f->cancel))) {
         if (diff > FOLD_TOL)
             f->capped = 1;
         for (int e = 0; e < Q_N; e++)
