@@ -64,7 +64,8 @@ void quad_separate(const pde_solution *s, quad_sep *sep);
  * with lines along u where jsign is 0, v takes one uniform rule over the period, exact where det J
  * keeps its sign (checked on the lines, else the path above), and out->err is the a-posteriori
  * estimate of w's rules instead (their rows' Legendre tails), large where the work's bound stopped
- * their refinement. */
+ * their refinement. A loft (x, y = C(w) + t^n P(s, w), z = Z(w)) whose jsign is 0 takes rows of w
+ * split at det J's roots along s instead (quad.c's fold_solid): exact where the roots are found. */
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
                       int jsign, const pde_cancel *cancel, quad_result *out);
 
