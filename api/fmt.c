@@ -194,10 +194,19 @@ int api_out_mesh(api_output *o, const pde_cancel *cancel, api_mesh *m, api_error
         return no_volume(err);
     if (api_mesh_build(o->sol, o->res, cancel, m, err))
         return -1;
-    if (m->ntris == 0)
+    /* With 3 samples or more per axis, a skin of no triangle is one whose points weld together: meshes are
+     * float32 (QA: radius 1 at 1e15, where float32 steps by 6.7e7; a 6.4e10 by 2 solid), and more samples
+     * cannot help. */
+    if (m->ntris == 0 && (o->res[0] < 3 || o->res[1] < 3 || o->res[2] < 3))
         return api_fail(err, API_ERR_DOCUMENT, "", "res: %u,%u,%u samples give a skin with no triangle (every face "
                         "collapses to a line or a point); take at least 3 samples per axis, more along an axis that "
                         "closes into a loop", o->res[0], o->res[1], o->res[2]);
+    if (m->ntris == 0)
+        return api_fail(err, API_ERR_DOCUMENT, "", "the skin has no triangle at res %u,%u,%u: the solid's extent, or "
+                        "that of its thin parts, is below float32's resolution at its size and distance from the "
+                        "origin, so its points weld together (every face collapses to a line or a point); meshes are "
+                        "float32: move or scale the solid nearer unit size at the origin, or take json output, which "
+                        "has full precision", o->res[0], o->res[1], o->res[2]);
     return 0;
 }
 

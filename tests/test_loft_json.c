@@ -512,6 +512,49 @@ static void every_bad_loft_should_name_its_field(void **state)
     free(b.s);
 }
 
+/* Sections very close in w (QA: 1 ulp, 1e-14 or 1e-15 apart): the slab between them gives the slab problem a
+ * condition near 3/L to 20/L, past the refusal's 1e12 below L = 2e-11. They were refused as "/loft/pde: ...
+ * singular near slab 2", blaming the PDE (with a, b, c > 0, which cannot be singular) and a slab beside the
+ * thin one. They are the sections' fault, like wider gaps whose solution misses them: the pointer names the
+ * section beside the thin slab that can move (not the last, w = 1), the message its neighbour and the gap. */
+static void sections_a_few_ulps_apart_should_be_refused_as_too_close_naming_them(void **state)
+{
+    (void)state;
+    static const struct {
+        double w[4];
+        const char *pointer, *says;
+    } cases[] = {
+        { { 0, 0.5, 0x1.0000000000001p-1, 1 }, "/loft/sections/2/w", "section 1 (w = 0.5)" },
+        { { 0, 0.5, 0.50000000000001, 1 }, "/loft/sections/2/w", "section 1 (w = 0.5)" },
+        { { 0, 1e-15, 0.5, 1 }, "/loft/sections/1/w", "section 0 (w = 0)" },
+        { { 0, 1e-15, 0.3333333333333343, 1 }, "/loft/sections/1/w", "section 0 (w = 0)" },
+        { { 0, 0.5, 1 - 1e-13, 1 }, "/loft/sections/2/w", "section 3 (w = 1)" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        char doc[1024];
+        snprintf(doc, sizeof doc,
+                 "{\"loft\": {\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], \"c\": [4, 4, 4]}, \"sections\": ["
+                 "{\"w\": %.17g, \"profile\": [[1, 0, 0], [0, 1, 0], [-1, -1, 0]]},"
+                 "{\"w\": %.17g, \"profile\": [[2, 0, 1], [0, 2, 1], [-2, -2, 1]]},"
+                 "{\"w\": %.17g, \"profile\": [[3, 0, 2], [0, 3, 2], [-3, -3, 2]]},"
+                 "{\"w\": %.17g, \"profile\": [[4, 0, 3], [0, 4, 3], [-4, -4, 3]]}]}}",
+                 cases[i].w[0], cases[i].w[1], cases[i].w[2], cases[i].w[3]);
+        api_error err;
+        api_model *m = api_model_parse(doc, strlen(doc), &err);
+        assert_non_null(m);
+        pde_solution *s = NULL;
+        int rc = api_solve(m, &s, &err);
+        pde_solution_free(s);
+        api_model_free(m);
+        if (!rc)
+            fail_msg("case %zu accepted", i);
+        if (strcmp(err.pointer, cases[i].pointer) != 0 || err.status != API_ERR_DOCUMENT || !strstr(err.message, "too close") ||
+            !strstr(err.message, cases[i].says) || !strstr(err.message, "apart"))
+            fail_msg("case %zu: %s (status %d): %s; want %s naming %s too close", i, err.pointer, (int)err.status, err.message,
+                     cases[i].pointer, cases[i].says);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -527,6 +570,7 @@ int main(void)
         cmocka_unit_test(a_loft_of_zero_sections_should_be_the_zero_solid),
         cmocka_unit_test(every_loft_preset_should_solve_soundly_and_its_document_give_the_same_id),
         cmocka_unit_test(a_near_resonant_loft_should_report_its_harmonic_and_condition),
+        cmocka_unit_test(sections_a_few_ulps_apart_should_be_refused_as_too_close_naming_them),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
