@@ -92,7 +92,7 @@ static const flag flags[] = {
       "properties and output (an eval, its points; a\n"
       "/solve body of N/90 bytes or more, all of it)\n"
       "apart, on at most all threads but one: light\n"
-      "requests do not wait for heavy work, but for\n"
+      "requests wait for no heavy work, only for\n"
       "parses and for solves estimated light (docs/API.md;\n"
       "with one thread, a heavy request waits for at\n"
       "most 8 light ones)" },
