@@ -176,10 +176,11 @@ int api_volmesh_build(const pde_solution *s, const unsigned res[3], const pde_ca
     double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
     double sum = 0, dmax = 0;
     unsigned a[3];
-    for (a[2] = 0; a[2] < res[2]; a[2]++) {
-        if (stopped(cancel))
-            goto cancelled;
-        for (a[1] = 0; a[1] < res[1]; a[1]++)
+    /* Polled once a row: a plane of a big loft is res^2 pde_eval_d calls, seconds past --job-timeout. */
+    for (a[2] = 0; a[2] < res[2]; a[2]++)
+        for (a[1] = 0; a[1] < res[1]; a[1]++) {
+            if (stopped(cancel))
+                goto cancelled;
             for (a[0] = 0; a[0] < res[0]; a[0]++) {
                 size_t x = sidx(&g, a);
                 double xu[3], xv[3], xw[3];
@@ -192,7 +193,7 @@ int api_volmesh_build(const pde_solution *s, const unsigned res[3], const pde_ca
                 for (int c = 0; c < 3; c++)
                     lo[c] = fmin(lo[c], g.pos[3 * x + c]), hi[c] = fmax(hi[c], g.pos[3 * x + c]);
             }
-    }
+        }
     g.tol = API_VOLMESH_TOL * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                    (hi[2] - lo[2]) * (hi[2] - lo[2]));
     m.sign = sum < 0 ? -1 : 1;

@@ -89,10 +89,13 @@ static const flag flags[] = {
       "scratch memory one request may use beyond\nthe caches, MiB" },
     { "--heavy-work", "N", K_REAL, AT(heavy_work), 0, 1e18, "5e7", NULL,
       "a request estimated at N units or more runs its\n"
-      "properties and output apart, on at most all\n"
-      "threads but one: light requests never wait for\n"
-      "heavy work (with one thread, a heavy request\n"
-      "waits for at most 8 light ones)" },
+      "properties and output (an eval, its points; a\n"
+      "/solve body of N/90 bytes or more, all of it)\n"
+      "apart, on at most all threads but one: light\n"
+      "requests wait for no heavy work, only for\n"
+      "parses and for solves estimated light (docs/API.md;\n"
+      "with one thread, a heavy request waits for at\n"
+      "most 8 light ones)" },
     { "--heavy-queue", "N", K_COUNT, AT(heavy_queue), 1, 1 << 20, "8", NULL,
       "heavy requests that may wait before 503" },
     { "--job-timeout", "S", K_REAL, AT(job_timeout), 0, 86400, "2", NULL,

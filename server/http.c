@@ -82,10 +82,18 @@ static void make_key(srv_req *r)
     r->klen = (size_t)(k - r->key) + tl;
 }
 
-/* What a 413 suggests: a loft's profiles are the usual large bodies, and keep harmonics below half their points. */
-#define BODY_HINT                                                                                                 \
-    "; a loft's profile needs no more points than twice the highest harmonic it should keep (see docs/API.md), "  \
-    "or run the CLI offline, which has no such limit"
+/* What a 413 suggests: a loft's profiles are the usual large bodies, and keep harmonics below half their
+ * points. Only /solve takes a loft; another route's body (eval's points) gets the limit alone. A
+ * Content-Length over the limit is refused before the route is found: then the path tells. */
+static const char *body_hint(const srv_req *r)
+{
+    const int solve = r->route < srv_nroutes ? !strcmp(srv_routes[r->route].name, "solve")
+                                             : !strcmp(r->path, "/solve");
+    if (!solve)
+        return "";
+    return "; if this is a loft, its profiles need no more points than twice the highest harmonic they should "
+           "keep (see docs/API.md), or run the CLI offline, which has no such limit";
+}
 
 /* ---- the first call: what the headers decide ---- */
 
@@ -246,7 +254,7 @@ static int admit(srv_req *r, const char *method)
         const char *expect = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_EXPECT);
         r->decided = r->close = 1;
         srv_problem(r, 413, NULL, "the body of %lld bytes is more than the limit of %zu bytes (--max-body)%s", cl,
-                    s->cfg.max_body, BODY_HINT);
+                    s->cfg.max_body, body_hint(r));
         /* Expect: 100-continue: the client waits, and sends nothing. Too large to discard: close. */
         return (expect && !strcasecmp(expect, "100-continue")) || cl > (long long)DRAIN_BYTES;
     }
@@ -449,7 +457,7 @@ static enum MHD_Result take_body(srv_req *r, const char *upload, size_t n)
         free(r->body);
         r->body = NULL;
         srv_problem(r, 413, NULL, "the body is more than the limit of %zu bytes (--max-body)%s", s->cfg.max_body,
-                    BODY_HINT);
+                    body_hint(r));
         r->drained = r->len + n;
         r->len = r->cap = 0;
         return MHD_YES;

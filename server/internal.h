@@ -95,6 +95,11 @@ typedef struct srv_req {
     double queued_at, run_start;
     double work;                 /* seconds the solver threads spent on it before this run */
     srv_entry *heavy;            /* the solid whose output waits apart (--heavy-work), or NULL */
+    void (*later)(struct srv_req *r);   /* the heavy remainder, run apart (--heavy-work), or NULL */
+    int apart;                   /* running that remainder now: it runs to the end, not deferred again */
+    double *pts;                 /* an eval's points (3 a point), kept for its remainder */
+    size_t npts;
+    int derivs;
     struct {
         double queue, parse, solve, props, output;
         int cached;

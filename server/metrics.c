@@ -27,6 +27,7 @@ struct srv_metrics {
     double solve_sum, output_sum;
     unsigned long long solve_count, output_count, output_bytes;
     atomic_llong connections;
+    atomic_ullong heavy;                    /* parts run apart (--heavy-work) */
 };
 
 srv_metrics *srv_metrics_create(const char *const *routes, int nroutes)
@@ -86,6 +87,11 @@ void srv_metrics_output(srv_metrics *m, double seconds, size_t bytes)
     pthread_mutex_unlock(&m->lock);
 }
 
+void srv_metrics_heavy(srv_metrics *m)
+{
+    atomic_fetch_add_explicit(&m->heavy, 1, memory_order_relaxed);
+}
+
 void srv_metrics_connection(srv_metrics *m, int delta)
 {
     atomic_fetch_add_explicit(&m->connections, delta, memory_order_relaxed);
@@ -129,6 +135,8 @@ char *srv_metrics_render(srv_metrics *m, const srv_cache_stats *c, size_t queue_
         m->output_sum, m->output_count);
     srv_sbuf_printf(&b, "# HELP pdesolid_output_bytes_total Bytes of outputs written.\n"
             "# TYPE pdesolid_output_bytes_total counter\npdesolid_output_bytes_total %llu\n", m->output_bytes);
+    srv_sbuf_printf(&b, "# HELP pdesolid_heavy_total Requests whose rest ran apart from light ones (--heavy-work).\n"
+            "# TYPE pdesolid_heavy_total counter\npdesolid_heavy_total %llu\n", atomic_load(&m->heavy));
     srv_sbuf_printf(&b, "# HELP pdesolid_connections Open HTTP connections.\n# TYPE pdesolid_connections gauge\n"
             "pdesolid_connections %lld\n", (long long)atomic_load(&m->connections));
     pthread_mutex_unlock(&m->lock);

@@ -17,6 +17,8 @@ void srv_metrics_destroy(srv_metrics *m);
 void srv_metrics_request(srv_metrics *m, int route, int status, double seconds);
 void srv_metrics_solve(srv_metrics *m, double seconds);
 void srv_metrics_output(srv_metrics *m, double seconds, size_t bytes);
+/* A request's rest deferred to the heavy lane (pool.h) and run. */
+void srv_metrics_heavy(srv_metrics *m);
 void srv_metrics_connection(srv_metrics *m, int delta);
 
 /* The exposition text (malloc'd), with the caches' figures and the queue depth. */

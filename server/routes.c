@@ -166,6 +166,17 @@ static int solve_model(void *arg, pde_solution **out, api_error *err)
 }
 
 static void answer_heavy(srv_req *r, srv_entry *e);
+static void answer_later(srv_req *r);
+
+/* Whether the rest of a request, estimated at r->cost so far, runs apart from light requests: then
+ * srv_run_job defers later (with what it needs in r) as its last act. A remainder already apart runs now. */
+static int defer(srv_req *r, void (*later)(srv_req *r))
+{
+    if (r->apart || r->cost.work < r->s->cfg.heavy_work)
+        return 0;
+    r->later = later;
+    return 1;
+}
 
 /* 304 Not Modified, releasing e, when If-None-Match names this request's representation (or is *) and the
  * output is known to exist: opened by this request (opened), or by one before. An ETag (or *) of an output
@@ -208,10 +219,15 @@ static void answer_entry(srv_req *r, srv_entry *e)
         srv_cache_release(s->cache, e);
         return;
     }
-    if (r->cost.work >= s->cfg.heavy_work) {
-        r->heavy = e;   /* srv_run_job defers the rest (answer_heavy) as its last act */
-        return;
-    }
+    r->heavy = e;
+    if (!defer(r, answer_later))
+        answer_later(r);
+}
+
+static void answer_later(srv_req *r)
+{
+    srv_entry *e = r->heavy;
+    r->heavy = NULL;
     answer_heavy(r, e);
 }
 
@@ -322,14 +338,32 @@ static srv_entry *solve_cached(srv_req *r, api_model *m, const char *id, int kee
     return e;
 }
 
+/* What parsing and fitting a loft costs a byte of its body, in work units: measured at about 0.09
+ * CPU-seconds for 1 MB (/tmp/qa13, QA round 13), some 8 times api_cost_parse's estimate. Only where
+ * the request runs depends on it (a body of 556 kB or more, at the default --heavy-work), not the budget. */
+#define BODY_WORK_BYTE 90.0
+
+static void solve_body(srv_req *r);
+
 static void post_solve(srv_req *r)
 {
-    srv_server *s = r->s;
-    api_error err;
     api_cost part;
     api_cost_parse(r->len, &part);
     if (over_budget(r, &part))
         return;
+    /* A big body is a big loft: its parse and fit are heavy work before any estimate knows it. */
+    if (!r->apart && (double)r->len * BODY_WORK_BYTE >= r->s->cfg.heavy_work) {
+        r->later = solve_body;
+        return;
+    }
+    solve_body(r);
+}
+
+/* A /solve body parsed, solved and answered. */
+static void solve_body(srv_req *r)
+{
+    srv_server *s = r->s;
+    api_error err;
     double t0 = srv_now();
     pthread_mutex_lock(&s->json_lock);
     api_model *m = api_model_parse(r->body ? r->body : "", r->len, &err);
@@ -429,6 +463,8 @@ static void get_solid(srv_req *r)
         answer_entry(r, e);
 }
 
+static void eval_points(srv_req *r);
+
 static void post_eval(srv_req *r)
 {
     srv_server *s = r->s;
@@ -456,13 +492,33 @@ static void post_eval(srv_req *r)
         srv_problem_api(r, &err);
         return;
     }
-    const pde_solution *sol = srv_entry_solution(e);
-    api_cost_eval(sol, n, derivs, &part);
+    api_cost_eval(srv_entry_solution(e), n, derivs, &part);
     if (over_budget(r, &part)) {
         free(pts);
         srv_cache_release(s->cache, e);
         return;
     }
+    r->heavy = e;
+    r->pts = pts;
+    r->npts = n;
+    r->derivs = derivs;
+    if (!defer(r, eval_points))
+        eval_points(r);
+}
+
+/* An eval's points, parsed and admitted (post_eval), evaluated and answered. */
+static void eval_points(srv_req *r)
+{
+    srv_server *s = r->s;
+    srv_entry *e = r->heavy;
+    double *pts = r->pts;
+    const size_t n = r->npts;
+    const int derivs = r->derivs;
+    r->heavy = NULL;
+    r->pts = NULL;
+    api_error err;
+    double t0;
+    const pde_solution *sol = srv_entry_solution(e);
     double *v = malloc((n ? n : 1) * 12 * sizeof *v);
     if (!v) {
         free(pts);
@@ -502,19 +558,32 @@ static void post_eval(srv_req *r)
 
 static void job_end(srv_req *r);
 
+/* What a remainder that will not run holds (job_end, run_heavy), given back. */
+static void drop_later(srv_req *r)
+{
+    if (r->heavy)
+        srv_cache_release(r->s->cache, r->heavy);
+    free(r->pts);
+    r->heavy = NULL;
+    r->pts = NULL;
+    r->later = NULL;
+}
+
 /* The heavy remainder of a request (--heavy-work), on the thread that took it from the pool. */
 static void run_heavy(void *arg)
 {
     srv_req *r = arg;
-    srv_entry *e = r->heavy;
-    r->heavy = NULL;
+    void (*later)(srv_req *r) = r->later;
+    r->later = NULL;
+    r->apart = 1;
+    srv_metrics_heavy(r->s->metrics);
     r->run_start = srv_now();
     r->tm.queue += r->run_start - r->queued_at;
     if (atomic_load(&r->s->aborting)) {
-        srv_cache_release(r->s->cache, e);
+        drop_later(r);
         stopped(r);
     } else
-        answer_heavy(r, e);
+        later(r);
     job_end(r);
 }
 
@@ -536,12 +605,11 @@ static void job_end(srv_req *r)
 {
     srv_server *s = r->s;
     r->work += srv_now() - r->run_start;
-    if (r->heavy) {
+    if (r->later) {
         r->queued_at = srv_now();
         if (srv_pool_defer_heavy(s->pool, run_heavy, r, s->cfg.heavy_queue) == 0)
             return;
-        srv_cache_release(s->cache, r->heavy);
-        r->heavy = NULL;
+        drop_later(r);
         srv_problem(r, 503, NULL,
                     "the server is busy: %zu requests estimated at over %.3g units of work (--heavy-work) wait "
                     "already (--heavy-queue); try again shortly, or ask for a lower res",

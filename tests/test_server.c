@@ -672,6 +672,59 @@ static void a_light_request_should_not_wait_behind_heavy_ones(void **state)
     }
 }
 
+/* An eval estimated at --heavy-work or more, and a /solve body big enough to be a big loft (its parse and
+ * fit are heavy before any estimate of them is known), run apart like /solve's heavy outputs (QA 13: two
+ * clients evaluating 12k points, or posting 1 MB lofts, held up a light request for 1.2 s in the queue).
+ * Counted in pdesolid_heavy_total, not timed. A light eval and a small body do not go there. */
+static void heavy_evals_and_big_bodies_should_run_apart(void **state)
+{
+    (void)state;
+    daemon_t d;
+    /* 3e6: below the estimate of 5000 points, and of the padded body's parse (1.2e6 by api_cost_parse) */
+    start(&d, "--heavy-work 3e6");
+    reply r = post(&d, "/solve?format=f32&res=2", "{\"preset\":\"fig1a\"}");
+    assert_int_equal(r.status, 200);
+    char id[64], path[96];
+    assert_true(header_value(&r, "X-Solid-Id", id, sizeof id));
+    free(r.body);
+    snprintf(path, sizeof path, "/solids/%s/eval", id);
+    long h = metric(&d, "pdesolid_heavy_total");
+    assert_true(h >= 0);
+    r = post(&d, path, "{\"points\":[[0.5,0.5,0.5]]}");
+    assert_int_equal(r.status, 200);
+    free(r.body);
+    assert_int_equal(metric(&d, "pdesolid_heavy_total"), h);
+    enum { N = 5000 };
+    size_t cap = 64 + N * 40, len = 0;
+    char *body = malloc(cap);
+    len += (size_t)snprintf(body + len, cap - len, "{\"derivatives\":true,\"points\":[");
+    for (int i = 0; i < N; i++)
+        len += (size_t)snprintf(body + len, cap - len, "%s[%.6f,0.25,0.75]", i ? "," : "", (double)i / N);
+    len += (size_t)snprintf(body + len, cap - len, "]}");
+    r = http(&d, "POST", path, body, len, NULL);
+    assert_int_equal(r.status, 200);
+    cJSON *a = cJSON_Parse(r.body);
+    assert_int_equal(cJSON_GetArraySize(cJSON_GetObjectItem(a, "values")), N);
+    cJSON_Delete(a);
+    free(r.body);
+    free(body);
+    assert_int_equal(metric(&d, "pdesolid_heavy_total"), h + 1);
+    /* fig1a padded to 100 KB: 9.2e6 units of parse and fit at 90 a byte; answered as the plain one is */
+    size_t big = 100 << 10;
+    body = malloc(big);
+    memset(body, ' ', big);
+    memcpy(body, "{\"preset\":\"fig1a\"}", 18);
+    r = http(&d, "POST", "/solve?format=f32&res=2", body, big, NULL);
+    assert_int_equal(r.status, 200);
+    char id2[64];
+    assert_true(header_value(&r, "X-Solid-Id", id2, sizeof id2));
+    assert_string_equal(id2, id);
+    free(r.body);
+    free(body);
+    assert_int_equal(metric(&d, "pdesolid_heavy_total"), h + 2);
+    stop(&d);
+}
+
 /* ---- bad input ---- */
 
 static void bad_requests_should_get_problems_and_the_daemon_should_keep_serving(void **state)
@@ -684,6 +737,12 @@ static void bad_requests_should_get_problems_and_the_daemon_should_keep_serving(
     memset(huge, ' ', big);
     reply r = http(&d, "POST", "/solve", huge, big, NULL);
     expect_problem(&r, 413, NULL, "limit of 1048576 bytes");
+    assert_non_null(strstr(r.body, "if this is a loft"));
+    free(r.body);
+    /* The loft hint is /solve's: an eval's body is points (QA 13) */
+    r = http(&d, "POST", "/solids/0123456789abcdef0123456789abcdef/eval", huge, big, NULL);
+    expect_problem(&r, 413, NULL, "limit of 1048576 bytes");
+    assert_null(strstr(r.body, "loft"));
     free(r.body);
     free(huge);
     r = post(&d, "/solve", "{\"pde\": [1, 2");
@@ -1310,6 +1369,7 @@ int main(void)
         cmocka_unit_test(sixty_four_concurrent_clients_should_all_get_correct_answers),
         cmocka_unit_test(a_full_queue_should_give_503_with_retry_after),
         cmocka_unit_test(a_light_request_should_not_wait_behind_heavy_ones),
+        cmocka_unit_test(heavy_evals_and_big_bodies_should_run_apart),
         cmocka_unit_test(bad_requests_should_get_problems_and_the_daemon_should_keep_serving),
         cmocka_unit_test(a_loft_should_solve_and_a_bad_one_get_its_pointer),
         cmocka_unit_test(two_content_lengths_and_stalled_clients_should_be_refused),

@@ -3,6 +3,7 @@
  * collapsed axes, orientation, volumes against core's pde_properties, merges, and the msh and vtu
  * files read back by python3-meshio and checked by gmsh.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -284,6 +285,40 @@ static void a_cancelled_build_should_say_so(void **state)
     pde_solution_free(s);
 }
 
+/* A stop that counts its calls and answers yes from call number at on. */
+typedef struct {
+    unsigned calls, at;
+} countdown;
+
+static int stop_at(void *arg)
+{
+    countdown *c = arg;
+    return ++c->calls > c->at;
+}
+
+/* The samples poll per row (u), not per plane (u, v): a plane of a big loft is seconds of pde_eval_d
+ * past --job-timeout. Counted, not timed: a whole build polls at least once a row, so at most res[0]
+ * evaluations go by unpolled, and a stop asked for midway ends the build at its next poll. */
+static void a_build_should_poll_its_cancel_once_a_row(void **state)
+{
+    (void)state;
+    pde_solution *s = preset_solution("fig1a");
+    api_volmesh m;
+    api_error err;
+    unsigned r[3] = { 40, 6, 5 };
+    countdown never = { 0, UINT_MAX };
+    pde_cancel c = { stop_at, &never };
+    assert_int_equal(api_volmesh_build(s, r, &c, &m, &err), 0);
+    api_volmesh_free(&m);
+    assert_true(never.calls >= r[1] * r[2]);
+    countdown mid = { 0, r[1] * r[2] / 2 };
+    c.arg = &mid;
+    assert_int_equal(api_volmesh_build(s, r, &c, &m, &err), -1);
+    assert_int_equal(err.status, API_ERR_CANCELLED);
+    assert_int_equal(mid.calls, mid.at + 1);
+    pde_solution_free(s);
+}
+
 static int put_file(void *ctx, const void *p, size_t n)
 {
     return fwrite(p, 1, n, ctx) == n ? 0 : -1;
@@ -521,6 +556,7 @@ int main(void)
         cmocka_unit_test(three_samples_around_a_loop_should_be_refused_naming_the_axis),
         cmocka_unit_test(msh_entities_should_bound_their_own_faces),
         cmocka_unit_test(a_cancelled_build_should_say_so),
+        cmocka_unit_test(a_build_should_poll_its_cancel_once_a_row),
         cmocka_unit_test(a_solid_with_no_volume_should_get_no_mesh_and_say_why),
         cmocka_unit_test(files_should_read_back_in_meshio),
         cmocka_unit_test(large_files_should_stream_in_pieces_of_about_a_megabyte),
