@@ -188,6 +188,46 @@ static double least(const trig4 *q, double lo, double hi, double *d2)
     return x;
 }
 
+/* q' (returned) and q'' (into *d2) at theta, for q = |x_t x x_w|^2 */
+static double dq(const trig4 *q, double th, double *d2)
+{
+    double cs[8], d1 = 0.0;
+    harmonics(th, cs);
+    *d2 = 0.0;
+    for (int j = 1; j <= 4; j++) {
+        d1 += j * (q->b[j] * cs[j - 1] - q->a[j] * cs[j + 3]);
+        *d2 -= j * j * (q->a[j] * cs[j - 1] + q->b[j] * cs[j + 3]);
+    }
+    return d1;
+}
+
+/*
+ * Every least value of |x_t x x_w|^2 in [lo, hi] (q' there d1lo, d1hi) into at[], *n of them, located
+ * (least). q' is a trigonometric polynomial of degree 4, with at most 8 zeros a period, but two of
+ * them (two narrow dips) may sit closer than any sampling's spacing: they are isolated by bounds
+ * instead, L[0] of |q''| and L[1] of |q'''| (sums of j^2 and j^3 times the harmonics' amplitudes): no
+ * zero where |q'(mid)| > L[0] h (h the half-width), at most one where |q''(mid)| > L[1] h (q'
+ * monotone: a least value where it rises through 0), else halved (a degenerate one: to 2^-CRIT_DEPTH).
+ */
+#define CRIT_DEPTH 40
+#define CRIT_MAX 8
+static void minima(const trig4 *q, double lo, double hi, double d1lo, double d1hi, const double L[2], int depth,
+                   double *at, int *n)
+{
+    const double h = 0.5 * (hi - lo), mid = lo + h;
+    double d2;
+    const double d1 = dq(q, mid, &d2);
+    if (fabs(d1) > L[0] * h)
+        return;
+    if (fabs(d2) > L[1] * h || depth >= CRIT_DEPTH) {
+        if (d1lo < 0.0 && d1hi >= 0.0 && *n < CRIT_MAX)
+            at[(*n)++] = least(q, lo, hi, &d2);
+        return;
+    }
+    minima(q, lo, mid, d1lo, d1, L, depth + 1, at, n);
+    minima(q, mid, hi, d1, d1hi, L, depth + 1, at, n);
+}
+
 /* The element at c + t, cos c = cb and sin c = sb, |t| <= PIECE_MAX: cos and sin of t by their series */
 static double elem_off(const trig4 *q, double cb, double sb, double t)
 {
@@ -515,18 +555,28 @@ static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
     }
     if (!q->odd && stride <= NT / 2 / N0 && even_mean(q, e, &ev, dip))
         return ev;
-    const double dt = stride * 2.0 * M_PI / NT, period = per * (2.0 * M_PI / NT);
-    const int ns = per / stride;
-    double cut[NT], scale[NT];
+    const double period = per * (2.0 * M_PI / NT);
+    /* the cuts: every least value of the element, isolated by bounds (minima), not at the least
+     * samples, which took two narrow dips between two samples for one (2.5e-6 of the mean off) */
+    double cut[CRIT_MAX], scale[CRIT_MAX], L[2] = { 0.0, 0.0 }, d2;
     int ncut = 0;
-    for (int j = 0; j < ns; j++) {
-        const double l = e[(j + ns - 1) % ns * stride], r = e[(j + 1) % ns * stride], ej = e[j * stride];
-        if (ej < l && ej <= r) {
-            double d2, m;
-            cut[ncut] = least(q, (j - 1) * dt, (j + 1) * dt, &d2);
-            elem_fn((void *)q, cut[ncut], &m);
-            scale[ncut++] = d2 > 0.0 ? m / sqrt(0.5 * d2) : 0.0;
-        }
+    for (int j = 1; j <= 4; j++) {
+        const double amp = hypot(q->a[j], q->b[j]);
+        L[0] += j * j * amp, L[1] += j * j * j * amp;
+    }
+    /* q' at 16 ends, its value at 0 also at the period's end: a least value at a shared end then goes to
+     * exactly one side (q' < 0 on the left, >= 0 on the right) */
+    double d1[17];
+    for (int p = 0; p < 16; p++)
+        d1[p] = dq(q, period * p / 16, &d2);
+    d1[16] = d1[0];
+    for (int p = 0; p < 16; p++)
+        minima(q, period * p / 16, period * (p + 1) / 16, d1[p], d1[p + 1], L, 0, cut, &ncut);
+    for (int j = 0; j < ncut; j++) {
+        double m;
+        dq(q, cut[j], &d2);
+        elem_fn((void *)q, cut[j], &m);
+        scale[j] = d2 > 0.0 ? m / sqrt(0.5 * d2) : 0.0;
     }
     if (!ncut)
         cut[ncut] = 0.0, scale[ncut++] = period;
