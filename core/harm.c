@@ -701,7 +701,7 @@ static double dip_place(harm_ctx *H, double a, double b)
  * Along w, each panel's 10-point Gauss rule, then its 21-point Kronrod extension (QUADPACK's qk21 on
  * [-1, 1]: xgk[1], xgk[3], ... the Gauss rule's nodes, wg its weights): 11 points more where halving
  * took 20, the Gauss points kept for it (wpanel). Where the two differ, the halves' Gauss rules, the
- * children's own.
+ * children's own. A face of many harmonics (a loft's) against its halves still (outer).
  */
 static const double xgk[11] = { 0.995657163025808080735527280689003, 0.973906528517171720077964012084452,
                                 0.930157491355708226001207180059508, 0.865063366688984510732096688423493,
@@ -804,7 +804,13 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
     if (H->stopped || H->nodes > H->max_nodes || H->work > MANY_WORK || H->fold)
         return 0;   /* the panels then, which bound their work */
     H->dip = INFINITY;
-    kronrod_w(H, a, b, coarse, K);
+    if (H->many) {   /* a loft's: its halves (the Kronrod rule moved the tower's area by 1.3e-12) */
+        rule_w(H, a, m, &l);
+        rule_w(H, m, b, &r);
+        for (int k = 0; k < 2; k++)
+            K[k] = l.sum[k] + r.sum[k];
+    } else
+        kronrod_w(H, a, b, coarse, K);
     int ok = 1;
     for (int k = 0; k < 2; k++) {
         if (isnan(K[k]))
@@ -818,8 +824,10 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
     }
     if (depth >= DEPTH)
         return 0;
-    rule_w(H, a, m, &l);
-    rule_w(H, m, b, &r);
+    if (!H->many) {
+        rule_w(H, a, m, &l);
+        rule_w(H, m, b, &r);
+    }
     if (split && H->dip < DIP && H->splits > 0) {
         H->splits--;
         const double q = 0.125 * (b - a), near = 1e3 * DIP_EPS * (b - a);
