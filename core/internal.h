@@ -175,11 +175,16 @@ struct pde_grid {
     double *k[3];               /* 3 nd: a row's coefficients for x, xv and xw */
     double *row;                /* 12 nu */
     double *col;                /* nu <= COL_NU: max(3 max(nd), 9) nv, the coefficients of a plane's rows side by side */
+    double *blk;                /* wider, with BLK_MODES modes or more in a component: 3 nd BLK_ROWS per component,
+                                 * the coefficients of BLK_ROWS rows (col_coefs' layout), x's then y's and z's */
 };
 
 /* Grids this narrow (faces u = const) fill a plane column-wise: the coefficients of all its rows at
  * once, over contiguous v, instead of a few points per row. */
 enum { COL_NU = 2 };
+/* Wider grids with this many modes in a component take their rows' coefficients BLK_ROWS rows at a
+ * time the same way (eval.c's grid_blocks): a row at a time read a cache line per mode. */
+enum { BLK_MODES = 64, BLK_ROWS = 64 };
 
 enum { GRID_X = 1, GRID_XU = 2, GRID_XV = 4, GRID_XW = 8 };
 

@@ -177,6 +177,59 @@ static void narrow_grid_should_match_a_wide_grids_columns(void **state)
     assert_true(ones > 0 && more > 0);
 }
 
+/*
+ * A wide grid of many modes (BLK_MODES or more in a component) takes its rows' coefficients a block of rows
+ * at a time (eval.c's grid_blocks): its planes, with and without derivatives, and any run of rows (across a
+ * block's end, positions alone or one derivative alone) against pointwise evaluation and the plane's own rows.
+ */
+static void a_wide_grid_of_many_modes_should_match_pointwise_evaluation(void **state)
+{
+    (void)state;
+    enum { NM = 80, NU = 5, NV = 70, NW = 4 };
+    static pde_bterm b[3][NM + 1];
+    for (int c = 0; c < 3; c++) {
+        b[c][0] = (pde_bterm){ c == 0 ? F_pow(1) : F_pow(0), c == 1 ? F_pow(1) : F_pow(0), c == 2 ? 0 : 1, c == 2,
+                               1, c == 2 };
+        for (int k = 1; k <= NM; k++)   /* x and y: u cos / sin of 2 k pi v; z: u^2 cos */
+            b[c][k] = (pde_bterm){ F_pow(c == 2 ? 2 : 1), c == 1 ? F_sin(2 * k) : F_cos(2 * k), 0.3 / k, 0.1 / k,
+                                   0.2 / k, -0.05 / k };
+    }
+    pde_model m = { { { 1, 1, 1, b[0], NM + 1, NULL, 0 }, { 1, 1, 1, b[1], NM + 1, NULL, 0 },
+                      { 1, 1, 1, b[2], NM + 1, NULL, 0 } } };
+    pde_solution *sol;
+    assert_int_equal(pde_solve(&m, &sol, NULL), PDE_OK);
+    double us[NU], vs[NV];
+    for (int i = 0; i < NU; i++)
+        us[i] = i / (NU - 1.0);
+    for (int j = 0; j < NV; j++)
+        vs[j] = j / (NV - 1.0);
+    pde_grid *g;
+    assert_int_equal(pde_grid_create(sol, us, NU, vs, NV, &g), PDE_OK);
+    assert_non_null(g->blk);   /* the path under test */
+    static float q[4][3 * NU * NV], only[3 * NU * NV];
+    for (int k = 0; k < NW; k++) {
+        const double w = k / (NW - 1.0);
+        pde_grid_plane_d(g, w, q[0], q[1], q[2], q[3]);
+        for (int j = 0; j < NV; j++)
+            for (int i = 0; i < NU; i++) {
+                double x[3], d[3][3];
+                pde_eval_d(sol, us[i], vs[j], w, x, d[0], d[1], d[2]);
+                for (int c = 0; c < 3; c++) {
+                    const int at = 3 * (j * NU + i) + c;
+                    assert_rel(q[0][at], x[c], 1e-6, 1.0);
+                    for (int a = 0; a < 3; a++)
+                        assert_rel(q[1 + a][at], d[a][c], 1e-6, 1.0);
+                }
+            }
+        pde_grid_rows(g, w, 60, NV, only, NULL, NULL, NULL);   /* across the first block's end, positions alone */
+        assert_memory_equal(only, q[0] + 3 * NU * 60, 3 * NU * (NV - 60) * sizeof(float));
+        pde_grid_rows(g, w, 3, 67, NULL, NULL, only, NULL);    /* x_v alone, a block and a part */
+        assert_memory_equal(only, q[2] + 3 * NU * 3, 3 * NU * 64 * sizeof(float));
+    }
+    pde_grid_free(g);
+    pde_solution_free(sol);
+}
+
 /* Richardson-extrapolated central differences of order n (1..4) along one axis. */
 static double fd(const pde_solution *sol, int comp, const double p[3], int axis, int n, double h)
 {
@@ -432,6 +485,7 @@ int main(void)
         cmocka_unit_test(sample_should_match_pointwise_evaluation),
         cmocka_unit_test(grid_should_give_faces_and_derivatives),
         cmocka_unit_test(narrow_grid_should_match_a_wide_grids_columns),
+        cmocka_unit_test(a_wide_grid_of_many_modes_should_match_pointwise_evaluation),
         cmocka_unit_test(eval_partial_should_agree_with_differences_and_first_derivatives),
         cmocka_unit_test(detj_should_be_the_determinant_of_differences_and_flat_solids_found),
         cmocka_unit_test(force_should_be_the_models_force),
