@@ -48,8 +48,9 @@
 #define MAX_SPLITS 32   /* cuts at dips of w in a face, at most: a cut inside a graded piece may cut
                          * again (a stiff model's valley of dips cut 30 deep, each deeper) */
 #define MAX_NODES 40000 /* points of w in a face, at most (fig. 2c: 2400), else the panels */
-#define MANY_WORK 2e6   /* a face of many harmonics (below): its points of theta, at most, else the panels
-                         * (tower 2e5, blade 1.6e5) */
+#define MANY_WORK 1.5e7 /* a face of many harmonics (below): its points of theta times (harmonics + 1), at
+                         * most, else the panels (tower and blade 5.4e6: 1.65e5 points of 32 harmonics; a
+                         * loft of 80 harmonics took 2e6 points, 1.6e8, before it gave up) */
 
 #define EV_N 1024       /* the cut's rule (even_mean): intervals of beta on [0, pi] on its finest level */
 #define EV_N0 8         /* ... on its first */
@@ -884,7 +885,7 @@ static void mtrig_init(void)
 /* The element over 2 pi, |g|, at theta = 2 pi idx / MT; x . g into *flux where flux is not NULL. */
 static double many_sample(harm_ctx *H, int idx, double *flux)
 {
-    H->work += 1.0;
+    H->work += 1.0 + H->nh;   /* a point's cost: its harmonics */
     const double *cf = H->cf;
     double xt[3] = { 0, 0, 0 }, xw[3] = { cf[3], cf[4], cf[5] }, x[3] = { cf[0], cf[1], cf[2] };
     for (int h = 0; h < H->nh; h++) {
@@ -908,7 +909,7 @@ static double many_sample(harm_ctx *H, int idx, double *flux)
 /* g = x_theta x x_w at theta, and with nd = 2 its first two derivatives in theta (d[1], d[2]). */
 static void many_g(harm_ctx *H, double th, int nd, double d[3][3])
 {
-    H->work += 1.0;
+    H->work += 1.0 + H->nh;   /* a point's cost: its harmonics */
     const double *cf = H->cf, c1 = cos(th), s1 = sin(th);
     double xt[3][3] = { { 0 } }, xw[3][3] = { { cf[3], cf[4], cf[5] }, { 0 }, { 0 } };   /* [order][comp] */
     double c = 1.0, sn = 0.0;
@@ -990,8 +991,8 @@ static double many_rule(const many_half *f, double lo, double hi)
 static double many_adapt(const many_half *f, double lo, double hi, double coarse, int depth)
 {
     const double m = 0.5 * (lo + hi), l = many_rule(f, lo, m), r = many_rule(f, m, hi);
-    if (!(fabs(l + r - coarse) > f->tol * (hi - lo)) || depth >= MANY_DEPTH)
-        return l + r;
+    if (!(fabs(l + r - coarse) > f->tol * (hi - lo)) || depth >= MANY_DEPTH || f->H->work > MANY_WORK)
+        return l + r;   /* past the work's bound the face goes to the panels (harm_face): no more halving */
     return many_adapt(f, lo, m, l, depth + 1) + many_adapt(f, m, hi, r, depth + 1);
 }
 

@@ -2266,13 +2266,17 @@ static pde_status solid_run(const pde_solution *s, const double x0[3], double js
 #define FOLD_SAMPLES 8        /* samples of Q per wavelength of its fastest harmonic (2K) */
 #define FOLD_RULE 16          /* Gauss points per panel of a span of w (in its own variable) */
 #define FOLD_CHECK 10         /* ... and of the rule it is checked against */
+#define FOLD_OVER_RULE 4      /* ... and of a span's one rule past the work's bound */
 #define FOLD_DEPTH 30         /* halvings of a span, at most */
 #define FOLD_TOL 1e-15        /* a panel and its halves agree to this of the volume (each integral's scale) */
 #define FOLD_SPANS 512        /* spans of w (cut where the rows' root counts change), at most */
 #define FOLD_EPS 1e-12        /* a count change this close (of the span) to a cut already there is that cut */
-#define FOLD_WORK (10 * MAX_WORK)  /* samples and fold_eval's calls times (K + 1) (fold_ctx.work, some 30
-                                    * instructions each: 4 MAX_WORK is the other paths' time), at most: past
-                                    * it no span is halved or cut, and err says so (fold_span; 1e-9 at least) */
+#define FOLD_WORK (2 * MAX_WORK)   /* samples and fold_eval's calls times (K + 1) (fold_ctx.work), at most:
+                                    * past it no span is halved or cut, and err says so (fold_span; 1e-9 at
+                                    * least). At 10 MAX_WORK a loft of 127 harmonics (4 sections of 256
+                                    * points, c = -1e-3) spent 5.4 s here, past any --job-timeout: a unit
+                                    * costs more than the 30 instructions first thought, and 2 MAX_WORK is
+                                    * about a second */
 
 typedef struct {
     const pde_solution *s;
@@ -2557,19 +2561,31 @@ static void fold_span(fold_ctx *f, fold_span_t sp, double acc[Q_N])
     /* past the work's bound, as it is: its lobes, unresolved, count in err as a whole (the rules'
      * difference missed a star loft's error by 15%) */
     const int over = fold_over(f);
-    for (int lenient = over; lenient < 2; lenient++) {
+    if (over) {   /* one short rule, its lobes in err as a whole: the spans still pending past the bound (98
+                   * of a loft of 127 harmonics) took two full rules each, 5 s */
+        double part[Q_N], at[2], w1;
+        int cnt[2];
+        fold_rule(f, &sp, 0.0, 1.0, FOLD_OVER_RULE, part, at, cnt, &w1);
+        for (int e = 0; e < Q_N; e++)
+            acc[e] += part[e];
+        f->err += fabs(part[Q_VOL]) - fabs(part[Q_SIGNED]);
+        return;
+    }
+    for (int lenient = 0; lenient < 2; lenient++) {
         double part[Q_N] = { 0 }, at[2], err = 0.0, wsig = 0.0;
         int cnt[2], sig = -2;
         if (!fold_adapt(f, &sp, 0.0, 1.0, &sig, &wsig, lenient, 0, part, &err, at, cnt)) {
             for (int e = 0; e < Q_N; e++)
                 acc[e] += part[e];
-            f->err += over ? fmax(err, fabs(part[Q_VOL]) - fabs(part[Q_SIGNED])) : err;
+            f->err += over || fold_over(f) ? fmax(err, fabs(part[Q_VOL]) - fabs(part[Q_SIGNED])) : err;
             return;
         }
         /* the change between at[0] (count cnt[0]) and at[1], located by bisection */
         double lo = fmin(at[0], at[1]), hi = fmax(at[0], at[1]);
         int clo = at[0] < at[1] ? cnt[0] : cnt[1];
-        while (hi - lo > 0.1 * FOLD_EPS * (sp.wb - sp.wa) && hi - lo > 4 * DBL_EPSILON * fmax(fabs(lo), fabs(hi))) {
+        while (hi - lo > 0.1 * FOLD_EPS * (sp.wb - sp.wa) && hi - lo > 4 * DBL_EPSILON * fmax(fabs(lo), fabs(hi)) &&
+               !fold_over(f)) {   /* a row a step: within the work's bound too (512 cuts of 40 steps, 127
+                                   * harmonics: 5 s) */
             const double mid = 0.5 * (lo + hi);
             if (!(mid > lo && mid < hi))
                 break;
@@ -2579,12 +2595,13 @@ static void fold_span(fold_ctx *f, fold_span_t sp, double acc[Q_N])
                 hi = mid;
         }
         const double w0 = 0.5 * (lo + hi), L = sp.wb - sp.wa;
-        if (w0 - sp.wa > FOLD_EPS * L && sp.wb - w0 > FOLD_EPS * L && f->spans + 2 <= FOLD_SPANS) {
+        if (w0 - sp.wa > FOLD_EPS * L && sp.wb - w0 > FOLD_EPS * L && f->spans + 2 <= FOLD_SPANS && !fold_over(f)) {
             fold_span(f, (fold_span_t){ sp.wa, w0, sp.ca, 1 }, acc);
             fold_span(f, (fold_span_t){ w0, sp.wb, 1, sp.cb }, acc);
             return;
         }
-        /* at a cut already there (rounding of a tiny lobe's sign), or past FOLD_SPANS: as it is */
+        /* at a cut already there (rounding of a tiny lobe's sign), or past FOLD_SPANS or the work's bound:
+         * as it is */
     }
 }
 

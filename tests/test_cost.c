@@ -518,6 +518,56 @@ static void every_loft_preset_should_load_in_the_browser_within_the_default_budg
 }
 
 /*
+ * A loft of two 160-point sections of every harmonic (319 modes, more than core/bound.c's memo serves):
+ * its properties took 1.5 to 4.8 s of CPU on the reference machine against an estimate of 0.71 s, so
+ * pdesolidd took it and cancelled it at --job-timeout (503, and again on every retry). Its estimate must
+ * now be over the default budget (1e9), a 422 before any work.
+ */
+static void a_loft_of_more_modes_than_the_memo_should_be_over_the_default_budget(void **state)
+{
+    (void)state;
+    enum { N = 160 };
+    size_t cap = 64 * 2 * N + 256, len = 0;
+    char *doc = malloc(cap);
+    assert_non_null(doc);
+    len += (size_t)snprintf(doc + len, cap - len, "{\"loft\": {\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], "
+                                                   "\"c\": [4, 4, 4]}, \"sections\": [");
+    for (int k = 0; k < 2; k++) {
+        len += (size_t)snprintf(doc + len, cap - len, "%s{\"w\": %d, \"profile\": [", k ? ", " : "", k);
+        for (int j = 0; j < N; j++) {
+            const double t = 2.0 * M_PI * j / N;
+            double r = 1.0;
+            for (int m = 2; m < N / 2; m++)   /* every harmonic up to 79, a rough section */
+                r += 0.02 / m * cos(m * t + 0.7 * m * m + k);
+            len += (size_t)snprintf(doc + len, cap - len, "%s[%.17g, %.17g, %d]", j ? ", " : "", r * cos(t), r * sin(t), k);
+        }
+        len += (size_t)snprintf(doc + len, cap - len, "]}");
+    }
+    len += (size_t)snprintf(doc + len, cap - len, "]}}");
+    assert_true(len < cap);
+    api_error err;
+    api_model *m = api_model_parse(doc, len, &err);
+    if (!m)
+        fail_msg("%s: %s", err.pointer, err.message);
+    pde_solution *sol = NULL;
+    assert_int_equal(api_solve(m, &sol, &err), 0);
+    size_t modes = 0;
+    for (int c = 0; c < 3; c++) {
+        size_t nm;
+        pde_solution_modes(sol, c, &nm);
+        modes += nm;
+    }
+    assert_true(modes > 256);
+    api_cost props;
+    api_cost_props(sol, &props);
+    if (!(props.work >= 1e9))
+        fail_msg("%zu modes: properties estimated at %.3g units, under the default budget of 1e9", modes, props.work);
+    pde_solution_free(sol);
+    api_model_free(m);
+    free(doc);
+}
+
+/*
  * A model a designer might write: 16 cosine modes in u per component, a solid that folds. Its
  * properties took 6.7 s and pdesolidd refused every request for it (1.06e10 units); they are now
  * bounded by PDE_PROPS_WORK (about 0.5 s here) and fit the default budget of 1e9 with json.
@@ -562,6 +612,7 @@ int main(void)
         cmocka_unit_test(every_preset_in_every_format_should_stay_well_under_the_budget),
         cmocka_unit_test(every_loft_preset_should_load_in_the_browser_within_the_default_budget),
         cmocka_unit_test(a_model_of_sixteen_modes_per_component_should_fit_the_default_budget),
+        cmocka_unit_test(a_loft_of_more_modes_than_the_memo_should_be_over_the_default_budget),
     };
     test_filter_from_env();
     return cmocka_run_group_tests(tests, NULL, NULL);
