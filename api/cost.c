@@ -230,10 +230,11 @@ static double sweep_work(const comp_stats st[3], double nu, double nv, double nw
 
 /* ---- the properties ---- */
 
-/* Every mode t^n along u and 1 or a whole harmonic of 2 pi v along v: a loft's form (core/props.c's radial
- * paths, core/quad.c's periodic and folding ones). */
-static int loft_form(const pde_solution *sol)
+/* Every mode t^n along u and 1 or a whole harmonic of 2 pi v along v, a loft's form (core/props.c's radial
+ * paths, core/quad.c's periodic and folding ones): its highest harmonic K (0 for none), else -1. */
+static int loft_harmonics(const pde_solution *sol)
 {
+    int K = 0;
     for (int c = 0; c < 3; c++) {
         size_t nm;
         const pde_mode *m = pde_solution_modes(sol, c, &nm);
@@ -241,10 +242,12 @@ static int loft_form(const pde_solution *sol)
             const pde_factor v = m[i].v;
             if (m[i].u.kind != PDE_POW ||
                 !((v.kind == PDE_POW && v.p == 0.0) || ((v.kind == PDE_SIN || v.kind == PDE_COS) && fmod(v.p, 2.0) == 0.0)))
-                return 0;
+                return -1;
+            if (v.kind != PDE_POW)
+                K = fmax(K, fabs(v.p) / 2.0);
         }
     }
-    return 1;
+    return K;
 }
 
 void api_cost_props(const pde_solution *sol, api_cost *c)
@@ -306,13 +309,18 @@ void api_cost_props(const pde_solution *sol, api_cost *c)
      * faces and folds take their paths to their work's bounds: measured 2 to 4 times the above (a loft
      * of 511 modes, 4 sections of 256 points, c = -1e-3: 3.9 s against 1.27 s; 319 modes: 1.45 s
      * against 0.71 s), where the loft presets, under 256 modes, are over (tower 0.26 s against 0.89 s). */
-    if (modes > 256.0 && loft_form(sol))
+    const int K = loft_harmonics(sol);
+    if (modes > 256.0 && K >= 0)
         w *= 3.0;
     c->work = w;
     /* core/quad.c's factor tables: each axis's values and derivatives at up to 26 points per mode;
      * core/bound.c's memo of factors (up to 16 MB, for up to 256 modes). */
     c->bytes = grid_bytes(st, res, res) + 64.0 * (PDE_PROPS_BOXES + jboxes) + 64.0 * modes + 65536.0 +
                8.0 * (6.0 * 26.0 + 5.0) * (modes + 1.0) + (double)pde_properties_memo_bytes(sol);
+    /* ... and a loft's folding path's cos and sin tables: 16 N (K + 1) bytes, N = 16 K samples a row (16.7 MB
+     * at K = 255; core/quad.c's fold_solid, for K up to FOLD_K = 256) */
+    if (K > 0 && K <= 256)
+        c->bytes += 256.0 * K * (K + 1.0);
 }
 
 /* ---- outputs ---- */

@@ -178,7 +178,10 @@ pde_status pde_grid_create(const pde_solution *sol, const double *us, size_t nu,
                 factor_eval(modes[m].v, vs[j], &g->psi[c][m * nv + j], &g->dpsi[c][m * nv + j]);
         }
     }
+    /* col_coefs scans every mode for each u-factor: nd nm a block, fine for a loft's few u-factors (1, t),
+     * not for 4000 distinct ones (tests/test_hostile.c's heavy stream stalled /livez) */
     if (nu > COL_NU && (g->nm[0] >= BLK_MODES || g->nm[1] >= BLK_MODES || g->nm[2] >= BLK_MODES) &&
+        g->nd[0] <= BLK_ND && g->nd[1] <= BLK_ND && g->nd[2] <= BLK_ND &&
         !(g->blk = malloc(3 * (g->nd[0] + g->nd[1] + g->nd[2] + 3) * BLK_ROWS * sizeof *g->blk)))
         goto nomem;
     if (nu <= COL_NU) {

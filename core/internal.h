@@ -184,7 +184,7 @@ struct pde_grid {
 enum { COL_NU = 2 };
 /* Wider grids with this many modes in a component take their rows' coefficients BLK_ROWS rows at a
  * time the same way (eval.c's grid_blocks): a row at a time read a cache line per mode. */
-enum { BLK_MODES = 64, BLK_ROWS = 64 };
+enum { BLK_MODES = 64, BLK_ROWS = 64, BLK_ND = 4 /* distinct u-factors a component, at most */ };
 
 enum { GRID_X = 1, GRID_XU = 2, GRID_XV = 4, GRID_XW = 8 };
 

@@ -2293,6 +2293,7 @@ typedef struct {
     double work;              /* rows' samples times (K + 1), and fold_eval's calls times (K + 1) */
     double err;               /* the sum of |fine - coarse| of the volume over accepted panels */
     int stopped, capped;
+    double next_poll;         /* work at which the caller's stop() is asked next */
 } fold_ctx;
 
 /* P_c and its derivative of order d (1 or 2) along s at s, c = 0, 1 (by the rotation e^{2 pi i s}: two
@@ -2371,6 +2372,10 @@ static int fold_row(fold_ctx *f, double w, double out[Q_N])
         }
     }
     f->rows++;
+    if (!f->stopped && f->work >= f->next_poll) {   /* a row of 127 harmonics is some 1 ms: by work, not panels */
+        f->next_poll = f->work + POLL_WORK;
+        f->stopped |= pde_stopped(f->cancel);
+    }
     f->work += (double)N * (K + 1);
     for (int c = 0; c < 2; c++)
         for (int k = 0; k <= K; k++) {
@@ -2511,9 +2516,10 @@ static int fold_count(fold_ctx *f, double w)
     return fold_row(f, w, NULL);
 }
 
+/* Past the work's bound, or asked to stop: no more cuts, bisections or halvings */
 static int fold_over(const fold_ctx *f)
 {
-    return f->work >= FOLD_WORK;
+    return f->stopped || f->work >= FOLD_WORK;
 }
 
 /* [s0, s1] of the span by the FOLD_RULE-point rule against the FOLD_CHECK-point one, halved where they
@@ -2559,9 +2565,12 @@ static void fold_span(fold_ctx *f, fold_span_t sp, double acc[Q_N])
 {
     f->spans++;
     /* past the work's bound, as it is: its lobes, unresolved, count in err as a whole (the rules'
-     * difference missed a star loft's error by 15%) */
+     * difference missed a star loft's error by 15%), and err is 1e-9 at least (capped) */
+    if (f->stopped)
+        return;
     const int over = fold_over(f);
-    if (over) {   /* one short rule, its lobes in err as a whole: the spans still pending past the bound (98
+    if (over) {
+        f->capped = 1;   /* one short rule, its lobes in err as a whole: the spans still pending past the bound (98
                    * of a loft of 127 harmonics) took two full rules each, 5 s */
         double part[Q_N], at[2], w1;
         int cnt[2];

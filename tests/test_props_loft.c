@@ -643,6 +643,65 @@ static void a_twisted_folding_loft_matches_a_root_split_reference(void **state)
     cJSON_Delete(j);
 }
 
+/* A stop() that counts its calls and asks to stop from call `at` on (never where at is 0). */
+typedef struct {
+    int calls, at;
+} poll_count;
+
+static int count_polls(void *arg)
+{
+    poll_count *c = arg;
+    c->calls++;
+    return c->at && c->calls >= c->at;
+}
+
+/*
+ * The folding path polls the caller's stop() by its work (pde.h: a few ms apart at most), and stops at the
+ * poll that asks. A star loft of 33 harmonics (2 sections of 64 points, r = 1 + 0.15 cos 31t + 0.3 w cos 2t:
+ * folds, some 4000 rows of 512 samples): it was polled only where a panel was to be halved, 0 times in 5 s
+ * on a loft of 120 harmonics (the review of session 13).
+ */
+static void the_folding_path_should_poll_by_its_work_and_stop_when_asked(void **state)
+{
+    (void)state;
+    enum { N = 64 };
+    char *doc = malloc(2 * N * 64 + 256);
+    assert_non_null(doc);
+    size_t len = (size_t)sprintf(doc, "{\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], \"c\": [1, 1, 1]}, \"sections\": [");
+    for (int k = 0; k < 2; k++) {
+        len += (size_t)sprintf(doc + len, "%s{\"w\": %d, \"profile\": [", k ? ", " : "", k);
+        for (int j = 0; j < N; j++) {
+            const double t = 2 * M_PI * j / N, r = 1 + 0.15 * cos(31 * t) + 0.3 * k * cos(2 * t);
+            len += (size_t)sprintf(doc + len, "%s[%.17g, %.17g, %d]", j ? ", " : "", r * cos(t), r * sin(t), k);
+        }
+        len += (size_t)sprintf(doc + len, "]}");
+    }
+    sprintf(doc + len, "]}");
+    cJSON *j = cJSON_Parse(doc);
+    assert_non_null(j);
+    api_error err;
+    api_loft *l = api_loft_parse(j, "/loft", &err);
+    assert_non_null(l);
+    pde_solution *sol = NULL;
+    assert_int_equal(api_loft_solve(l, "/loft", NULL, &sol, &err), 0);
+    poll_count never = { 0, 0 };
+    pde_cancel c = { count_polls, &never };
+    quad_result q;
+    assert_int_equal(quad_solid(sol, (const double[3]){ 0, 0, 0 }, 1.0, 1.0, 1, 0, &c, &q), PDE_OK);
+    const double rows = (double)q.evals / 512.0;   /* N = 16 K samples a row, K = 32 */
+    print_message("%.0f rows, %d polls\n", rows, never.calls);
+    if (!(rows > 500 && never.calls >= rows / 16))
+        fail_msg("%d polls in %.0f rows of 512 samples", never.calls, rows);
+    poll_count third = { 0, 3 };
+    c.arg = &third;
+    assert_int_equal(quad_solid(sol, (const double[3]){ 0, 0, 0 }, 1.0, 1.0, 1, 0, &c, &q), PDE_ERR_CANCELLED);
+    assert_int_equal(third.calls, 3);   /* no poll after the one that asked */
+    pde_solution_free(sol);
+    api_loft_free(l);
+    cJSON_Delete(j);
+    free(doc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -652,6 +711,7 @@ int main(void)
         cmocka_unit_test(models_within_the_work_bound_report_a_small_error),
         cmocka_unit_test(a_folding_loft_volume_should_count_its_negative_lobes),
         cmocka_unit_test(a_twisted_folding_loft_matches_a_root_split_reference),
+        cmocka_unit_test(the_folding_path_should_poll_by_its_work_and_stop_when_asked),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
