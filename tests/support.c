@@ -1579,15 +1579,14 @@ static double rp_detj(rp_eval *e, double w)
     return rp_det(J);
 }
 
-/* A root of det J in [a, b], where it changes sign: Illinois steps, a bisection when they stall. */
-static double rp_root(rp_eval *e, double a, double fa, double b, double fb)
+double ref_root(double (*f)(void *ctx, double x), void *ctx, double a, double fa, double b, double fb)
 {
     int side = 0;
     for (int it = 0; it < 200 && b - a > 1e-15 * fmax(1.0, fabs(a)); it++) {
         double m = (it % 4 == 3) ? 0.5 * (a + b) : (a * fb - b * fa) / (fb - fa);
         if (!(m > a && m < b))
             m = 0.5 * (a + b);
-        double fm = rp_detj(e, m);
+        double fm = f(ctx, m);
         if (fm == 0)
             return m;
         if ((fm < 0) == (fa < 0)) {
@@ -1603,6 +1602,23 @@ static double rp_root(rp_eval *e, double a, double fa, double b, double fb)
         }
     }
     return 0.5 * (a + b);
+}
+
+int ref_cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* A root of det J in [a, b], where it changes sign. */
+static double rp_detj_of(void *e, double w)
+{
+    return rp_detj(e, w);
+}
+
+static double rp_root(rp_eval *e, double a, double fa, double b, double fb)
+{
+    return ref_root(rp_detj_of, e, a, fa, b, fb);
 }
 
 /*

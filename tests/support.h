@@ -55,6 +55,12 @@ void indep_loft_free(indep_loft *s);
 /* |a - b| <= tol * max(|a|, |b|, floor): a relative test with an absolute floor. */
 int close_rel(double a, double b, double tol, double floor);
 
+/* A root of f in [a, b], where fa = f(a) and fb = f(b) have opposite signs: Illinois steps, a bisection
+ * every fourth (where they stall), to 1e-15 of max(1, |a|). The tests' references' one root finder. */
+double ref_root(double (*f)(void *ctx, double x), void *ctx, double a, double fa, double b, double fb);
+/* qsort's comparison of doubles, ascending. */
+int ref_cmp_double(const void *a, const void *b);
+
 #define assert_rel(a, b, tol, floor)                                                          \
     do {                                                                                      \
         double a_ = (a), b_ = (b);                                                            \

@@ -317,12 +317,6 @@ typedef struct {
     volatile int done;
 } stream_arg;
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 static void *stream_client(void *arg)
 {
     stream_arg *a = arg;
@@ -370,7 +364,7 @@ static void livez_should_answer_while_the_only_polling_thread_sends_a_heavy_stre
     assert_int_equal(a.bytes, 64LL * 64 * 16 * 12);
     if (asked < 5)
         fail_msg("the stream ended before /livez was asked 5 times (%d): make it heavier", asked);
-    qsort(took, (size_t)asked, sizeof *took, cmp_double);
+    qsort(took, (size_t)asked, sizeof *took, ref_cmp_double);
     print_message("  /livez asked %d times during the stream: median %.1f ms, slowest %.1f ms\n", asked,
                   took[asked / 2] * 1e3, took[asked - 1] * 1e3);
     /* A stall, not a latency goal (bench/bench_livez.sh measures p99 <= 10 ms): the finding's polling

@@ -124,38 +124,22 @@ static void u_integrals(fig3_line *L, double w, double wt)
     }
 }
 
-/* The root of kink `which` in [a, b], where it changes sign (fa, fb): regula falsi (Illinois's
- * variant) with a bisection every third step, to 1e-14 (the kink is of |s|^2 at worst: what is left
- * is far below rounding). */
-static double kink_root(const fig3_line *L, double a, double b, double fa, double fb, int which)
+typedef struct {
+    const fig3_line *L;
+    int which;
+} kink_arg;
+
+static double kink_of(void *arg, double w)
 {
-    int side = 0;
-    for (int it = 0; it < 200 && b - a > 1e-14; it++) {
-        double m = it % 3 == 2 ? 0.5 * (a + b) : (a * fb - b * fa) / (fb - fa);
-        if (!(m > a && m < b))
-            m = 0.5 * (a + b);
-        const double fm = kink(L, m, which);
-        if (fm == 0.0)
-            return m;
-        if ((fm < 0) == (fa < 0)) {
-            a = m, fa = fm;
-            if (side == -1)
-                fb *= 0.5;
-            side = -1;
-        } else {
-            b = m, fb = fm;
-            if (side == 1)
-                fa *= 0.5;
-            side = 1;
-        }
-    }
-    return 0.5 * (a + b);
+    const kink_arg *k = arg;
+    return kink(k->L, w, k->which);
 }
 
-static int cmp_double(const void *a, const void *b)
+/* The root of kink `which` in [a, b], where it changes sign (fa, fb) */
+static double kink_root(const fig3_line *L, double a, double b, double fa, double fb, int which)
 {
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
+    kink_arg k = { L, which };
+    return ref_root(kink_of, &k, a, fa, b, fb);
 }
 
 /* The line of v: w cut at the kinks (found among L->ns samples), each piece in panels of at most
@@ -177,7 +161,7 @@ static void w_line(fig3_line *L, int panels)
             prev[which] = f[which];
         }
     }
-    qsort(cut, (size_t)nc, sizeof *cut, cmp_double);
+    qsort(cut, (size_t)nc, sizeof *cut, ref_cmp_double);
     for (int k = 0; k + 1 < nc; k++) {
         const double a = cut[k], b = cut[k + 1];
         if (b <= a)

@@ -351,36 +351,15 @@ static double fold_j(const fold_ref *f, double v)
     return fold_at(S, 1.0, x);
 }
 
+static double fold_j_of(void *f, double v)
+{
+    return fold_j(f, v);
+}
+
 /* det J's root in [a, b] at u = 1, where fa, fb have opposite signs: Illinois, then bisection. */
 static double fold_bisect(const fold_ref *f, double a, double b, double fa)
 {
-    double fb = fold_j(f, b);
-    for (int i = 0, side = 0; i < 200 && b - a > 1e-15; i++) {
-        double m = i < 40 ? (a * fb - b * fa) / (fb - fa) : 0.5 * (a + b);
-        if (!(m > a && m < b))
-            m = 0.5 * (a + b);
-        const double fm = fold_j(f, m);
-        if (fm == 0.0)
-            return m;
-        if ((fm < 0) == (fa < 0)) {
-            a = m, fa = fm;
-            if (side == -1)
-                fb *= 0.5;
-            side = -1;
-        } else {
-            b = m, fb = fm;
-            if (side == 1)
-                fa *= 0.5;
-            side = 1;
-        }
-    }
-    return 0.5 * (a + b);
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
+    return ref_root(fold_j_of, (void *)f, a, fa, b, fold_j(f, b));
 }
 
 /* The integrals over (u, v) of the row w, into acc (about the origin). */
@@ -429,7 +408,7 @@ static void fold_row(fold_ref *f, double w, double acc[11])
     free(sj);
     for (int i = 0; i < nr; i++)   /* onto [0, 1) */
         roots[i] -= floor(roots[i]);
-    qsort(roots, (size_t)nr, sizeof *roots, cmp_double);
+    qsort(roots, (size_t)nr, sizeof *roots, ref_cmp_double);
     if (!nr)
         roots[nr++] = 0.0;
     roots[nr] = roots[0] + 1.0;   /* the pieces, cyclically */
