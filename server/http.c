@@ -13,7 +13,8 @@
  * else the handler reserves a place in the solver queue (or answers 503),
  * suspends the connection and submits the job, whose last act is to resume
  * it, and the handler, called again, sends the result: a whole body, or a
- * stream that the solver threads fill (stream.c).
+ * stream that the solver threads fill (stream.c); or, when the job saw its
+ * client close the connection, closes it too, without an answer (499).
  * A request refused before its body was read still has its body read and
  * discarded, bounded in bytes and time as nginx's lingering close, so that
  * the client, which is still writing, can read the answer.

@@ -7,7 +7,8 @@
  * times it, and resumes the connection. Handlers only set the request's
  * result (srv_set_text, srv_problem, r->stream); http.c sends it.
  * Every job checks its cost before the work (--max-work, --max-mem-mb) and
- * polls srv_job_stop() in its long loops (--job-timeout, shutdown).
+ * polls srv_job_stop() in its long loops (--job-timeout, shutdown, the
+ * client's close: then no answer, and the request is logged 499).
  */
 #include <errno.h>
 #include <malloc.h>
