@@ -749,6 +749,30 @@ static void a_client_gone_while_its_job_runs_should_stop_the_job_and_be_logged_4
     free(log);
 }
 
+/* Bytes that come while a job runs, a request pipelined on the same keep-alive connection, are no close: the job
+ * runs to its end (here its deadline, a 503) and both requests are answered, in order. */
+static void a_request_pipelined_while_a_job_runs_should_not_cancel_it(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--threads 1 --job-timeout 3 --max-work 1e15 --max-mem-mb 4096");
+    int fd = heavy_job_running(&d, 43);
+    static const char next[] = "GET /livez HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n";
+    raw_send_all(fd, next, sizeof next - 1);
+    static char buf[1 << 16];
+    long n = raw_read_to_close(fd, buf, sizeof buf, 8);
+    close(fd);
+    const char *first = strstr(buf, "HTTP/1.1 "), *second = first ? strstr(first + 9, "HTTP/1.1 ") : NULL;
+    if (n < 0 || !first || !second || strncmp(first, "HTTP/1.1 503", 12) || strncmp(second, "HTTP/1.1 200", 12))
+        fail_msg("expected the job's 503 (its deadline) and the pipelined request's 200, got (%ld bytes): %s", n,
+                 shown(buf, 0));
+    stop(&d);
+    char *log = read_file(d.log, NULL);
+    if (log && strstr(log, "closed its connection"))
+        fail_msg("a pipelined request was taken for a close:\n%s", log);
+    free(log);
+}
+
 /* Each budget alone: the other one is set out of the way. */
 static void requests_over_the_work_or_memory_budget_should_be_422_naming_the_flag(void **state)
 {
@@ -1493,6 +1517,7 @@ int main(void)
         T(sigterm_should_answer_queued_jobs_503_cancel_the_running_one_and_exit_within_grace_plus_one),
         T(a_job_over_its_deadline_should_be_cancelled_with_a_503_problem),
         T(a_client_gone_while_its_job_runs_should_stop_the_job_and_be_logged_499),
+        T(a_request_pipelined_while_a_job_runs_should_not_cancel_it),
         T(requests_over_the_work_or_memory_budget_should_be_422_naming_the_flag),
         T(every_flag_should_take_the_equals_form_and_unknown_arguments_should_exit_2_naming_them),
         T(eval_far_outside_the_cube_should_be_422_naming_the_point_and_never_write_nan),
