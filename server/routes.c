@@ -117,9 +117,10 @@ static void get_preset(srv_req *r)
  * error. Bytes waiting are no close (a client may pipeline its next request on a keep-alive connection);
  * a half-close (shutdown(SHUT_WR)) is one, as for nginx (ngx_http_test_reading) and libmicrohttpd. The
  * socket stays open while the connection is suspended: libmicrohttpd closes it only after the resume. */
-static int client_gone(srv_req *r)
+static int client_gone(srv_req *r, double now)
 {
     char c;
+    r->checked = now;
     if (!r->gone && r->fd >= 0) {
         ssize_t n = recv(r->fd, &c, 1, MSG_PEEK | MSG_DONTWAIT);
         r->gone = n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR);
@@ -131,10 +132,8 @@ int srv_job_stop(void *arg)
 {
     srv_req *r = arg;
     const double now = srv_now();
-    if (now - r->checked >= CLIENT_CHECK) {
-        r->checked = now;
-        client_gone(r);
-    }
+    if (now - r->checked >= CLIENT_CHECK)
+        client_gone(r, now);
     return r->gone || atomic_load(&r->s->aborting) || r->work + (now - r->run_start) > r->s->cfg.job_timeout;
 }
 
@@ -618,7 +617,7 @@ static void run_heavy(void *arg)
     srv_metrics_heavy(r->s->metrics);
     r->run_start = srv_now();
     r->tm.queue += r->run_start - r->queued_at;
-    if (atomic_load(&r->s->aborting) || client_gone(r)) {
+    if (atomic_load(&r->s->aborting) || client_gone(r, r->run_start)) {
         drop_later(r);
         stopped(r);
     } else
@@ -632,7 +631,7 @@ void srv_run_job(void *arg)
     r->run_start = srv_now();
     r->tm.queue = r->run_start - r->queued_at;
     r->cancel = (pde_cancel){ srv_job_stop, r };
-    if (atomic_load(&r->s->aborting) || client_gone(r))   /* a client that left while its job was queued */
+    if (atomic_load(&r->s->aborting) || client_gone(r, r->run_start))   /* a client that left while its job was queued */
         stopped(r);
     else
         srv_routes[r->route].handler(r);
@@ -643,7 +642,7 @@ void srv_run_job(void *arg)
 static void job_end(srv_req *r)
 {
     srv_server *s = r->s;
-    if (r->later && client_gone(r)) {
+    if (r->later && client_gone(r, srv_now())) {
         drop_later(r);
         stopped(r);
     }
