@@ -93,7 +93,7 @@ typedef struct srv_req {
     api_cost cost;               /* the estimate so far (--max-work, --max-mem-mb) */
     pde_cancel cancel;           /* polls srv_job_stop(r) */
     int fd;                      /* the connection's socket, which the jobs watch for the client's close */
-    int gone;                    /* the client closed its connection while its job ran: logged 499, no answer */
+    int gone;                    /* the client closed its connection while its job waited or ran: 499, no answer */
     double checked;              /* when a job last looked at fd (srv_now) */
     double queued_at, run_start;
     double work;                 /* seconds the solver threads spent on it before this run */

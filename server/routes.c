@@ -109,8 +109,8 @@ static void get_preset(srv_req *r)
 
 /* ---- the solver threads' jobs ---- */
 
-/* How often a job looks at its client's socket, in seconds of the job: a recv(2) of some microseconds
- * each, so the look costs under 0.1 % of the job, and a job whose client left stops within this. */
+/* How often a job looks at its client's socket, in seconds of the job: a recv(2) of about a microsecond
+ * each, so the look costs some 0.01 % of the job, and a job whose client left stops within this. */
 #define CLIENT_CHECK 0.01
 
 /* 1 (and r->gone) once r's client has closed its connection or reset it: the socket reads as EOF or an
