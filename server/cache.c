@@ -163,13 +163,21 @@ static srv_entry *await(srv_cache *c, srv_entry *e, api_error *err)
 srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void *arg, int *hit, api_error *err)
 {
     pthread_mutex_lock(&c->lock);
-    srv_entry *e = lookup(c, id);
-    if (e) {
+    srv_entry *e;
+    api_error why;
+    while ((e = lookup(c, id))) {
         c->hits++;
         *hit = 1;
-        e = await(c, e, err);
-        pthread_mutex_unlock(&c->lock);
-        return e;
+        e = await(c, e, &why);
+        /* A solve stopped for its own request (its deadline, its client gone) is no answer for this one:
+         * failures are not cached, so this request solves, under its own cancel. */
+        if (e || why.status != API_ERR_CANCELLED) {
+            if (!e && err)
+                *err = why;
+            pthread_mutex_unlock(&c->lock);
+            return e;
+        }
+        c->hits--;
     }
     *hit = 0;
     c->misses++;

@@ -32,6 +32,8 @@ void srv_cache_destroy(srv_cache *c);
  * The entry of id, solving it with solve(arg) if no one has. Returns a
  * reference (release it), or NULL with err when the solve failed. *hit tells
  * whether the solution was there (or being solved by another request).
+ * When the solve it waited for is cancelled (API_ERR_CANCELLED: that request's
+ * deadline, or its client gone), it solves itself rather than fail.
  */
 srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void *arg, int *hit, api_error *err);
 /* The entry of id if it is cached (waiting for a solve under way), else NULL. */

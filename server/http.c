@@ -13,7 +13,8 @@
  * else the handler reserves a place in the solver queue (or answers 503),
  * suspends the connection and submits the job, whose last act is to resume
  * it, and the handler, called again, sends the result: a whole body, or a
- * stream that the solver threads fill (stream.c).
+ * stream that the solver threads fill (stream.c); or, when the job saw its
+ * client close the connection, closes it too, without an answer (499).
  * A request refused before its body was read still has its body read and
  * discarded, bounded in bytes and time as nginx's lingering close, so that
  * the client, which is still writing, can read the answer.
@@ -343,6 +344,7 @@ static srv_req *begin(srv_server *s, struct MHD_Connection *conn, const char *ur
     r->t0 = srv_now();
     r->route = srv_nroutes;
     r->phase = SRV_BODY;
+    r->fd = -1;
     copy(r->method, sizeof r->method, method);
     copy(r->version, sizeof r->version, version);
     /* RFC 9112 3.2.2: a target in absolute form is routed by its path, and its authority stands for Host. Any
@@ -416,6 +418,8 @@ static enum MHD_Result dispatch_job(srv_req *r)
     }
     r->phase = SRV_QUEUED;
     r->queued_at = srv_now();
+    const union MHD_ConnectionInfo *ci = MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_CONNECTION_FD);
+    r->fd = ci ? ci->connect_fd : -1;   /* the jobs watch it for the client's close (srv_job_stop) */
     MHD_suspend_connection(r->conn);   /* before the job exists, so that its resume finds it suspended */
     srv_pool_submit(s->pool, srv_run_job, r);
     return MHD_YES;
@@ -478,11 +482,17 @@ static enum MHD_Result take_body(srv_req *r, const char *upload, size_t n)
     return MHD_YES;
 }
 
+/* Set on a polling thread as its handler closes the connection of a client gone (MHD_NO): libmicrohttpd then
+ * logs, on the same thread at once, "Application reported internal error", which it is not; mhd_logger drops
+ * that one line (the job's own line says why, and the access log has the 499). */
+static _Thread_local int closing_gone;
+
 static enum MHD_Result handler(void *cls, struct MHD_Connection *conn, const char *url, const char *method,
                                const char *version, const char *upload, size_t *upload_size, void **con_cls)
 {
     srv_server *s = cls;
     srv_req *r = *con_cls;
+    closing_gone = 0;
     if (!r) {
         if (!(r = begin(s, conn, url, method, version)))
             return MHD_NO;
@@ -495,6 +505,10 @@ static enum MHD_Result handler(void *cls, struct MHD_Connection *conn, const cha
         size_t n = *upload_size;
         *upload_size = 0;
         return take_body(r, upload, n);
+    }
+    if (r->phase == SRV_DONE && r->gone) {   /* resumed after the job saw its client close: no one to answer */
+        closing_gone = 1;
+        return MHD_NO;
     }
     if (r->phase == SRV_DONE)   /* resumed: the job's result is ready */
         return r->stream ? srv_stream_respond(r) : srv_respond_text(r);
@@ -643,6 +657,16 @@ void srv_say(srv_server *s, const char *fmt, ...)
 static void mhd_logger(void *cls, const char *fmt, va_list ap)
 {
     srv_server *s = cls;
+    if (closing_gone) {
+        closing_gone = 0;
+        va_list aq;
+        va_copy(aq, ap);
+        char msg[128];
+        vsnprintf(msg, sizeof msg, fmt, aq);
+        va_end(aq);
+        if (!strncmp(msg, "Application reported internal error", 35))
+            return;
+    }
     say(s->log, "libmicrohttpd", fmt, ap);
 }
 

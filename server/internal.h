@@ -92,6 +92,9 @@ typedef struct srv_req {
     /* Cost, timing and cancellation. */
     api_cost cost;               /* the estimate so far (--max-work, --max-mem-mb) */
     pde_cancel cancel;           /* polls srv_job_stop(r) */
+    int fd;                      /* the connection's socket, which the jobs watch for the client's close */
+    int gone;                    /* the client closed its connection while its job waited or ran: 499, no answer */
+    double checked;              /* when a job last looked at fd (srv_now) */
     double queued_at, run_start;
     double work;                 /* seconds the solver threads spent on it before this run */
     srv_entry *heavy;            /* the solid whose output waits apart (--heavy-work), or NULL */
@@ -145,7 +148,8 @@ enum MHD_Result srv_stream_respond(srv_req *r);
 /* When the request completes: drops its hold on its stream, if any. */
 void srv_stream_release(srv_req *r);
 
-/* routes.c: the jobs' entry, and the cancellation test every long loop polls. */
+/* routes.c: the jobs' entry, and the cancellation test every long loop polls: the deadline (--job-timeout),
+ * shutdown, and the client's close (r->gone; at most every 10 ms of a job, a recv(2) that peeks). */
 void srv_run_job(void *arg);
 int srv_job_stop(void *arg);
 

@@ -7,13 +7,16 @@
  * times it, and resumes the connection. Handlers only set the request's
  * result (srv_set_text, srv_problem, r->stream); http.c sends it.
  * Every job checks its cost before the work (--max-work, --max-mem-mb) and
- * polls srv_job_stop() in its long loops (--job-timeout, shutdown).
+ * polls srv_job_stop() in its long loops (--job-timeout, shutdown, the
+ * client's close: then no answer, and the request is logged 499).
  */
+#include <errno.h>
 #include <malloc.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
 #include <time.h>
 
 #include <cJSON.h>
@@ -106,20 +109,55 @@ static void get_preset(srv_req *r)
 
 /* ---- the solver threads' jobs ---- */
 
+/* How often a job looks at its client's socket, in seconds of the job: a recv(2) of about a microsecond
+ * each, so the look costs some 0.01 % of the job, and a job whose client left stops within this. */
+#define CLIENT_CHECK 0.01
+
+/* 1 (and r->gone) once r's client has closed its connection or reset it: the socket reads as EOF or an
+ * error. Bytes waiting are no close (a client may pipeline its next request on a keep-alive connection);
+ * a half-close (shutdown(SHUT_WR)) is one, as for nginx (ngx_http_test_reading) and libmicrohttpd. The
+ * socket stays open while the connection is suspended: libmicrohttpd closes it only after the resume. */
+static int client_gone(srv_req *r, double now)
+{
+    char c;
+    r->checked = now;
+    if (!r->gone && r->fd >= 0) {
+        ssize_t n = recv(r->fd, &c, 1, MSG_PEEK | MSG_DONTWAIT);
+        r->gone = n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR);
+    }
+    return r->gone;
+}
+
 int srv_job_stop(void *arg)
 {
     srv_req *r = arg;
-    return atomic_load(&r->s->aborting) || r->work + (srv_now() - r->run_start) > r->s->cfg.job_timeout;
+    const double now = srv_now();
+    if (now - r->checked >= CLIENT_CHECK)
+        client_gone(r, now);
+    return r->gone || atomic_load(&r->s->aborting) || r->work + (now - r->run_start) > r->s->cfg.job_timeout;
 }
 
-/* The problem of a job that stopped: the deadline, or shutdown. */
+/* The problem of a job that stopped: shutdown, the deadline, or no problem at all for a client gone (499,
+ * nginx's "client closed request": http.c closes the connection without an answer). */
 static void stopped(srv_req *r)
 {
-    if (atomic_load(&r->s->aborting))
+    srv_server *s = r->s;
+    if (atomic_load(&s->aborting)) {
         srv_problem(r, 503, NULL, "the server is shutting down");
-    else
+    } else if (r->gone) {
+        free(r->text);
+        r->text = NULL;
+        r->status = 499;
+        if (s->log) {
+            char msg[200];
+            snprintf(msg, sizeof msg, "rid=%s: the client closed its connection; its job stopped after %.3f s of "
+                     "solver time", r->rid, r->work + (srv_now() - r->run_start));
+            srv_log_note(s->log, "pdesolidd", msg);
+        }
+    } else {
         srv_problem(r, 503, NULL, "the request ran past its deadline of %g s of solver time (--job-timeout)",
-                    r->s->cfg.job_timeout);
+                    s->cfg.job_timeout);
+    }
 }
 
 /* Adds part to the request's estimate; 1 (with the problem set) when the whole is over a budget. */
@@ -579,7 +617,7 @@ static void run_heavy(void *arg)
     srv_metrics_heavy(r->s->metrics);
     r->run_start = srv_now();
     r->tm.queue += r->run_start - r->queued_at;
-    if (atomic_load(&r->s->aborting)) {
+    if (atomic_load(&r->s->aborting) || client_gone(r, r->run_start)) {
         drop_later(r);
         stopped(r);
     } else
@@ -593,7 +631,7 @@ void srv_run_job(void *arg)
     r->run_start = srv_now();
     r->tm.queue = r->run_start - r->queued_at;
     r->cancel = (pde_cancel){ srv_job_stop, r };
-    if (atomic_load(&r->s->aborting))
+    if (atomic_load(&r->s->aborting) || client_gone(r, r->run_start))   /* a client that left while its job was queued */
         stopped(r);
     else
         srv_routes[r->route].handler(r);
@@ -604,6 +642,10 @@ void srv_run_job(void *arg)
 static void job_end(srv_req *r)
 {
     srv_server *s = r->s;
+    if (r->later && client_gone(r, srv_now())) {
+        drop_later(r);
+        stopped(r);
+    }
     r->work += srv_now() - r->run_start;
     if (r->later) {
         r->queued_at = srv_now();

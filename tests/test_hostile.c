@@ -2,7 +2,7 @@
  * test_hostile.c: pdesolidd as a hostile client meets it, over raw sockets on
  * loopback (issue 8). Each test starts the sanitised daemon ($PDESOLIDD_SAN)
  * and stops it with SIGTERM, which must end in exit status 0. Every wait is
- * bounded by poll() timeouts: no test waits more than about 10 s.
+ * bounded by poll() timeouts: no test waits more than about 10 s, but for a heavy stream to end.
  *
  * These tests pin the behaviour the daemon must reach: the slow-body deadline,
  * a per-address limit that does not lock an address out, a 413 that clients
@@ -317,10 +317,12 @@ typedef struct {
     volatile int done;
 } stream_arg;
 
+/* The stream takes some 11 s under ASan, and 100 s under TSan (make tsan) on a loaded 2-core machine: the client
+ * waits up to 240 s for it to end. */
 static void *stream_client(void *arg)
 {
     stream_arg *a = arg;
-    raw_reply r = ask(a->d, "POST", "/solve?format=f32&res=64,64,16", NULL, a->body, strlen(a->body), 60000);
+    raw_reply r = ask(a->d, "POST", "/solve?format=f32&res=64,64,16", NULL, a->body, strlen(a->body), 240000);
     a->status = r.status;
     a->bytes = (long long)r.body_len;
     raw_reply_free(&r);
@@ -686,6 +688,91 @@ static void a_job_over_its_deadline_should_be_cancelled_with_a_503_problem(void 
     assert_int_equal(r.body_len, 8 * 12);
     raw_reply_free(&r);
     stop(&d);
+}
+
+/* Opens a connection, sends a heavy /solve on it (keep-alive) and returns the socket once the job runs. */
+static int heavy_job_running(const daemon_t *d, int seed)
+{
+    char *body = heavy_model(512, seed);
+    size_t blen = strlen(body);
+    char head[160];
+    int hn = snprintf(head, sizeof head, "POST /solve?format=glb&res=512 HTTP/1.1\r\nHost: localhost\r\n"
+                                         "Content-Length: %zu\r\n\r\n", blen);
+    int fd = raw_dial(d->port);
+    assert_true(fd >= 0);
+    raw_send_all(fd, head, (size_t)hn);
+    raw_send_all(fd, body, blen);
+    free(body);
+    for (int i = 0; i < 200 && metric_or_none(d, "pdesolid_queue_depth") < 1; i++)
+        usleep(50000);
+    usleep(300000);   /* well into its work, which takes some 23 s without sanitisers */
+    return fd;
+}
+
+/* A client that closes its connection while its job runs (nginx's 499, "client closed request"): the job
+ * stops at its next poll rather than at --job-timeout, its thread serves the next request, and it is counted
+ * and logged as 499 with the reason. Before, it ran on to the deadline and was logged 503 aborted. */
+static void a_client_gone_while_its_job_runs_should_stop_the_job_and_be_logged_499(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--threads 1 --job-timeout 60 --max-work 1e15 --max-mem-mb 4096");
+    int fd = heavy_job_running(&d, 41);
+    double t0 = mono_now();
+    close(fd);
+    static const char counted[] = "pdesolid_requests_total{route=\"solve\",status=\"499\"} 1\n";
+    int seen = 0;
+    while (!seen && mono_now() - t0 < 10) {
+        raw_reply m = get(&d, "/metrics");
+        seen = m.status == 200 && strstr(m.body, counted);
+        raw_reply_free(&m);
+        if (!seen)
+            usleep(50000);
+    }
+    double took = mono_now() - t0;
+    if (!seen)
+        fail_msg("the job of a client gone 10 s ago still runs (or was not counted 499); --job-timeout is 60 s");
+    /* The only solver thread is free: a new solve is answered at once (its post waits 8 s at most). */
+    raw_reply r = post(&d, "/solve?format=f32&res=2", "{\"preset\":\"fig4a\"}");
+    assert_int_equal(r.status, 200);
+    raw_reply_free(&r);
+    expect_livez(&d);
+    stop(&d);
+    char *log = read_file(d.log, NULL);
+    assert_non_null(log);
+    const char *line = strstr(log, "\"POST /solve?format=glb&res=512\" 499 ");
+    if (!line || !strstr(line, "aborted"))
+        fail_msg("no access-log line of the gone client's request as 499 aborted:\n%s", log);
+    if (!strstr(log, "closed its connection"))
+        fail_msg("the log does not say why the job stopped:\n%s", log);
+    if (strstr(log, "internal error"))   /* libmicrohttpd's words for the handler's refusal to answer */
+        fail_msg("the log calls a client gone an internal error:\n%s", log);
+    print_message("  the job stopped %.2f s after its client closed\n", took);
+    free(log);
+}
+
+/* Bytes that come while a job runs, a request pipelined on the same keep-alive connection, are no close: the job
+ * runs to its end (here its deadline, a 503) and both requests are answered, in order. */
+static void a_request_pipelined_while_a_job_runs_should_not_cancel_it(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--threads 1 --job-timeout 3 --max-work 1e15 --max-mem-mb 4096");
+    int fd = heavy_job_running(&d, 43);
+    static const char next[] = "GET /livez HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n";
+    raw_send_all(fd, next, sizeof next - 1);
+    static char buf[1 << 16];
+    long n = raw_read_to_close(fd, buf, sizeof buf, 8);
+    close(fd);
+    const char *first = strstr(buf, "HTTP/1.1 "), *second = first ? strstr(first + 9, "HTTP/1.1 ") : NULL;
+    if (n < 0 || !first || !second || strncmp(first, "HTTP/1.1 503", 12) || strncmp(second, "HTTP/1.1 200", 12))
+        fail_msg("expected the job's 503 (its deadline) and the pipelined request's 200, got (%ld bytes): %s", n,
+                 shown(buf, 0));
+    stop(&d);
+    char *log = read_file(d.log, NULL);
+    if (log && strstr(log, "closed its connection"))
+        fail_msg("a pipelined request was taken for a close:\n%s", log);
+    free(log);
 }
 
 /* Each budget alone: the other one is set out of the way. */
@@ -1130,13 +1217,19 @@ static double timing_sum(const char *st, const char *const *names, size_t n)
     return sum;
 }
 
+/* Every request's Server-Timing fits in its wall time; the best of N covers at least half of it. (A stall of the
+ * test or the loopback on a loaded machine may make one request's wall time many times its sum; a Server-Timing
+ * that leaves most of the server's time out does so in every request.) */
 static void server_timing_should_add_up_to_most_of_the_wall_time_of_a_new_solve(void **state)
 {
     (void)state;
     daemon_t d;
     start(&d, "");
     static const char *const names[] = { "queue", "parse", "solve", "props", "output" };
-    for (int k = 0; k < 3; k++) {
+    enum { N = 5 };
+    double best = 0;
+    char best_st[640] = "";
+    for (int k = 0; k < N; k++) {
         char body[128], st[512];
         snprintf(body, sizeof body, "{\"preset\":\"fig4a\",\"params\":{\"p0\":%d.%d}}", 20000 + rand() % 20000, k);
         raw_reply r = post(&d, "/solve", body);
@@ -1146,10 +1239,17 @@ static void server_timing_should_add_up_to_most_of_the_wall_time_of_a_new_solve(
         double sum = timing_sum(st, names, sizeof names / sizeof *names), wall = r.first_response * 1e3;
         if (sum < 0)
             fail_msg("Server-Timing \"%s\" lacks one of queue, parse, solve, props, output with dur=", st);
-        if (sum > wall || sum < 0.5 * wall)
-            fail_msg("Server-Timing sums to %.3f ms of a %.3f ms request: %s", sum, wall, st);
+        if (sum > wall)
+            fail_msg("Server-Timing sums to %.3f ms, more than the %.3f ms of the request: %s", sum, wall, st);
+        if (sum / wall > best) {
+            best = sum / wall;
+            snprintf(best_st, sizeof best_st, "%.3f ms of %.3f ms: %s", sum, wall, st);
+        }
         raw_reply_free(&r);
     }
+    if (best < 0.5)
+        fail_msg("Server-Timing sums to at most %.0f%% of a request's wall time in %d requests (best %s)", 100 * best,
+                 N, best_st);
     stop(&d);
 }
 
@@ -1418,6 +1518,8 @@ int main(void)
         T(a_chunked_body_growing_over_the_limit_should_get_a_readable_413),
         T(sigterm_should_answer_queued_jobs_503_cancel_the_running_one_and_exit_within_grace_plus_one),
         T(a_job_over_its_deadline_should_be_cancelled_with_a_503_problem),
+        T(a_client_gone_while_its_job_runs_should_stop_the_job_and_be_logged_499),
+        T(a_request_pipelined_while_a_job_runs_should_not_cancel_it),
         T(requests_over_the_work_or_memory_budget_should_be_422_naming_the_flag),
         T(every_flag_should_take_the_equals_form_and_unknown_arguments_should_exit_2_naming_them),
         T(eval_far_outside_the_cube_should_be_422_naming_the_point_and_never_write_nan),

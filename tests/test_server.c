@@ -26,6 +26,7 @@
 #include <cmocka.h>
 #include <curl/curl.h>
 
+#include "cache.h"
 #include "id.h"
 #include "loft.h"
 #include "output.h"
@@ -400,6 +401,99 @@ static void *same_request(void *arg)
     a->status = r.status;
     free(r.body);
     return NULL;
+}
+
+/* A solve that blocks until released, then reports itself cancelled (its request's deadline, or its client
+ * gone): what a request waiting on the same id must not take for its own answer. */
+typedef struct {
+    pthread_mutex_t m;
+    pthread_cond_t c;
+    int entered, released, calls;
+    srv_cache *cache;
+    srv_entry *e;
+    api_error err;
+    int hit;
+} cancel_gate;
+
+static int solve_then_cancelled(void *arg, pde_solution **out, api_error *err)
+{
+    (void)out;
+    cancel_gate *g = arg;
+    pthread_mutex_lock(&g->m);
+    g->entered = 1;
+    pthread_cond_broadcast(&g->c);
+    while (!g->released)
+        pthread_cond_wait(&g->c, &g->m);
+    pthread_mutex_unlock(&g->m);
+    return api_fail_cancelled(err);
+}
+
+static int solve_fig4a(void *arg, pde_solution **out, api_error *err)
+{
+    (void)err;
+    ((cancel_gate *)arg)->calls++;
+    *out = preset_solution("fig4a");
+    return 0;
+}
+
+static void *get_cancelled(void *arg)
+{
+    cancel_gate *g = arg;
+    g->e = srv_cache_get(g->cache, "0123456789abcdef0123456789abcdef", solve_then_cancelled, g, &g->hit, &g->err);
+    return NULL;
+}
+
+static void *solve_waiting(void *arg)
+{
+    cancel_gate *g = arg;
+    g->e = srv_cache_get(g->cache, "0123456789abcdef0123456789abcdef", solve_fig4a, g, &g->hit, &g->err);
+    return NULL;
+}
+
+/* A request that waits for another's solve of the same id, which is then cancelled for that request alone,
+ * solves for itself: before, it got the cancellation, and answered 503 "ran past its deadline" with no time
+ * spent, so that one client closing its connection could fail the others' identical requests. */
+static void a_request_waiting_on_a_cancelled_solve_should_solve_for_itself(void **state)
+{
+    (void)state;
+    cancel_gate a = { .m = PTHREAD_MUTEX_INITIALIZER, .c = PTHREAD_COND_INITIALIZER };
+    cancel_gate b = { 0 };
+    a.cache = srv_cache_create(64u << 20);
+    assert_non_null(a.cache);
+    pthread_t t;
+    assert_int_equal(pthread_create(&t, NULL, get_cancelled, &a), 0);
+    pthread_mutex_lock(&a.m);
+    while (!a.entered)
+        pthread_cond_wait(&a.c, &a.m);
+    pthread_mutex_unlock(&a.m);
+    /* b finds a's entry being solved and waits on it; its hit is counted, under the lock, as it starts to wait. */
+    b.cache = a.cache;
+    pthread_t tb;
+    assert_int_equal(pthread_create(&tb, NULL, solve_waiting, &b), 0);
+    srv_cache_stats cs = { 0 };
+    for (int i = 0; i < 5000 && cs.hits < 1; i++) {
+        srv_cache_stats_get(a.cache, &cs);
+        if (cs.hits < 1)
+            usleep(1000);
+    }
+    assert_int_equal(cs.hits, 1);
+    pthread_mutex_lock(&a.m);
+    a.released = 1;
+    pthread_cond_broadcast(&a.c);
+    pthread_mutex_unlock(&a.m);
+    pthread_join(t, NULL);
+    pthread_join(tb, NULL);
+    assert_null(a.e);
+    assert_int_equal(a.err.status, API_ERR_CANCELLED);
+    if (!b.e)
+        fail_msg("the waiting request failed with a's cancellation: %s", b.err.message);
+    assert_int_equal(b.calls, 1);
+    assert_int_equal(b.hit, 0);
+    srv_cache_stats_get(a.cache, &cs);
+    assert_int_equal(cs.hits, 0);
+    assert_int_equal(cs.misses, 2);
+    srv_cache_release(a.cache, b.e);
+    srv_cache_destroy(a.cache);
 }
 
 static void concurrent_identical_requests_should_solve_once(void **state)
@@ -1365,6 +1459,7 @@ int main(void)
         cmocka_unit_test(eval_should_agree_with_the_cli),
         cmocka_unit_test(cache_hits_misses_and_evictions_should_show_in_metrics),
         cmocka_unit_test(concurrent_identical_requests_should_solve_once),
+        cmocka_unit_test(a_request_waiting_on_a_cancelled_solve_should_solve_for_itself),
         cmocka_unit_test(etag_with_if_none_match_should_give_304),
         cmocka_unit_test(sixty_four_concurrent_clients_should_all_get_correct_answers),
         cmocka_unit_test(a_full_queue_should_give_503_with_retry_after),
