@@ -58,6 +58,7 @@
 #include <limits.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -1133,6 +1134,14 @@ static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
 #define FREE_SPAN_DEPTH 12    /* halvings of a w-panel where its halves disagree, at most */
 #define FREE_KNOWN 32         /* roots and dips remembered per w-panel */
 
+#define FREE_MEMO 512         /* points of w remembered (a power of 2): ends, halves' ends, pieces */
+
+/* A moment of free_point's sums that is not 0: acc[slot] += mom h[o] (h[p]). */
+typedef struct {
+    unsigned o, p, slot;
+    double mom;
+} free_term;
+
 typedef struct {
     qctx *q;
     int flat, free;              /* the face's fixed axis t, and s */
@@ -1141,16 +1150,39 @@ typedef struct {
     double *mom1, *mom2;         /* mt, mt x mt */
     double *da, *ds, *dw;        /* det J's partials' coefficients at s0: F'_t F_s, F_t F'_s, F_t F_s */
     double *h, *dh;              /* mt: the current point's h, h' */
+    /* The moments that are not 0, in free_point's order of (o, p): fig. 2 and 4's products of sin
+     * and cos 2 pi v (half of them 0) add nothing, and skipping them leaves every sum as it was. */
+    free_term *terms;
+    size_t nterms;
+    /* Points of w evaluated, by the bits of w (direct-mapped): G and, where had_m, the integrals m.
+     * Panels share their ends with their halves and neighbours, and a piece between a root and an
+     * end is the same piece in the panel and in its half (fig. 4a: 356 points a call, 300 distinct). */
+    double *memo_w, *memo_j, (*memo_m)[Q_N];
+    unsigned char *memo_had_m;
     /* The current w-panel's roots of G, and its dip searches' leasts (where G's sign at them), found
      * by its coarse rule: its halves' brackets that hold one take it rather than search again. */
     double root[FREE_KNOWN], dip_at[FREE_KNOWN], dip_f[FREE_KNOWN];
     int nroot, ndip;
 } free_ctx;
 
+static unsigned free_slot(double w)
+{
+    uint64_t k;
+    memcpy(&k, &w, sizeof k);
+    k *= 0x9e3779b97f4a7c15u;
+    return (unsigned)(k >> 55) & (FREE_MEMO - 1);
+}
+
 /* det J at w on the face (at s0), and into m[Q_N] the integrals over s of 1, x_c, x_c x_d at w. */
 static double free_point(free_ctx *f, double w, double m[Q_N])
 {
     qctx *q = f->q;
+    const unsigned at = free_slot(w);
+    if (f->memo_w[at] == w && (!m || f->memo_had_m[at])) {
+        if (m)
+            memcpy(m, f->memo_m[at], sizeof f->memo_m[at]);
+        return f->memo_j[at];
+    }
     solution_factors(q->s, 2, w, f->h, f->dh);
     q->r.evals++;
     double d[3][3] = { { 0 } };
@@ -1159,26 +1191,17 @@ static double free_point(free_ctx *f, double w, double m[Q_N])
         d[f->flat][c] += f->da[o] * f->h[o], d[f->free][c] += f->ds[o] * f->h[o], d[2][c] += f->dw[o] * f->dh[o];
     }
     const double j = det3(d[0], d[1], d[2]);
+    f->memo_w[at] = w, f->memo_j[at] = j, f->memo_had_m[at] = m != NULL;
     if (!m)
         return j;
     for (int e = 0; e < Q_N; e++)
         m[e] = 0.0;
     m[Q_VOL] = 1.0;
-    for (size_t o = 0; o < f->mt; o++) {
-        const int c = f->comp[o];
-        const double ho = f->h[o], *row = f->mom2 + o * f->mt;
-        m[Q_M1 + c] += f->mom1[o] * ho;
-        for (size_t p = 0; p < f->mt; p++) {   /* each pair (c <= d) once: o's component first */
-            const int cd = f->comp[p];
-            if (cd < c)
-                continue;
-            const double v = row[p] * ho * f->h[p];
-            if (cd == c)
-                m[Q_M2 + c] += v;
-            else
-                m[Q_M2 + (c == 0 ? (cd == 1 ? 3 : 4) : 5)] += v;
-        }
+    for (size_t i = 0; i < f->nterms; i++) {
+        const free_term *t = &f->terms[i];
+        m[t->slot] += t->slot < Q_M2 ? t->mom * f->h[t->o] : t->mom * f->h[t->o] * f->h[t->p];
     }
+    memcpy(f->memo_m[at], m, sizeof f->memo_m[at]);
     return j;
 }
 
@@ -1338,17 +1361,24 @@ static int free_solid(qctx *q, const qplan *p, int flat, int sa)
     const size_t mt = q->mt;
     if (mt == 0 || mt > FREE_MODES)
         return 0;
-    double *buf = malloc((2 * mt * mt + 11 * mt) * sizeof *buf);
+    double *buf = malloc((2 * mt * mt + 11 * mt + (2 + Q_N) * FREE_MEMO) * sizeof *buf);
     int *comp = malloc(mt * sizeof *comp);
-    if (!buf || !comp) {
+    free_term *terms = malloc((mt * mt + mt) * sizeof *terms);
+    unsigned char *had = malloc(FREE_MEMO);
+    if (!buf || !comp || !terms || !had) {
         free(buf);
         free(comp);
+        free(terms);
+        free(had);
         return 0;
     }
-    free_ctx f = { .q = q, .flat = flat, .free = sa, .mt = mt, .comp = comp };
+    free_ctx f = { .q = q, .flat = flat, .free = sa, .mt = mt, .comp = comp, .terms = terms, .memo_had_m = had };
     f.mom2 = buf, f.mom1 = buf + mt * mt, f.da = f.mom1 + mt, f.ds = f.da + mt, f.dw = f.ds + mt;
     f.h = f.dw + mt, f.dh = f.h + mt;
     double *ft = f.dh + mt, *dft = ft + mt, *fs = dft + mt, *dfs = fs + mt, *abs2 = dfs + mt, *abs1 = abs2 + mt * mt;
+    f.memo_w = abs1 + mt, f.memo_j = f.memo_w + FREE_MEMO, f.memo_m = (double(*)[Q_N])(f.memo_j + FREE_MEMO);
+    for (size_t i = 0; i < FREE_MEMO; i++)
+        f.memo_w[i] = NAN;
     for (int c = 0; c < 3; c++)
         for (size_t m = 0; m < q->s->comp[c].nmodes; m++)
             comp[q->off[c] + m] = c;
@@ -1381,6 +1411,19 @@ static int free_solid(qctx *q, const qplan *p, int flat, int sa)
     for (size_t o = 0; o < mt * mt + mt; o++)
         if (fabs(buf[o]) <= 1e-14 * abs2[o])
             buf[o] = 0.0;
+    /* free_point's sums, each pair (c <= d) once (o's component first), in the order of (o, p) */
+    for (size_t o = 0; o < mt; o++) {
+        const int c = comp[o];
+        if (f.mom1[o] != 0.0)
+            terms[f.nterms++] = (free_term){ (unsigned)o, 0, (unsigned)(Q_M1 + c), f.mom1[o] };
+        for (size_t r = 0; r < mt; r++) {
+            const int cd = comp[r];
+            if (cd >= c && f.mom2[o * mt + r] != 0.0)
+                terms[f.nterms++] = (free_term){ (unsigned)o, (unsigned)r,
+                                                 (unsigned)(Q_M2 + (cd == c ? c : c == 0 ? (cd == 1 ? 3 : 4) : 5)),
+                                                 f.mom2[o * mt + r] };
+        }
+    }
     for (int l = 0; l < p->np[2] && !poll(q); l++) {
         const double lo = p->edge[2][l], hi = p->edge[2][l + 1];
         double coarse[Q_N], acc[Q_N];
@@ -1399,6 +1442,8 @@ static int free_solid(qctx *q, const qplan *p, int flat, int sa)
     }
     free(buf);
     free(comp);
+    free(terms);
+    free(had);
     return 1;
 }
 
