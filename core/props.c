@@ -158,6 +158,8 @@ static inline double min2(double a, double b)
  * So scale = max(data, min(drive, own)), data and drive as sums of the absolute values of their
  * terms at each point; own alone for a component with neither.
  */
+#define BC_ROWS 32   /* rows of w = 0 and 1 at a time: one h(w) per side and block, in bounded memory */
+
 static pde_status bc_residual(const pde_solution *s, int res, const double own_size[3], poller *pl,
                               double *out)
 {
@@ -167,11 +169,13 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
     }
     const size_t n = (size_t)res;
     const size_t nb = s->comp[0].nbterms + s->comp[1].nbterms + s->comp[2].nbterms;
-    double *uni = malloc((n + 2 * nb * n + 12 * n) * sizeof *uni);
+    const size_t nj = n < BC_ROWS ? n : BC_ROWS;
+    double *uni = malloc((n + 2 * nb * n + 12 * n * nj) * sizeof *uni);
     if (!uni)
         return PDE_ERR_NOMEM;
-    /* The boundary terms' factors at the samples, all components' terms in a row; x, x_w of both sides. */
-    double *fu = uni + n, *fv = fu + nb * n, *row = fv + nb * n;
+    /* The boundary terms' factors at the samples, all components' terms in a row; x, x_w of both sides
+     * in rows j of a block of BC_ROWS (12 n each), each side's h(w) once a block. */
+    double *fu = uni + n, *fv = fu + nb * n, *rows = fv + nb * n;
     for (size_t i = 0; i < n; i++)
         uni[i] = (double)i / (double)(n - 1);
     for (size_t c = 0, t0 = 0; c < 3; t0 += s->comp[c++].nbterms)
@@ -188,15 +192,19 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
     }
     double err[3] = { 0, 0, 0 }, scale[3] = { 0, 0, 0 };
     for (size_t j = 0; j < n && st == PDE_OK; j++) {
-        for (int side = 0; side < 2; side++) {
+        for (int side = 0; side < 2 && j % BC_ROWS == 0; side++) {
             grid_set_w(g, side);
-            grid_row(g, j, GRID_X | GRID_XW);
-            for (int c = 0; c < 3; c++)
-                for (size_t i = 0; i < n; i++) {
-                    row[(6 * side + c) * n + i] = g->row[c * n + i];
-                    row[(6 * side + 3 + c) * n + i] = g->row[(9 + c) * n + i];
-                }
+            for (size_t jb = j; jb < j + nj && jb < n; jb++) {
+                double *row = rows + 12 * n * (jb - j);
+                grid_row(g, jb, GRID_X | GRID_XW);
+                for (int c = 0; c < 3; c++)
+                    for (size_t i = 0; i < n; i++) {
+                        row[(6 * side + c) * n + i] = g->row[c * n + i];
+                        row[(6 * side + 3 + c) * n + i] = g->row[(9 + c) * n + i];
+                    }
+            }
         }
+        const double *row = rows + 12 * n * (j % BC_ROWS);
         for (size_t c = 0, t0 = 0; c < 3; t0 += s->comp[c++].nbterms) {
             const comp_solution *cs = &s->comp[c];
             if (poll_after(pl, (2 * cs->nmodes + cs->nbterms) * (n + 2) / 4 + 1)) {
