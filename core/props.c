@@ -671,18 +671,28 @@ static pde_status line_minimise(const pde_solution *s, const line_fn *f, double 
  * by |alpha'''(c)| + r M4 (r = max |w - c|): no bound of each mode over each interval, and near c as
  * tight as the sum's own value (a mode's bound loses the cancellation between its terms).
  */
-static void harmonic_models(const harmonic *hc, double w0, double w1, double c, tm1 m[2])
+static void harmonic_models_of(const harmonic *hc, double w0, double w1, double c, const int *twin,
+                               const double (*known)[4], double (*jet)[4], tm1 m[2])
 {
     const double r = fmax(c - w0, w1 - c);
     double j[2][4] = { { 0, 0, 0, 0 }, { 0, 0, 0, 0 } };
     for (size_t k = 0; k < hc->nmodes; k++) {
-        double d[4];
+        double e[4];
+        const double *d = e;
         const int i = harmonic_is_cos(hc, k);
-        mode_h_derivs(&hc->modes[k], c, 3, d);
+        if (twin && twin[k] >= 0)
+            d = known[twin[k]];
+        else
+            mode_h_derivs(&hc->modes[k], c, 3, jet ? (double *)(d = jet[k]) : e);
         j[i][0] += d[0], j[i][1] += d[1], j[i][2] += d[2], j[i][3] += d[3];
     }
     for (int i = 0; i < 2; i++)
         m[i] = tm_jet(j[i], fabs(j[i][3]) + r * hc->M4[i]);
+}
+
+static void harmonic_models(const harmonic *hc, double w0, double w1, double c, tm1 m[2])
+{
+    harmonic_models_of(hc, w0, w1, c, NULL, NULL, NULL, m);
 }
 
 /* alpha and beta at w. */
@@ -830,11 +840,36 @@ static pde_status w_only_extremes(const pde_solution *s, int c, const double *st
  * (S^2 + C^2 = 1), so det J = t^(2n - 1) g(w), g = sigma n k pi Z'(w) (beta gamma - alpha delta),
  * sigma the sign the rows' and columns' order gives: g's extremes are a problem in w alone.
  */
+#define DL_MODES 8   /* modes of each harmonic at most whose h a twin of the other's shares */
+
 typedef struct {
     harmonic h[2];
     const comp_solution *zc;   /* z */
     double scale;         /* sigma n k pi */
+    /* the mode of h[0] with the same h(w) as h[1]'s mode k (fig. 4: x = h1 sin + h2 cos, y = h2 sin
+     * + h1 cos), or -1: its jet once; twins[1] NULL where a harmonic has more than DL_MODES */
+    int twin[DL_MODES];
+    const int *twins[2];
 } detj_line;
+
+/* a and b have the same h(w): the same slabs and terms */
+static int same_h(const pde_mode *a, const pde_mode *b)
+{
+    if (a->nterms != b->nterms || a->nslabs != b->nslabs)
+        return 0;
+    for (size_t k = 0; a->nslabs > 1 && k <= a->nslabs; k++)
+        if (a->breaks[k] != b->breaks[k] || a->first[k] != b->first[k])
+            return 0;
+    for (size_t k = 0; k < a->nterms; k++) {
+        const pde_wterm *x = &a->terms[k], *y = &b->terms[k];
+        if (x->alpha != y->alpha || x->beta != y->beta || x->shift != y->shift || x->deg != y->deg)
+            return 0;
+        for (int i = 0; i <= x->deg; i++)
+            if (x->A[i] != y->A[i] || x->B[i] != y->B[i])
+                return 0;
+    }
+    return 1;
+}
 
 static int detj_line_of(const pde_solution *s, detj_line *d)
 {
@@ -851,6 +886,16 @@ static int detj_line_of(const pde_solution *s, detj_line *d)
         M[c0][a->a] = 1.0, M[c1][a->b] = 1.0, M[z][2] = 1.0;
         d->zc = zc;
         d->scale = det3(M[0], M[1], M[2]) * a->n * a->k * M_PI;
+        d->twins[0] = d->twins[1] = NULL;
+        if (a->nmodes <= DL_MODES && b->nmodes <= DL_MODES) {
+            for (size_t k = 0; k < b->nmodes; k++) {
+                d->twin[k] = -1;
+                for (size_t i = 0; i < a->nmodes && d->twin[k] < 0; i++)
+                    if (same_h(&a->modes[i], &b->modes[k]))
+                        d->twin[k] = (int)i;
+            }
+            d->twins[1] = d->twin;
+        }
         return 1;
     }
     return 0;
@@ -861,8 +906,9 @@ static void detj_line_model(const void *ctx, double w0, double w1, double c, tm1
     const detj_line *d = ctx;
     const double r = fmax(c - w0, w1 - c);
     tm1 ab[2], gd[2];
-    harmonic_models(&d->h[0], w0, w1, c, ab);
-    harmonic_models(&d->h[1], w0, w1, c, gd);
+    double jet[DL_MODES][4];   /* each mode of h[0]: h and its derivatives at c */
+    harmonic_models_of(&d->h[0], w0, w1, c, NULL, NULL, d->twins[1] ? jet : NULL, ab);
+    harmonic_models_of(&d->h[1], w0, w1, c, d->twins[1], (const double(*)[4])jet, NULL, gd);
     const tm1 zp = w_only_model(d->zc, 1, w0, w1, c), bg = tm_mul(&ab[1], &gd[0], r), ad = tm_mul(&ab[0], &gd[1], r);
     const tm1 q = tm_add(bg, &ad, -1.0);
     *m = tm_mul(&zp, &q, r);
