@@ -147,7 +147,7 @@ typedef struct {
     double f[3];                 /* the integrand's frequencies (at least 1) */
     int poly[3];                 /* the solution's degree along each axis where it is a polynomial, else -1 */
     double vscale;               /* the solid's volume, roughly: for refinement's tolerance */
-    double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];   /* n-point rules on [0, 1] */
+    const double (*gx)[GMAX], (*gw)[GMAX];   /* n-point rules on [0, 1] (rules_x, rules_w) */
     int n[3];                    /* the current panel's points per axis (0: the flat axis) */
     int flat;                    /* the axis fixed at 1 (quad_separate), or -1 */
     int along;                   /* a polynomial axis every line runs along, never split (quad_solid), or -1 */
@@ -1655,8 +1655,8 @@ static qctx *qctx_new(const pde_solution *s, const pde_cancel *cancel)
     q->modes = q->mt + 1;
     poly_degrees(s, q->poly);
     pthread_once(&rules_once, rules_init);
-    memcpy(q->gx, rules_x, sizeof q->gx);
-    memcpy(q->gw, rules_w, sizeof q->gw);
+    q->gx = (const double(*)[GMAX])rules_x;
+    q->gw = (const double(*)[GMAX])rules_w;
     return q;
 }
 
