@@ -852,25 +852,6 @@ typedef struct {
     const int *twins[2];
 } detj_line;
 
-/* a and b have the same h(w): the same slabs and terms */
-static int same_h(const pde_mode *a, const pde_mode *b)
-{
-    if (a->nterms != b->nterms || a->nslabs != b->nslabs)
-        return 0;
-    for (size_t k = 0; a->nslabs > 1 && k <= a->nslabs; k++)
-        if (a->breaks[k] != b->breaks[k] || a->first[k] != b->first[k])
-            return 0;
-    for (size_t k = 0; k < a->nterms; k++) {
-        const pde_wterm *x = &a->terms[k], *y = &b->terms[k];
-        if (x->alpha != y->alpha || x->beta != y->beta || x->shift != y->shift || x->deg != y->deg)
-            return 0;
-        for (int i = 0; i <= x->deg; i++)
-            if (x->A[i] != y->A[i] || x->B[i] != y->B[i])
-                return 0;
-    }
-    return 1;
-}
-
 static int detj_line_of(const pde_solution *s, detj_line *d)
 {
     for (int z = 0; z < 3; z++) {
@@ -891,7 +872,7 @@ static int detj_line_of(const pde_solution *s, detj_line *d)
             for (size_t k = 0; k < b->nmodes; k++) {
                 d->twin[k] = -1;
                 for (size_t i = 0; i < a->nmodes && d->twin[k] < 0; i++)
-                    if (same_h(&a->modes[i], &b->modes[k]))
+                    if (quad_same_h(&a->modes[i], &b->modes[k]))
                         d->twin[k] = (int)i;
             }
             d->twins[1] = d->twin;
