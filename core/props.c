@@ -752,16 +752,51 @@ static void harmonic_place(const harmonic *hc, double w, const double ab[2], int
  * The extremes of such a component (bound, best, at: as single_mode_extremes'); PDE_ERR_INVALID where
  * it is not one (or its bound is no number). start: a w to begin from.
  */
-pde_status props_harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
-                                   const pde_cancel *cancel, double bound[2], double best[2], double at[2][3])
+/* The modes of a whose factor is (not) cos (ia) are b's of ib, one by one with the same h(w). */
+static int same_modes(const harmonic *a, int ia, const harmonic *b, int ib)
+{
+    size_t i = 0, k = 0;
+    for (;; i++, k++) {
+        while (i < a->nmodes && harmonic_is_cos(a, i) != ia)
+            i++;
+        while (k < b->nmodes && harmonic_is_cos(b, k) != ib)
+            k++;
+        if (i == a->nmodes || k == b->nmodes)
+            return i == a->nmodes && k == b->nmodes;
+        if (!quad_same_h(&a->modes[i], &b->modes[k]))
+            return 0;
+    }
+}
+
+/* A harmonic's largest R(w) found, for another component with the same R^2 = alpha^2 + beta^2 term by
+ * term (fig. 4's y = h2 sin + h1 cos beside x = h1 sin + h2 cos: alpha and beta swapped): its search
+ * would be the same, point by point, from the same start. */
+typedef struct {
+    int done;
+    harmonic hc;
+    double start, tol, up, w;
+    size_t budget;
+} harmonic_memo;
+
+static pde_status harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
+                                    const pde_cancel *cancel, harmonic_memo *memo, double bound[2], double best[2],
+                                    double at[2][3])
 {
     harmonic hc;
     if (!harmonic_of(s, c, &hc))
         return PDE_ERR_INVALID;
     double up, w, ab[2];
-    pde_status st = harmonic_max(s, &hc, start, tol, budget, cancel, &up, &w);
-    if (st != PDE_OK)
-        return st;
+    const harmonic *p = memo && memo->done ? &memo->hc : NULL;
+    if (p && memo->start == start && memo->tol == tol && memo->budget == budget &&
+        ((same_modes(p, 0, &hc, 0) && same_modes(p, 1, &hc, 1)) || (same_modes(p, 0, &hc, 1) && same_modes(p, 1, &hc, 0))))
+        up = memo->up, w = memo->w;
+    else {
+        pde_status st = harmonic_max(s, &hc, start, tol, budget, cancel, &up, &w);
+        if (st != PDE_OK)
+            return st;
+        if (memo)
+            *memo = (harmonic_memo){ 1, hc, start, tol, up, w, budget };
+    }
     harmonic_ab(&hc, w, ab);
     for (int e = 0; e < 2; e++) {
         double x[3];
@@ -771,6 +806,12 @@ pde_status props_harmonic_extremes(const pde_solution *s, int c, double start, d
     }
     bound[0] = fmin(-up, best[0]), bound[1] = fmax(up, best[1]);
     return PDE_OK;
+}
+
+pde_status props_harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
+                                   const pde_cancel *cancel, double bound[2], double best[2], double at[2][3])
+{
+    return harmonic_extremes(s, c, start, tol, budget, cancel, NULL, bound, best, at);
 }
 
 /* Non-zero when every mode of the component has the factors 1 along u and v: x_c = Z(w) (fig. 2's and 4's z). */
@@ -1369,6 +1410,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     int ra;
     double rn;
     bb_result sb[3][2];
+    harmonic_memo hmemo = { 0 };
     for (int o = 0; o < 8; o++) {
         const int what = o < 6 ? o / 2 : 3;
         const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
@@ -1385,8 +1427,8 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             const double *starts[2] = { lo, hi };
             st = s->comp[what].nmodes && w_only(&s->comp[what])
                      ? w_only_extremes(s, what, starts, tol, cancel, bd, bs, ba)
-                     : props_harmonic_extremes(s, what, fabs(best[o]) > fabs(best[o + 1]) ? lo[2] : hi[2], tol,
-                                               PDE_PROPS_BOXES, cancel, bd, bs, ba);
+                     : harmonic_extremes(s, what, fabs(best[o]) > fabs(best[o + 1]) ? lo[2] : hi[2], tol,
+                                         PDE_PROPS_BOXES, cancel, &hmemo, bd, bs, ba);
             if (st == PDE_ERR_INVALID && s->comp[what].nmodes == 1)
                 st = single_mode_extremes(s, what, tol, cancel, bd, bs, ba);
             if (st == PDE_OK) {
