@@ -260,11 +260,49 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
  * measured against their size. The derivatives of each factor and each h are tabulated once per
  * sample line: a point then costs three multiply-adds per mode.
  */
+#define RESIDUAL_TWINS 64   /* modes at most among which pde_residual looks for the same h(w) */
+
 static pde_status pde_residual(const pde_solution *s, int res, poller *pl, double *out)
 {
-    const size_t n = (size_t)res;
+    const size_t n = (size_t)res, mt = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes;
     double worst = 0.0;
-    for (int c = 0; c < 3; c++) {
+    /* h and h'''' of every mode at the samples, x's modes then y's and z's: a mode with the same h(w) as
+     * an earlier one (fig. 4: each of x's again in y) copies its rows */
+    double *hall = malloc((2 * mt * n + 1) * sizeof *hall);
+    if (!hall)
+        return PDE_ERR_NOMEM;
+    for (size_t o = 0, c = 0, m = 0; o < mt; o++, m++) {
+        while (m >= s->comp[c].nmodes)
+            c++, m = 0;
+        const pde_mode *md = &s->comp[c].modes[m];
+        if (poll_after(pl, n * (4 + md->nterms * 8))) {
+            free(hall);
+            return PDE_ERR_CANCELLED;
+        }
+        size_t tw = o;
+        for (size_t p = 0, pc = 0, pm = 0; p < o && mt <= RESIDUAL_TWINS && tw == o; p++, pm++) {
+            while (pm >= s->comp[pc].nmodes)
+                pc++, pm = 0;
+            if (quad_same_h(&s->comp[pc].modes[pm], md))
+                tw = p;
+        }
+        for (size_t i = 0; i < n; i++) {
+            double h0 = 0.0, hw = 0.0;
+            if (tw < o)
+                h0 = hall[tw * n + i], hw = hall[(mt + tw) * n + i];
+            else {
+                const double t = (i + 0.5) / res;
+                size_t k0, k1;
+                mode_slab(md, t, &k0, &k1);   /* a loft's slab of t */
+                for (size_t k = k0; k < k1; k++) {
+                    h0 += wterm_deriv(&md->terms[k], t, 0);
+                    hw += wterm_deriv(&md->terms[k], t, 4);
+                }
+            }
+            hall[o * n + i] = h0, hall[(mt + o) * n + i] = hw;
+        }
+    }
+    for (int c = 0, off = 0; c < 3; off += (int)s->comp[c].nmodes, c++) {
         const comp_solution *cs = &s->comp[c];
         const size_t nm = cs->nmodes;
         if (nm == 0 && cs->nfterms == 0)
@@ -274,11 +312,13 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
          * terms likewise: each factor at the samples, and per term coef f_u f_v on the current (u, v)
          * (pde_force's values, in its order, without its three factor evaluations a point). */
         const size_t nf = cs->nfterms;
-        double *tab = malloc((6 * nm * n + 3 * nm + 3 * nf * n + nf + 1) * sizeof *tab);
-        if (!tab)
+        double *tab = malloc((4 * nm * n + 3 * nm + 3 * nf * n + nf + 1) * sizeof *tab);
+        if (!tab) {
+            free(hall);
             return PDE_ERR_NOMEM;
-        double *fu = tab, *fu4 = fu + nm * n, *fv = fu4 + nm * n, *fv4 = fv + nm * n;
-        double *h = fv4 + nm * n, *h4 = h + nm * n, *uv = h4 + nm * n;
+        }
+        double *fu = tab, *fu4 = fu + nm * n, *fv = fu4 + nm * n, *fv4 = fv + nm * n, *uv = fv4 + nm * n;
+        const double *h = hall + off * n, *h4 = hall + (mt + off) * n;
         double *pu = uv + 3 * nm, *pv = pu + nf * n, *pw = pv + nf * n, *puv = pw + nf * n;
         for (size_t t = 0; t < nf; t++)
             for (size_t i = 0; i < n; i++) {
@@ -289,25 +329,12 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
             }
         for (size_t m = 0; m < nm; m++) {
             const pde_mode *md = &cs->modes[m];
-            if (poll_after(pl, n * (4 + md->nterms * 8))) {
-                free(tab);
-                return PDE_ERR_CANCELLED;
-            }
             for (size_t i = 0; i < n; i++) {
                 double t = (i + 0.5) / res;
                 fu[m * n + i] = factor_deriv(md->u, t, 0);
                 fu4[m * n + i] = factor_deriv(md->u, t, 4);
                 fv[m * n + i] = factor_deriv(md->v, t, 0);
                 fv4[m * n + i] = factor_deriv(md->v, t, 4);
-                double h0 = 0.0, hw = 0.0;
-                size_t k0, k1;
-                mode_slab(md, t, &k0, &k1);   /* a loft's slab of t */
-                for (size_t k = k0; k < k1; k++) {
-                    h0 += wterm_deriv(&md->terms[k], t, 0);
-                    hw += wterm_deriv(&md->terms[k], t, 4);
-                }
-                h[m * n + i] = h0;
-                h4[m * n + i] = hw;
             }
         }
         double err = 0.0, scale = 0.0;
@@ -315,6 +342,7 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
             for (size_t j = 0; j < n; j++) {
                 if (poll_after(pl, n * (nm + cs->nfterms))) {
                     free(tab);
+                    free(hall);
                     return PDE_ERR_CANCELLED;
                 }
                 for (size_t m = 0; m < nm; m++) {
@@ -341,6 +369,7 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
         free(tab);
         worst = fmax(worst, scale > 0.0 ? err / scale : err);
     }
+    free(hall);
     *out = worst;
     return PDE_OK;
 }
