@@ -1440,6 +1440,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     double rn;
     bb_result sb[3][2];
     harmonic_memo hmemo = { 0 };
+    double magnitude = 0.0;
     for (int o = 0; o < 8; o++) {
         const int what = o < 6 ? o / 2 : 3;
         const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
@@ -1482,7 +1483,9 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         if (o >= 6)
             jlow[o - 6] = b.lower, jat[o - 6][0] = b.at[0], jat[o - 6][1] = b.at[1], jat[o - 6][2] = b.at[2];
         /* The bound holds for the exact closed form; evaluated values may differ by their rounding. */
-        const double pad = 64.0 * DBL_EPSILON * obj_magnitude(s, what);
+        if (!(o & 1))   /* each objective's magnitude once: its two extremes share it */
+            magnitude = obj_magnitude(s, what);
+        const double pad = 64.0 * DBL_EPSILON * magnitude;
         const double bound = sign * (b.lower - pad), gap = b.best - b.lower + pad;
         best[o] = sign * b.best + 0.0;   /* + 0: no -0 */
         if (o < 6) {
