@@ -21,6 +21,7 @@
  */
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -911,6 +912,15 @@ static pde_status w_only_extremes(const pde_solution *s, int c, const double *st
  * sigma the sign the rows' and columns' order gives: g's extremes are a problem in w alone.
  */
 #define DL_MODES 8   /* modes of each harmonic at most whose h a twin of the other's shares */
+#define DL_MEMO 128  /* g's models remembered across pde_properties' searches of det J */
+
+/* g's models by their interval and point (w0, w1, c): det J's searches for its least value, its
+ * largest and its sign (fig. 2a: 9, 23 and 29 models) share their intervals from [0, 1] down, and
+ * each takes the other's model where its own best point puts c at the same place. Direct-mapped. */
+typedef struct {
+    double key[DL_MEMO][3];
+    tm1 model[DL_MEMO];
+} detj_memo;
 
 typedef struct {
     harmonic h[2];
@@ -920,6 +930,7 @@ typedef struct {
      * + h1 cos), or -1: its jet once; twins[1] NULL where a harmonic has more than DL_MODES */
     int twin[DL_MODES];
     const int *twins[2];
+    detj_memo *memo;      /* NULL: none */
 } detj_line;
 
 static int detj_line_of(const pde_solution *s, detj_line *d)
@@ -955,6 +966,17 @@ static int detj_line_of(const pde_solution *s, detj_line *d)
 static void detj_line_model(const void *ctx, double w0, double w1, double c, tm1 *m)
 {
     const detj_line *d = ctx;
+    unsigned slot = 0;
+    if (d->memo) {
+        uint64_t b[3];
+        memcpy(&b[0], &w0, sizeof b[0]), memcpy(&b[1], &w1, sizeof b[1]), memcpy(&b[2], &c, sizeof b[2]);
+        slot = (unsigned)(((b[0] * 3 + b[1] * 5 + b[2]) * 0x9e3779b97f4a7c15u) >> 56) % DL_MEMO;
+        const double *k = d->memo->key[slot];
+        if (k[0] == w0 && k[1] == w1 && k[2] == c) {
+            *m = d->memo->model[slot];
+            return;
+        }
+    }
     const double r = fmax(c - w0, w1 - c);
     tm1 ab[2], gd[2];
     double jet[DL_MODES][4];   /* each mode of h[0]: h and its derivatives at c */
@@ -966,6 +988,10 @@ static void detj_line_model(const void *ctx, double w0, double w1, double c, tm1
     for (int k = 0; k < 3; k++)
         m->p[k] *= d->scale;
     m->k *= fabs(d->scale);
+    if (d->memo) {
+        d->memo->key[slot][0] = w0, d->memo->key[slot][1] = w1, d->memo->key[slot][2] = c;
+        d->memo->model[slot] = *m;
+    }
 }
 
 static double detj_line_value(const void *ctx, double w)
@@ -992,7 +1018,7 @@ static double detj_line_value(const void *ctx, double w)
  */
 static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, int what, double sign,
                                     const double start[3], double tol, size_t budget, const pde_cancel *cancel,
-                                    bb_result *out)
+                                    detj_memo *memo, bb_result *out)
 {
     pbox face = { { 0, 0, 0 }, { 1, 1, 1 } };
     face.lo[sp->axis] = 1.0;
@@ -1014,6 +1040,7 @@ static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, i
     pde_status st = PDE_ERR_INVALID;
     detj_line dl;
     if (what == 3 && sp->free >= 0 && detj_line_of(s, &dl) && dl.h[0].a == sp->axis) {
+        dl.memo = memo;
         const line_fn f = { detj_line_model, detj_line_value, &dl };   /* g(w) alone */
         st = line_minimise(s, &f, sign, at[2], tol, budget, cancel, &b.lower, &b.best, &b.at[2]);
     }
@@ -1245,10 +1272,10 @@ size_t pde_properties_detj_boxes(const pde_solution *s)
 
 /* The extreme of sign * det J by branch and bound, over the face where det J separates. */
 static pde_status what_detj(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
-                            double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
+                            double tol, size_t budget, const pde_cancel *cancel, detj_memo *memo, bb_result *out)
 {
     if (sp->axis >= 0)
-        return separable_extreme(s, sp, 3, sign, start, tol, budget, cancel, out);
+        return separable_extreme(s, sp, 3, sign, start, tol, budget, cancel, memo, out);
     const int a = radial_detj_axis(s);
     if (a >= 0)
         return radial_extreme(s, a, 3, sign, start, tol, budget, cancel, out);
@@ -1440,6 +1467,9 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     double rn;
     bb_result sb[3][2];
     harmonic_memo hmemo = { 0 };
+    detj_memo jm, *jmemo = &jm;
+    for (size_t i = 0; i < DL_MEMO; i++)
+        jm.key[i][0] = NAN;
     double magnitude = 0.0;
     for (int o = 0; o < 8; o++) {
         const int what = o < 6 ? o / 2 : 3;
@@ -1474,8 +1504,8 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             (void)0;
         else if (what < 3 && single[what])
             b = sb[what][o & 1];
-        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, jbudget, cancel, &b)
-                       : sp.axis >= 0 ? separable_extreme(s, &sp, what, sign, at[o], tol, PDE_PROPS_BOXES, cancel, &b)
+        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, jbudget, cancel, jmemo, &b)
+                       : sp.axis >= 0 ? separable_extreme(s, &sp, what, sign, at[o], tol, PDE_PROPS_BOXES, cancel, NULL, &b)
                        : (ra = radial_axis(&s->comp[what], &rn)) >= 0
                            ? radial_extreme(s, ra, what, sign, at[o], tol, RADIAL_BOXES, cancel, &b)
                                       : bb_minimise(s, what, sign, at[o], NULL, tol, PDE_PROPS_BOXES, cancel, &b)) != PDE_OK)
@@ -1515,7 +1545,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         if (jlow[k] < -jtol && fabs(best[6 + k]) <= 1e-9 * jscale) {
             bb_result b;
             st = po ? poly_minimise(&po->b[3], sign, 0.5 * jtol, SIGN_BOXES, &b)
-                    : what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, &b);
+                    : what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, jmemo, &b);
             if (st != PDE_OK) {
                 free(po);
                 return st;
