@@ -14,18 +14,34 @@
 
 #include "internal.h"
 
+#define EVAL_SHARED 64   /* modes at most whose factors pde_eval_d takes from solution_factors */
+
 void pde_eval_d(const pde_solution *sol, double u, double v, double w,
                 double x[3], double xu[3], double xv[3], double xw[3])
 {
-    for (int c = 0; c < 3; c++) {
+    /* Every mode's factors at once, a factor, an exp or a sincos that recurs across modes once (the
+     * same values as each mode's own: factor_eval's, mode_h's). */
+    double f[6][EVAL_SHARED];
+    const size_t mt = sol->comp[0].nmodes + sol->comp[1].nmodes + sol->comp[2].nmodes;
+    const int shared = mt <= EVAL_SHARED;
+    if (shared) {
+        solution_factors(sol, 0, u, f[0], f[1]);
+        solution_factors(sol, 1, v, f[2], f[3]);
+        solution_factors(sol, 2, w, f[4], f[5]);
+    }
+    for (int c = 0, o = 0; c < 3; c++) {
         const comp_solution *cs = &sol->comp[c];
         double s = 0.0, su = 0.0, sv = 0.0, sw = 0.0;
-        for (size_t m = 0; m < cs->nmodes; m++) {
+        for (size_t m = 0; m < cs->nmodes; m++, o++) {
             const pde_mode *md = &cs->modes[m];
             double fu, dfu, fv, dfv, h, dh;
-            factor_eval(md->u, u, &fu, &dfu);
-            factor_eval(md->v, v, &fv, &dfv);
-            mode_h(md, w, &h, &dh);
+            if (shared)
+                fu = f[0][o], dfu = f[1][o], fv = f[2][o], dfv = f[3][o], h = f[4][o], dh = f[5][o];
+            else {
+                factor_eval(md->u, u, &fu, &dfu);
+                factor_eval(md->v, v, &fv, &dfv);
+                mode_h(md, w, &h, &dh);
+            }
             s += h * fu * fv;
             su += h * dfu * fv;
             sv += h * fu * dfv;

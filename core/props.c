@@ -21,6 +21,7 @@
  */
 #include <float.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -158,6 +159,8 @@ static inline double min2(double a, double b)
  * So scale = max(data, min(drive, own)), data and drive as sums of the absolute values of their
  * terms at each point; own alone for a component with neither.
  */
+#define BC_ROWS 32   /* rows of w = 0 and 1 at a time: one h(w) per side and block, in bounded memory */
+
 static pde_status bc_residual(const pde_solution *s, int res, const double own_size[3], poller *pl,
                               double *out)
 {
@@ -167,11 +170,13 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
     }
     const size_t n = (size_t)res;
     const size_t nb = s->comp[0].nbterms + s->comp[1].nbterms + s->comp[2].nbterms;
-    double *uni = malloc((n + 2 * nb * n + 12 * n) * sizeof *uni);
+    const size_t nj = n < BC_ROWS ? n : BC_ROWS;
+    double *uni = malloc((n + 2 * nb * n + 12 * n * nj) * sizeof *uni);
     if (!uni)
         return PDE_ERR_NOMEM;
-    /* The boundary terms' factors at the samples, all components' terms in a row; x, x_w of both sides. */
-    double *fu = uni + n, *fv = fu + nb * n, *row = fv + nb * n;
+    /* The boundary terms' factors at the samples, all components' terms in a row; x, x_w of both sides
+     * in rows j of a block of BC_ROWS (12 n each), each side's h(w) once a block. */
+    double *fu = uni + n, *fv = fu + nb * n, *rows = fv + nb * n;
     for (size_t i = 0; i < n; i++)
         uni[i] = (double)i / (double)(n - 1);
     for (size_t c = 0, t0 = 0; c < 3; t0 += s->comp[c++].nbterms)
@@ -188,15 +193,19 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
     }
     double err[3] = { 0, 0, 0 }, scale[3] = { 0, 0, 0 };
     for (size_t j = 0; j < n && st == PDE_OK; j++) {
-        for (int side = 0; side < 2; side++) {
+        for (int side = 0; side < 2 && j % BC_ROWS == 0; side++) {
             grid_set_w(g, side);
-            grid_row(g, j, GRID_X | GRID_XW);
-            for (int c = 0; c < 3; c++)
-                for (size_t i = 0; i < n; i++) {
-                    row[(6 * side + c) * n + i] = g->row[c * n + i];
-                    row[(6 * side + 3 + c) * n + i] = g->row[(9 + c) * n + i];
-                }
+            for (size_t jb = j; jb < j + nj && jb < n; jb++) {
+                double *row = rows + 12 * n * (jb - j);
+                grid_row(g, jb, GRID_X | GRID_XW);
+                for (int c = 0; c < 3; c++)
+                    for (size_t i = 0; i < n; i++) {
+                        row[(6 * side + c) * n + i] = g->row[c * n + i];
+                        row[(6 * side + 3 + c) * n + i] = g->row[(9 + c) * n + i];
+                    }
+            }
         }
+        const double *row = rows + 12 * n * (j % BC_ROWS);
         for (size_t c = 0, t0 = 0; c < 3; t0 += s->comp[c++].nbterms) {
             const comp_solution *cs = &s->comp[c];
             if (poll_after(pl, (2 * cs->nmodes + cs->nbterms) * (n + 2) / 4 + 1)) {
@@ -252,11 +261,49 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
  * measured against their size. The derivatives of each factor and each h are tabulated once per
  * sample line: a point then costs three multiply-adds per mode.
  */
+#define RESIDUAL_TWINS 64   /* modes at most among which pde_residual looks for the same h(w) */
+
 static pde_status pde_residual(const pde_solution *s, int res, poller *pl, double *out)
 {
-    const size_t n = (size_t)res;
+    const size_t n = (size_t)res, mt = s->comp[0].nmodes + s->comp[1].nmodes + s->comp[2].nmodes;
     double worst = 0.0;
-    for (int c = 0; c < 3; c++) {
+    /* h and h'''' of every mode at the samples, x's modes then y's and z's: a mode with the same h(w) as
+     * an earlier one (fig. 4: each of x's again in y) copies its rows */
+    double *hall = malloc((2 * mt * n + 1) * sizeof *hall);
+    if (!hall)
+        return PDE_ERR_NOMEM;
+    for (size_t o = 0, c = 0, m = 0; o < mt; o++, m++) {
+        while (m >= s->comp[c].nmodes)
+            c++, m = 0;
+        const pde_mode *md = &s->comp[c].modes[m];
+        if (poll_after(pl, n * (4 + md->nterms * 8))) {
+            free(hall);
+            return PDE_ERR_CANCELLED;
+        }
+        size_t tw = o;
+        for (size_t p = 0, pc = 0, pm = 0; p < o && mt <= RESIDUAL_TWINS && tw == o; p++, pm++) {
+            while (pm >= s->comp[pc].nmodes)
+                pc++, pm = 0;
+            if (quad_same_h(&s->comp[pc].modes[pm], md))
+                tw = p;
+        }
+        for (size_t i = 0; i < n; i++) {
+            double h0 = 0.0, hw = 0.0;
+            if (tw < o)
+                h0 = hall[tw * n + i], hw = hall[(mt + tw) * n + i];
+            else {
+                const double t = (i + 0.5) / res;
+                size_t k0, k1;
+                mode_slab(md, t, &k0, &k1);   /* a loft's slab of t */
+                for (size_t k = k0; k < k1; k++) {
+                    h0 += wterm_deriv(&md->terms[k], t, 0);
+                    hw += wterm_deriv(&md->terms[k], t, 4);
+                }
+            }
+            hall[o * n + i] = h0, hall[(mt + o) * n + i] = hw;
+        }
+    }
+    for (int c = 0, off = 0; c < 3; off += (int)s->comp[c].nmodes, c++) {
         const comp_solution *cs = &s->comp[c];
         const size_t nm = cs->nmodes;
         if (nm == 0 && cs->nfterms == 0)
@@ -266,11 +313,13 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
          * terms likewise: each factor at the samples, and per term coef f_u f_v on the current (u, v)
          * (pde_force's values, in its order, without its three factor evaluations a point). */
         const size_t nf = cs->nfterms;
-        double *tab = malloc((6 * nm * n + 3 * nm + 3 * nf * n + nf + 1) * sizeof *tab);
-        if (!tab)
+        double *tab = malloc((4 * nm * n + 3 * nm + 3 * nf * n + nf + 1) * sizeof *tab);
+        if (!tab) {
+            free(hall);
             return PDE_ERR_NOMEM;
-        double *fu = tab, *fu4 = fu + nm * n, *fv = fu4 + nm * n, *fv4 = fv + nm * n;
-        double *h = fv4 + nm * n, *h4 = h + nm * n, *uv = h4 + nm * n;
+        }
+        double *fu = tab, *fu4 = fu + nm * n, *fv = fu4 + nm * n, *fv4 = fv + nm * n, *uv = fv4 + nm * n;
+        const double *h = hall + off * n, *h4 = hall + (mt + off) * n;
         double *pu = uv + 3 * nm, *pv = pu + nf * n, *pw = pv + nf * n, *puv = pw + nf * n;
         for (size_t t = 0; t < nf; t++)
             for (size_t i = 0; i < n; i++) {
@@ -281,25 +330,12 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
             }
         for (size_t m = 0; m < nm; m++) {
             const pde_mode *md = &cs->modes[m];
-            if (poll_after(pl, n * (4 + md->nterms * 8))) {
-                free(tab);
-                return PDE_ERR_CANCELLED;
-            }
             for (size_t i = 0; i < n; i++) {
                 double t = (i + 0.5) / res;
                 fu[m * n + i] = factor_deriv(md->u, t, 0);
                 fu4[m * n + i] = factor_deriv(md->u, t, 4);
                 fv[m * n + i] = factor_deriv(md->v, t, 0);
                 fv4[m * n + i] = factor_deriv(md->v, t, 4);
-                double h0 = 0.0, hw = 0.0;
-                size_t k0, k1;
-                mode_slab(md, t, &k0, &k1);   /* a loft's slab of t */
-                for (size_t k = k0; k < k1; k++) {
-                    h0 += wterm_deriv(&md->terms[k], t, 0);
-                    hw += wterm_deriv(&md->terms[k], t, 4);
-                }
-                h[m * n + i] = h0;
-                h4[m * n + i] = hw;
             }
         }
         double err = 0.0, scale = 0.0;
@@ -307,6 +343,7 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
             for (size_t j = 0; j < n; j++) {
                 if (poll_after(pl, n * (nm + cs->nfterms))) {
                     free(tab);
+                    free(hall);
                     return PDE_ERR_CANCELLED;
                 }
                 for (size_t m = 0; m < nm; m++) {
@@ -333,6 +370,7 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
         free(tab);
         worst = fmax(worst, scale > 0.0 ? err / scale : err);
     }
+    free(hall);
     *out = worst;
     return PDE_OK;
 }
@@ -663,18 +701,28 @@ static pde_status line_minimise(const pde_solution *s, const line_fn *f, double 
  * by |alpha'''(c)| + r M4 (r = max |w - c|): no bound of each mode over each interval, and near c as
  * tight as the sum's own value (a mode's bound loses the cancellation between its terms).
  */
-static void harmonic_models(const harmonic *hc, double w0, double w1, double c, tm1 m[2])
+static void harmonic_models_of(const harmonic *hc, double w0, double w1, double c, const int *twin,
+                               const double (*known)[4], double (*jet)[4], tm1 m[2])
 {
     const double r = fmax(c - w0, w1 - c);
     double j[2][4] = { { 0, 0, 0, 0 }, { 0, 0, 0, 0 } };
     for (size_t k = 0; k < hc->nmodes; k++) {
-        double d[4];
+        double e[4];
+        const double *d = e;
         const int i = harmonic_is_cos(hc, k);
-        mode_h_derivs(&hc->modes[k], c, 3, d);
+        if (twin && twin[k] >= 0)
+            d = known[twin[k]];
+        else
+            mode_h_derivs(&hc->modes[k], c, 3, jet ? (double *)(d = jet[k]) : e);
         j[i][0] += d[0], j[i][1] += d[1], j[i][2] += d[2], j[i][3] += d[3];
     }
     for (int i = 0; i < 2; i++)
         m[i] = tm_jet(j[i], fabs(j[i][3]) + r * hc->M4[i]);
+}
+
+static void harmonic_models(const harmonic *hc, double w0, double w1, double c, tm1 m[2])
+{
+    harmonic_models_of(hc, w0, w1, c, NULL, NULL, NULL, m);
 }
 
 /* alpha and beta at w. */
@@ -734,16 +782,51 @@ static void harmonic_place(const harmonic *hc, double w, const double ab[2], int
  * The extremes of such a component (bound, best, at: as single_mode_extremes'); PDE_ERR_INVALID where
  * it is not one (or its bound is no number). start: a w to begin from.
  */
-pde_status props_harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
-                                   const pde_cancel *cancel, double bound[2], double best[2], double at[2][3])
+/* The modes of a whose factor is (not) cos (ia) are b's of ib, one by one with the same h(w). */
+static int same_modes(const harmonic *a, int ia, const harmonic *b, int ib)
+{
+    size_t i = 0, k = 0;
+    for (;; i++, k++) {
+        while (i < a->nmodes && harmonic_is_cos(a, i) != ia)
+            i++;
+        while (k < b->nmodes && harmonic_is_cos(b, k) != ib)
+            k++;
+        if (i == a->nmodes || k == b->nmodes)
+            return i == a->nmodes && k == b->nmodes;
+        if (!quad_same_h(&a->modes[i], &b->modes[k]))
+            return 0;
+    }
+}
+
+/* A harmonic's largest R(w) found, for another component with the same R^2 = alpha^2 + beta^2 term by
+ * term (fig. 4's y = h2 sin + h1 cos beside x = h1 sin + h2 cos: alpha and beta swapped): its search
+ * would be the same, point by point, from the same start. */
+typedef struct {
+    int done;
+    harmonic hc;
+    double start, tol, up, w;
+    size_t budget;
+} harmonic_memo;
+
+static pde_status harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
+                                    const pde_cancel *cancel, harmonic_memo *memo, double bound[2], double best[2],
+                                    double at[2][3])
 {
     harmonic hc;
     if (!harmonic_of(s, c, &hc))
         return PDE_ERR_INVALID;
     double up, w, ab[2];
-    pde_status st = harmonic_max(s, &hc, start, tol, budget, cancel, &up, &w);
-    if (st != PDE_OK)
-        return st;
+    const harmonic *p = memo && memo->done ? &memo->hc : NULL;
+    if (p && memo->start == start && memo->tol == tol && memo->budget == budget &&
+        ((same_modes(p, 0, &hc, 0) && same_modes(p, 1, &hc, 1)) || (same_modes(p, 0, &hc, 1) && same_modes(p, 1, &hc, 0))))
+        up = memo->up, w = memo->w;
+    else {
+        pde_status st = harmonic_max(s, &hc, start, tol, budget, cancel, &up, &w);
+        if (st != PDE_OK)
+            return st;
+        if (memo)
+            *memo = (harmonic_memo){ 1, hc, start, tol, up, w, budget };
+    }
     harmonic_ab(&hc, w, ab);
     for (int e = 0; e < 2; e++) {
         double x[3];
@@ -753,6 +836,12 @@ pde_status props_harmonic_extremes(const pde_solution *s, int c, double start, d
     }
     bound[0] = fmin(-up, best[0]), bound[1] = fmax(up, best[1]);
     return PDE_OK;
+}
+
+pde_status props_harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
+                                   const pde_cancel *cancel, double bound[2], double best[2], double at[2][3])
+{
+    return harmonic_extremes(s, c, start, tol, budget, cancel, NULL, bound, best, at);
 }
 
 /* Non-zero when every mode of the component has the factors 1 along u and v: x_c = Z(w) (fig. 2's and 4's z). */
@@ -822,10 +911,26 @@ static pde_status w_only_extremes(const pde_solution *s, int c, const double *st
  * (S^2 + C^2 = 1), so det J = t^(2n - 1) g(w), g = sigma n k pi Z'(w) (beta gamma - alpha delta),
  * sigma the sign the rows' and columns' order gives: g's extremes are a problem in w alone.
  */
+#define DL_MODES 8   /* modes of each harmonic at most whose h a twin of the other's shares */
+#define DL_MEMO 128  /* g's models remembered across pde_properties' searches of det J */
+
+/* g's models by their interval and point (w0, w1, c): det J's searches for its least value, its
+ * largest and its sign (fig. 2a: 9, 23 and 29 models) share their intervals from [0, 1] down, and
+ * each takes the other's model where its own best point puts c at the same place. Direct-mapped. */
+typedef struct {
+    double key[DL_MEMO][3];
+    tm1 model[DL_MEMO];
+} detj_memo;
+
 typedef struct {
     harmonic h[2];
     const comp_solution *zc;   /* z */
     double scale;         /* sigma n k pi */
+    /* the mode of h[0] with the same h(w) as h[1]'s mode k (fig. 4: x = h1 sin + h2 cos, y = h2 sin
+     * + h1 cos), or -1: its jet once; twins[1] NULL where a harmonic has more than DL_MODES */
+    int twin[DL_MODES];
+    const int *twins[2];
+    detj_memo *memo;      /* NULL: none */
 } detj_line;
 
 static int detj_line_of(const pde_solution *s, detj_line *d)
@@ -843,6 +948,16 @@ static int detj_line_of(const pde_solution *s, detj_line *d)
         M[c0][a->a] = 1.0, M[c1][a->b] = 1.0, M[z][2] = 1.0;
         d->zc = zc;
         d->scale = det3(M[0], M[1], M[2]) * a->n * a->k * M_PI;
+        d->twins[0] = d->twins[1] = NULL;
+        if (a->nmodes <= DL_MODES && b->nmodes <= DL_MODES) {
+            for (size_t k = 0; k < b->nmodes; k++) {
+                d->twin[k] = -1;
+                for (size_t i = 0; i < a->nmodes && d->twin[k] < 0; i++)
+                    if (quad_same_h(&a->modes[i], &b->modes[k]))
+                        d->twin[k] = (int)i;
+            }
+            d->twins[1] = d->twin;
+        }
         return 1;
     }
     return 0;
@@ -851,16 +966,32 @@ static int detj_line_of(const pde_solution *s, detj_line *d)
 static void detj_line_model(const void *ctx, double w0, double w1, double c, tm1 *m)
 {
     const detj_line *d = ctx;
+    unsigned slot = 0;
+    if (d->memo) {
+        uint64_t b[3];
+        memcpy(&b[0], &w0, sizeof b[0]), memcpy(&b[1], &w1, sizeof b[1]), memcpy(&b[2], &c, sizeof b[2]);
+        slot = (unsigned)(((b[0] * 3 + b[1] * 5 + b[2]) * 0x9e3779b97f4a7c15u) >> 56) % DL_MEMO;
+        const double *k = d->memo->key[slot];
+        if (k[0] == w0 && k[1] == w1 && k[2] == c) {
+            *m = d->memo->model[slot];
+            return;
+        }
+    }
     const double r = fmax(c - w0, w1 - c);
     tm1 ab[2], gd[2];
-    harmonic_models(&d->h[0], w0, w1, c, ab);
-    harmonic_models(&d->h[1], w0, w1, c, gd);
+    double jet[DL_MODES][4];   /* each mode of h[0]: h and its derivatives at c */
+    harmonic_models_of(&d->h[0], w0, w1, c, NULL, NULL, d->twins[1] ? jet : NULL, ab);
+    harmonic_models_of(&d->h[1], w0, w1, c, d->twins[1], (const double(*)[4])jet, NULL, gd);
     const tm1 zp = w_only_model(d->zc, 1, w0, w1, c), bg = tm_mul(&ab[1], &gd[0], r), ad = tm_mul(&ab[0], &gd[1], r);
     const tm1 q = tm_add(bg, &ad, -1.0);
     *m = tm_mul(&zp, &q, r);
     for (int k = 0; k < 3; k++)
         m->p[k] *= d->scale;
     m->k *= fabs(d->scale);
+    if (d->memo) {
+        d->memo->key[slot][0] = w0, d->memo->key[slot][1] = w1, d->memo->key[slot][2] = c;
+        d->memo->model[slot] = *m;
+    }
 }
 
 static double detj_line_value(const void *ctx, double w)
@@ -887,7 +1018,7 @@ static double detj_line_value(const void *ctx, double w)
  */
 static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, int what, double sign,
                                     const double start[3], double tol, size_t budget, const pde_cancel *cancel,
-                                    bb_result *out)
+                                    detj_memo *memo, bb_result *out)
 {
     pbox face = { { 0, 0, 0 }, { 1, 1, 1 } };
     face.lo[sp->axis] = 1.0;
@@ -909,6 +1040,7 @@ static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, i
     pde_status st = PDE_ERR_INVALID;
     detj_line dl;
     if (what == 3 && sp->free >= 0 && detj_line_of(s, &dl) && dl.h[0].a == sp->axis) {
+        dl.memo = memo;
         const line_fn f = { detj_line_model, detj_line_value, &dl };   /* g(w) alone */
         st = line_minimise(s, &f, sign, at[2], tol, budget, cancel, &b.lower, &b.best, &b.at[2]);
     }
@@ -1140,10 +1272,10 @@ size_t pde_properties_detj_boxes(const pde_solution *s)
 
 /* The extreme of sign * det J by branch and bound, over the face where det J separates. */
 static pde_status what_detj(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
-                            double tol, size_t budget, const pde_cancel *cancel, bb_result *out)
+                            double tol, size_t budget, const pde_cancel *cancel, detj_memo *memo, bb_result *out)
 {
     if (sp->axis >= 0)
-        return separable_extreme(s, sp, 3, sign, start, tol, budget, cancel, out);
+        return separable_extreme(s, sp, 3, sign, start, tol, budget, cancel, memo, out);
     const int a = radial_detj_axis(s);
     if (a >= 0)
         return radial_extreme(s, a, 3, sign, start, tol, budget, cancel, out);
@@ -1334,6 +1466,11 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     int ra;
     double rn;
     bb_result sb[3][2];
+    harmonic_memo hmemo = { 0 };
+    detj_memo jm, *jmemo = &jm;
+    for (size_t i = 0; i < DL_MEMO; i++)
+        jm.key[i][0] = NAN;
+    double magnitude = 0.0;
     for (int o = 0; o < 8; o++) {
         const int what = o < 6 ? o / 2 : 3;
         const double sign = (o & 1) ? -1.0 : 1.0, tol = (o < 6 ? 1e-12 * size : 1e-9 * jscale);
@@ -1350,8 +1487,8 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             const double *starts[2] = { lo, hi };
             st = s->comp[what].nmodes && w_only(&s->comp[what])
                      ? w_only_extremes(s, what, starts, tol, cancel, bd, bs, ba)
-                     : props_harmonic_extremes(s, what, fabs(best[o]) > fabs(best[o + 1]) ? lo[2] : hi[2], tol,
-                                               PDE_PROPS_BOXES, cancel, bd, bs, ba);
+                     : harmonic_extremes(s, what, fabs(best[o]) > fabs(best[o + 1]) ? lo[2] : hi[2], tol,
+                                         PDE_PROPS_BOXES, cancel, &hmemo, bd, bs, ba);
             if (st == PDE_ERR_INVALID && s->comp[what].nmodes == 1)
                 st = single_mode_extremes(s, what, tol, cancel, bd, bs, ba);
             if (st == PDE_OK) {
@@ -1367,8 +1504,8 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             (void)0;
         else if (what < 3 && single[what])
             b = sb[what][o & 1];
-        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, jbudget, cancel, &b)
-                       : sp.axis >= 0 ? separable_extreme(s, &sp, what, sign, at[o], tol, PDE_PROPS_BOXES, cancel, &b)
+        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, jbudget, cancel, jmemo, &b)
+                       : sp.axis >= 0 ? separable_extreme(s, &sp, what, sign, at[o], tol, PDE_PROPS_BOXES, cancel, NULL, &b)
                        : (ra = radial_axis(&s->comp[what], &rn)) >= 0
                            ? radial_extreme(s, ra, what, sign, at[o], tol, RADIAL_BOXES, cancel, &b)
                                       : bb_minimise(s, what, sign, at[o], NULL, tol, PDE_PROPS_BOXES, cancel, &b)) != PDE_OK)
@@ -1376,7 +1513,9 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         if (o >= 6)
             jlow[o - 6] = b.lower, jat[o - 6][0] = b.at[0], jat[o - 6][1] = b.at[1], jat[o - 6][2] = b.at[2];
         /* The bound holds for the exact closed form; evaluated values may differ by their rounding. */
-        const double pad = 64.0 * DBL_EPSILON * obj_magnitude(s, what);
+        if (!(o & 1))   /* each objective's magnitude once: its two extremes share it */
+            magnitude = obj_magnitude(s, what);
+        const double pad = 64.0 * DBL_EPSILON * magnitude;
         const double bound = sign * (b.lower - pad), gap = b.best - b.lower + pad;
         best[o] = sign * b.best + 0.0;   /* + 0: no -0 */
         if (o < 6) {
@@ -1406,7 +1545,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         if (jlow[k] < -jtol && fabs(best[6 + k]) <= 1e-9 * jscale) {
             bb_result b;
             st = po ? poly_minimise(&po->b[3], sign, 0.5 * jtol, SIGN_BOXES, &b)
-                    : what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, &b);
+                    : what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, jmemo, &b);
             if (st != PDE_OK) {
                 free(po);
                 return st;

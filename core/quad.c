@@ -58,6 +58,7 @@
 #include <limits.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -146,7 +147,7 @@ typedef struct {
     double f[3];                 /* the integrand's frequencies (at least 1) */
     int poly[3];                 /* the solution's degree along each axis where it is a polynomial, else -1 */
     double vscale;               /* the solid's volume, roughly: for refinement's tolerance */
-    double gx[GMAX + 1][GMAX], gw[GMAX + 1][GMAX];   /* n-point rules on [0, 1] */
+    const double (*gx)[GMAX], (*gw)[GMAX];   /* n-point rules on [0, 1] (rules_x, rules_w) */
     int n[3];                    /* the current panel's points per axis (0: the flat axis) */
     int flat;                    /* the axis fixed at 1 (quad_separate), or -1 */
     int along;                   /* a polynomial axis every line runs along, never split (quad_solid), or -1 */
@@ -1119,6 +1120,24 @@ static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
     panel_lines(q, b, k, definite, acc);
 }
 
+int quad_same_h(const pde_mode *a, const pde_mode *b)
+{
+    if (a->nterms != b->nterms || a->nslabs != b->nslabs)
+        return 0;
+    for (size_t k = 0; a->nslabs > 1 && k <= a->nslabs; k++)
+        if (a->breaks[k] != b->breaks[k] || a->first[k] != b->first[k])
+            return 0;
+    for (size_t k = 0; k < a->nterms; k++) {
+        const pde_wterm *x = &a->terms[k], *y = &b->terms[k];
+        if (x->alpha != y->alpha || x->beta != y->beta || x->shift != y->shift || x->deg != y->deg)
+            return 0;
+        for (int i = 0; i <= x->deg; i++)
+            if (x->A[i] != y->A[i] || x->B[i] != y->B[i])
+                return 0;
+    }
+    return 1;
+}
+
 /*
  * Where det J does not depend on the face's other parameter s (quad_sep's free, with few modes): on
  * the face t = 1 det J = n G(w), and every integrand is |G| (or G) times 1, x_c or x_c x_d with x_c =
@@ -1133,6 +1152,14 @@ static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
 #define FREE_SPAN_DEPTH 12    /* halvings of a w-panel where its halves disagree, at most */
 #define FREE_KNOWN 32         /* roots and dips remembered per w-panel */
 
+#define FREE_MEMO 512         /* points of w remembered (a power of 2): ends, halves' ends, pieces */
+
+/* A moment of free_point's sums that is not 0: acc[slot] += mom h[o] (h[p]). */
+typedef struct {
+    unsigned o, p, slot;
+    double mom;
+} free_term;
+
 typedef struct {
     qctx *q;
     int flat, free;              /* the face's fixed axis t, and s */
@@ -1141,17 +1168,51 @@ typedef struct {
     double *mom1, *mom2;         /* mt, mt x mt */
     double *da, *ds, *dw;        /* det J's partials' coefficients at s0: F'_t F_s, F_t F'_s, F_t F_s */
     double *h, *dh;              /* mt: the current point's h, h' */
+    /* Each distinct h(w) once (quad_same_h; fig. 2 and 4: 3 of 5 modes, each of x's h again in y):
+     * the modes of `distinct`, its exps and sincos shared as in every solution_factors; mode o's h is
+     * its hd[map[o]]. distinct NULL where every mode's h is its own. */
+    const pde_solution *distinct;
+    const unsigned *map;
+    double *hd, *dhd;
+    /* The moments that are not 0, in free_point's order of (o, p): fig. 2 and 4's products of sin
+     * and cos 2 pi v (half of them 0) add nothing, and skipping them leaves every sum as it was. */
+    free_term *terms;
+    size_t nterms;
+    /* Points of w evaluated, by the bits of w (direct-mapped): G and, where had_m, the integrals m.
+     * Panels share their ends with their halves and neighbours, and a piece between a root and an
+     * end is the same piece in the panel and in its half (fig. 4a: 356 points a call, 300 distinct). */
+    double *memo_w, *memo_j, (*memo_m)[Q_N];
+    unsigned char *memo_had_m;
     /* The current w-panel's roots of G, and its dip searches' leasts (where G's sign at them), found
      * by its coarse rule: its halves' brackets that hold one take it rather than search again. */
     double root[FREE_KNOWN], dip_at[FREE_KNOWN], dip_f[FREE_KNOWN];
     int nroot, ndip;
 } free_ctx;
 
+static unsigned free_slot(double w)
+{
+    uint64_t k;
+    memcpy(&k, &w, sizeof k);
+    k *= 0x9e3779b97f4a7c15u;
+    return (unsigned)(k >> 55) & (FREE_MEMO - 1);
+}
+
 /* det J at w on the face (at s0), and into m[Q_N] the integrals over s of 1, x_c, x_c x_d at w. */
 static double free_point(free_ctx *f, double w, double m[Q_N])
 {
     qctx *q = f->q;
-    solution_factors(q->s, 2, w, f->h, f->dh);
+    const unsigned at = free_slot(w);
+    if (f->memo_w[at] == w && (!m || f->memo_had_m[at])) {
+        if (m)
+            memcpy(m, f->memo_m[at], sizeof f->memo_m[at]);
+        return f->memo_j[at];
+    }
+    if (f->distinct) {
+        solution_factors(f->distinct, 2, w, f->hd, f->dhd);
+        for (size_t o = 0; o < f->mt; o++)
+            f->h[o] = f->hd[f->map[o]], f->dh[o] = f->dhd[f->map[o]];
+    } else
+        solution_factors(q->s, 2, w, f->h, f->dh);
     q->r.evals++;
     double d[3][3] = { { 0 } };
     for (size_t o = 0; o < f->mt; o++) {
@@ -1159,26 +1220,17 @@ static double free_point(free_ctx *f, double w, double m[Q_N])
         d[f->flat][c] += f->da[o] * f->h[o], d[f->free][c] += f->ds[o] * f->h[o], d[2][c] += f->dw[o] * f->dh[o];
     }
     const double j = det3(d[0], d[1], d[2]);
+    f->memo_w[at] = w, f->memo_j[at] = j, f->memo_had_m[at] = m != NULL;
     if (!m)
         return j;
     for (int e = 0; e < Q_N; e++)
         m[e] = 0.0;
     m[Q_VOL] = 1.0;
-    for (size_t o = 0; o < f->mt; o++) {
-        const int c = f->comp[o];
-        const double ho = f->h[o], *row = f->mom2 + o * f->mt;
-        m[Q_M1 + c] += f->mom1[o] * ho;
-        for (size_t p = 0; p < f->mt; p++) {   /* each pair (c <= d) once: o's component first */
-            const int cd = f->comp[p];
-            if (cd < c)
-                continue;
-            const double v = row[p] * ho * f->h[p];
-            if (cd == c)
-                m[Q_M2 + c] += v;
-            else
-                m[Q_M2 + (c == 0 ? (cd == 1 ? 3 : 4) : 5)] += v;
-        }
+    for (size_t i = 0; i < f->nterms; i++) {
+        const free_term *t = &f->terms[i];
+        m[t->slot] += t->slot < Q_M2 ? t->mom * f->h[t->o] : t->mom * f->h[t->o] * f->h[t->p];
     }
+    memcpy(f->memo_m[at], m, sizeof f->memo_m[at]);
     return j;
 }
 
@@ -1222,36 +1274,68 @@ static double free_root(free_ctx *f, double a, double b, double ga, double gb)
     return r;
 }
 
-/* The extreme of sign * G between t0 and t2 by golden section, as line_dip; 1 when it crosses 0. */
-static int free_dip(free_ctx *f, double t0, double t2, double sign, double *at, double *fat)
+/* The extreme of sign * G between t0 and t2, from the least sample t1 inside (f1 = sign * G there), by
+ * Brent's minimiser (golden section, and parabolic steps where they fall inside): to 1e-9 of t2 - t0
+ * as line_dip's golden section, in about a quarter of its points where G is smooth at that scale
+ * (fig. 4a's dip of |G| at w = 0.9446, 11.3 deep, took 40); 1 when it crosses 0. */
+static int free_dip(free_ctx *f, double t0, double t1, double f1, double t2, double sign, double *at,
+                    double *fat)
 {
     for (int i = 0; i < f->ndip; i++)
         if (f->dip_at[i] > t0 && f->dip_at[i] < t2) {
             *at = f->dip_at[i], *fat = f->dip_f[i];
             return sign * *fat < -f->q->jtol;
         }
-    const double g = 0.5 * (3.0 - sqrt(5.0));
-    double a = t0, b = t2;
-    double c = a + g * (b - a), d = b - g * (b - a);
-    double fc = sign * free_detj(f, c), fd = sign * free_detj(f, d);
-    for (int it = 0; it < 40 && b - a > 1e-9 * (t2 - t0); it++) {
-        if (fc < fd) {
-            b = d, d = c, fd = fc;
-            c = a + g * (b - a);
-            fc = sign * free_detj(f, c);
-        } else {
-            a = c, c = d, fc = fd;
-            d = b - g * (b - a);
-            fd = sign * free_detj(f, d);
-        }
-        if (fmin(fc, fd) < -f->q->jtol)
+    const double gold = 0.5 * (3.0 - sqrt(5.0)), tol = 0.25e-9 * (t2 - t0), stop = -f->q->jtol;
+    double a = t0, b = t2, x = t1, w = t1, v = t1, fx = f1, fw = f1, fv = f1, d = 0.0, e = 0.0;
+    for (int it = 0; it < 60 && fx >= stop; it++) {
+        const double m = 0.5 * (a + b), tol1 = tol + 2.0 * DBL_EPSILON * fabs(x), tol2 = 2.0 * tol1;
+        if (fabs(x - m) <= tol2 - 0.5 * (b - a))
             break;
+        double p = 0.0, q = 0.0, r = 0.0;
+        if (fabs(e) > tol1) {   /* a parabola through x, w, v */
+            r = (x - w) * (fx - fv);
+            q = (x - v) * (fx - fw);
+            p = (x - v) * q - (x - w) * r;
+            q = 2.0 * (q - r);
+            if (q > 0.0)
+                p = -p;
+            else
+                q = -q;
+            r = e;
+            e = d;
+        }
+        if (fabs(p) < fabs(0.5 * q * r) && p > q * (a - x) && p < q * (b - x)) {
+            d = p / q;
+            if (x + d - a < tol2 || b - (x + d) < tol2)
+                d = x < m ? tol1 : -tol1;
+        } else {
+            e = (x < m ? b : a) - x;
+            d = gold * e;
+        }
+        const double u = x + (fabs(d) >= tol1 ? d : d > 0.0 ? tol1 : -tol1), fu = sign * free_detj(f, u);
+        if (fu <= fx) {
+            if (u < x)
+                b = x;
+            else
+                a = x;
+            v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
+        } else {
+            if (u < x)
+                a = u;
+            else
+                b = u;
+            if (fu <= fw || w == x)
+                v = w, fv = fw, w = u, fw = fu;
+            else if (fu <= fv || v == x || v == w)
+                v = u, fv = fu;
+        }
     }
-    *at = fc < fd ? c : d;
-    *fat = sign * fmin(fc, fd);
+    *at = x;
+    *fat = sign * fx;
     if (f->ndip < FREE_KNOWN)
         f->dip_at[f->ndip] = *at, f->dip_f[f->ndip++] = *fat;
-    return fmin(fc, fd) < -f->q->jtol;
+    return fx < stop;
 }
 
 /* The panel [a, b] of w: G at its ends and rule's nodes, its sign changes and dips located, and each
@@ -1282,7 +1366,8 @@ static int free_rule(free_ctx *f, double a, double b, double acc[Q_N])
             cut[ncut++] = free_root(f, t[last], t[i], g[last], g[i]);
         else if (least && !(i < m && sign_changes(g[i], g[i + 1], q->jtol))) {
             double at, fat;
-            if (free_dip(f, t[i ? i - 1 : 0], t[i < m ? i + 1 : m], g[i] > 0 ? 1.0 : -1.0, &at, &fat)) {
+            const double sign = g[i] > 0 ? 1.0 : -1.0;
+            if (free_dip(f, t[i ? i - 1 : 0], t[i], sign * g[i], t[i < m ? i + 1 : m], sign, &at, &fat)) {
                 const int l = at > t[i] ? i : i - 1, r = at < t[i] ? i : i + 1;
                 cut[ncut++] = free_root(f, t[l], at, g[l], fat);
                 cut[ncut++] = free_root(f, at, t[r], fat, g[r]);
@@ -1338,17 +1423,46 @@ static int free_solid(qctx *q, const qplan *p, int flat, int sa)
     const size_t mt = q->mt;
     if (mt == 0 || mt > FREE_MODES)
         return 0;
-    double *buf = malloc((2 * mt * mt + 11 * mt) * sizeof *buf);
+    double *buf = malloc((2 * mt * mt + 13 * mt + (2 + Q_N) * FREE_MEMO) * sizeof *buf);
     int *comp = malloc(mt * sizeof *comp);
-    if (!buf || !comp) {
+    free_term *terms = malloc((mt * mt + mt) * sizeof *terms);
+    unsigned char *had = malloc(FREE_MEMO);
+    unsigned *map = malloc(mt * sizeof *map);
+    pde_mode *dmodes = malloc(mt * sizeof *dmodes);
+    if (!buf || !comp || !terms || !had || !map || !dmodes) {
         free(buf);
         free(comp);
+        free(terms);
+        free(had);
+        free(map);
+        free(dmodes);
         return 0;
     }
-    free_ctx f = { .q = q, .flat = flat, .free = sa, .mt = mt, .comp = comp };
+    free_ctx f = { .q = q, .flat = flat, .free = sa, .mt = mt, .comp = comp, .terms = terms, .memo_had_m = had,
+                   .map = map };
+    size_t nd = 0;
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < q->s->comp[c].nmodes; m++) {
+            const pde_mode *md = &q->s->comp[c].modes[m];
+            size_t i = 0;
+            while (i < nd && !quad_same_h(&dmodes[i], md))
+                i++;
+            if (i == nd)
+                dmodes[nd++] = *md;
+            map[q->off[c] + m] = (unsigned)i;
+        }
+    pde_solution distinct = *q->s;
+    distinct.comp[0].modes = dmodes, distinct.comp[0].nmodes = nd;
+    distinct.comp[1].nmodes = distinct.comp[2].nmodes = 0;
+    if (nd < mt)
+        f.distinct = &distinct;
     f.mom2 = buf, f.mom1 = buf + mt * mt, f.da = f.mom1 + mt, f.ds = f.da + mt, f.dw = f.ds + mt;
     f.h = f.dw + mt, f.dh = f.h + mt;
     double *ft = f.dh + mt, *dft = ft + mt, *fs = dft + mt, *dfs = fs + mt, *abs2 = dfs + mt, *abs1 = abs2 + mt * mt;
+    f.hd = abs1 + mt, f.dhd = f.hd + mt;
+    f.memo_w = f.dhd + mt, f.memo_j = f.memo_w + FREE_MEMO, f.memo_m = (double(*)[Q_N])(f.memo_j + FREE_MEMO);
+    for (size_t i = 0; i < FREE_MEMO; i++)
+        f.memo_w[i] = NAN;
     for (int c = 0; c < 3; c++)
         for (size_t m = 0; m < q->s->comp[c].nmodes; m++)
             comp[q->off[c] + m] = c;
@@ -1381,6 +1495,19 @@ static int free_solid(qctx *q, const qplan *p, int flat, int sa)
     for (size_t o = 0; o < mt * mt + mt; o++)
         if (fabs(buf[o]) <= 1e-14 * abs2[o])
             buf[o] = 0.0;
+    /* free_point's sums, each pair (c <= d) once (o's component first), in the order of (o, p) */
+    for (size_t o = 0; o < mt; o++) {
+        const int c = comp[o];
+        if (f.mom1[o] != 0.0)
+            terms[f.nterms++] = (free_term){ (unsigned)o, 0, (unsigned)(Q_M1 + c), f.mom1[o] };
+        for (size_t r = 0; r < mt; r++) {
+            const int cd = comp[r];
+            if (cd >= c && f.mom2[o * mt + r] != 0.0)
+                terms[f.nterms++] = (free_term){ (unsigned)o, (unsigned)r,
+                                                 (unsigned)(Q_M2 + (cd == c ? c : c == 0 ? (cd == 1 ? 3 : 4) : 5)),
+                                                 f.mom2[o * mt + r] };
+        }
+    }
     for (int l = 0; l < p->np[2] && !poll(q); l++) {
         const double lo = p->edge[2][l], hi = p->edge[2][l + 1];
         double coarse[Q_N], acc[Q_N];
@@ -1399,6 +1526,10 @@ static int free_solid(qctx *q, const qplan *p, int flat, int sa)
     }
     free(buf);
     free(comp);
+    free(terms);
+    free(had);
+    free(map);
+    free(dmodes);
     return 1;
 }
 
@@ -1610,8 +1741,8 @@ static qctx *qctx_new(const pde_solution *s, const pde_cancel *cancel)
     q->modes = q->mt + 1;
     poly_degrees(s, q->poly);
     pthread_once(&rules_once, rules_init);
-    memcpy(q->gx, rules_x, sizeof q->gx);
-    memcpy(q->gw, rules_w, sizeof q->gw);
+    q->gx = (const double(*)[GMAX])rules_x;
+    q->gw = (const double(*)[GMAX])rules_w;
     return q;
 }
 

@@ -88,6 +88,10 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
  * where the mirror t -> 1/N - t keeps det J too (fig. 3a, 3b); else 1. */
 double quad_detj_period(const pde_solution *s, int t, int *mirror);
 
+/* Whether two modes have the same h(w): the same slabs and terms (fig. 4's x = h1 sin + h2 cos, y =
+ * h2 sin + h1 cos: each h twice). Cannot fail. */
+int quad_same_h(const pde_mode *a, const pde_mode *b);
+
 /* Panels per axis and Gauss-Legendre points per panel on each axis (also for api/cost.h). */
 void quad_panels(const pde_solution *s, int np[3], int n[3]);
 
