@@ -825,11 +825,7 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
     }
     if (depth >= DEPTH)
         return 0;
-    if (!H->many) {
-        rule_w(H, a, m, &l);
-        rule_w(H, m, b, &r);
-    }
-    if (split && H->dip < DIP && H->splits > 0) {
+    if (split && H->dip < DIP && H->splits > 0) {   /* the Kronrod points' dip: no halves where it is cut */
         H->splits--;
         const double q = 0.125 * (b - a), near = 1e3 * DIP_EPS * (b - a);
         double w0 = dip_place(H, fmax(a, H->dip_at - q), fmin(b, H->dip_at + q));
@@ -838,6 +834,10 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
             return (w0 == a || outer_toward(H, w0, a - w0, depth + 1, out)) &&
                    (w0 == b || outer_toward(H, w0, b - w0, depth + 1, out));
         split = 0;   /* the dip is at an end, where a cut was: halves */
+    }
+    if (!H->many) {
+        rule_w(H, a, m, &l);
+        rule_w(H, m, b, &r);
     }
     return outer(H, a, m, &l, depth + 1, split, out) && outer(H, m, b, &r, depth + 1, split, out);
 }
