@@ -40,6 +40,9 @@
 #define U_LEVELS 2      /* ... or, where its width is known, this many such pieces, */
 #define U_NEAR 8.0      /* ... while the distance left is above this of the width, */
 #define U_WIDTH 2.0     /* ... and the rest in panels of u (s = width sinh u) this wide */
+#define HALVES_AGREE 1e-2 /* a panel whose Kronrod rule fails against its Gauss rule keeps it where its halves'
+                          * Gauss rules agree with it to this of the tolerance (at the tolerance itself,
+                          * fig. 4x's area moved by 7.7e-13) */
 #define DIP 0.05        /* a panel of w that fails its halves with the element below this of its largest */
 #define DIP_EPS 1e-7    /* ... is cut at the least place, located to this of the panel, */
 #define W_GRADE 0.1     /* ... and graded towards it, each piece this of the distance left, */
@@ -872,9 +875,17 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
                    (w0 == b || outer_toward(H, w0, b - w0, depth + 1, out));
         split = 0;   /* the dip is at an end, where a cut was: halves */
     }
-    if (!H->many) {
+    if (!H->many) {   /* the halves' Gauss rules, more accurate than the panel's, may confirm K */
         rule_w(H, a, m, &l);
         rule_w(H, m, b, &r);
+        ok = 1;
+        for (int k = 0; k < 2; k++)
+            ok &= fabs(K[k] - (l.sum[k] + r.sum[k])) <= HALVES_AGREE * fmax(H->tol[k] * (b - a), NOISE * fabs(K[k]));
+        if (ok) {
+            for (int k = 0; k < 2; k++)
+                out[k] += K[k];
+            return 1;
+        }
     }
     return outer(H, a, m, &l, depth + 1, split, out) && outer(H, m, b, &r, depth + 1, split, out);
 }
