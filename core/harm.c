@@ -60,7 +60,7 @@
 #define EV_MAP 0.05     /* ... alpha(beta) where a root lies within this of the circle, else alpha = beta */
 #define EV_SWITCH 1e-3  /* the trapezoidal rule's levels, from N0 points over pi, differ by more than this
                          * relative: even_mean instead of its next levels */
-#define EV_GUARD 1e-8   /* the roots reproduce the element's square at the samples to this of its largest */
+#define EV_GUARD 1e-8   /* the roots reproduce the element's square to this of its largest sample (a bound over the circle) */
 
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
@@ -416,7 +416,7 @@ static double complex polish(double complex b, double complex c, double complex 
  * the ends) takes that to about its cube root, and the trapezoidal rule in beta, the integrand even
  * and periodic, converges geometrically: EV_N0, 2 EV_N0, ... points until two levels agree. The sign
  * is m0's: positive. Returns 0 (the sampled path then) where c2 is small (a root near 0 or infinity),
- * a root lies on the circle (the element meets 0), the roots do not reproduce P at the samples to
+ * a root lies on the circle (the element meets 0), the roots do not reproduce P to
  * EV_GUARD, or the rule did not converge. *dip: the least over the largest of the element.
  */
 static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
@@ -450,12 +450,14 @@ static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
     if (!(norm2(z2) < 1.0))
         return 0;
     const double K = mag(c2) / (mag(z1) * mag(z2));
-    for (int i = 0; i < N0; i++) {
-        const double complex z = trig[stride * i][1] + I * trig[stride * i][5];
-        const double d1 = mag(z - z1), d2 = mag(z - z2);
-        if (!(fabs(K * d1 * d1 * d2 * d2 - e2[i]) <= EV_GUARD * big))
-            return 0;
-    }
+    /* The roots' P~ = K |z - z1|^2 |z - z2|^2 (C0 = K): its coefficients, p0 + dp0 and so on; P~ - P is
+     * below the sum of their moduli at every phi */
+    const double complex pr = conj(z1) * conj(z2);
+    const double e1 = 1.0 - norm2(z1), e2_ = 1.0 - norm2(z2), A1 = 2.0 - e1, A2 = 2.0 - e2_;
+    const double dp0 = K * (A1 * A2 + 2.0 * creal(conj(z1) * z2)) - p0;
+    const double complex dc1 = -K * (A1 * conj(z2) + A2 * conj(z1)) - c1, dc2 = K * pr - c2;
+    if (!(fabs(dp0) + 2.0 * (mag(dc1) + mag(dc2)) <= EV_GUARD * big))
+        return 0;
     /* P's least also where a root is nearest the circle (a narrow dip between the samples), where the
      * roots must reproduce P to 1e-3 (the correction below is of first order) but for P's rounding */
     for (int k = 0; k < 2; k++) {
@@ -466,11 +468,7 @@ static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
             return 0;
         lo = pk < lo ? pk : lo;
     }
-    const double complex M = 0.5 * (z1 + z2), H = 0.5 * (z1 - z2), pr = conj(z1) * conj(z2);
-    /* The roots' P~ = K |z - z1|^2 |z - z2|^2 (C0 = K): its coefficients, p0 + dp0 and so on */
-    const double e1 = 1.0 - norm2(z1), e2_ = 1.0 - norm2(z2), A1 = 2.0 - e1, A2 = 2.0 - e2_;
-    const double dp0 = K * (A1 * A2 + 2.0 * creal(conj(z1) * z2)) - p0;
-    const double complex dc1 = -K * (A1 * conj(z2) + A2 * conj(z1)) - c1, dc2 = K * pr - c2;
+    const double complex M = 0.5 * (z1 + z2), H = 0.5 * (z1 - z2);
     /* w = (1 - z conj(z1)) (1 - z conj(z2)), each factor from its end, z = z1 - H (1 - cos alpha) =
      * z2 + H (1 + cos alpha): e_k + ..., no cancellation where it is small (a root near the circle) */
     const double complex g1 = conj(z1) * H, g2 = -conj(z2) * H;
