@@ -91,6 +91,12 @@ typedef struct {
     int odd;
 } trig4;
 
+/* even_mean's two roots inside the circle at the last section that took it, to start from */
+typedef struct {
+    double complex z[2];
+    int ok;
+} ev_hint;
+
 typedef struct {
     const harm_opts *o;
     const pde_solution *s;
@@ -102,6 +108,7 @@ typedef struct {
     size_t nodes, next_poll;
     int splits;                /* cuts at a dip of w left */
     int stopped;               /* o->cancel asked to stop */
+    ev_hint roots;             /* even_mean's last roots */
     size_t poll_every, max_nodes;
     /* Many harmonics (the section below): */
     int many, nh;              /* the harmonics along t are hj[0..nh - 1] */
@@ -398,6 +405,33 @@ static double complex polish(double complex b, double complex c, double complex 
 }
 
 /*
+ * Two roots of z^4 + b z^3 + c z^2 + d z + e, not a root's mirror 1 / conj(z), into r[0], r[1], from
+ * start[1] (the last section's root nearest the circle) by Newton, the other pair by deflation:
+ * returns 0 where Newton does not converge in a few steps (Ferrari's formulas then).
+ */
+static int deflated(double complex b, double complex c, double complex d, double complex e, const double complex *start,
+                    double complex *r)
+{
+    double complex z = start[1];
+    for (int it = 0;; it++) {
+        const double complex f = (((z + b) * z + c) * z + d) * z + e, fp = ((4.0 * z + 3.0 * b) * z + 2.0 * c) * z + d;
+        if (it == 12 || fp == 0.0)
+            return 0;
+        const double complex dz = f / fp;
+        z -= dz;
+        if (!(norm2(dz) > 1e-24 * norm2(z)))
+            break;
+    }
+    z = polish(b, c, d, e, z);
+    /* z^4 + ... = (z^2 - sum z + prod) (z^2 + B z + C), sum and prod of z and 1 / conj(z) */
+    const double complex zm = 1.0 / conj(z), sum = z + zm, prod = z * zm, B = b + sum, C = c + sum * B - prod;
+    double complex y[2];
+    quad_roots(B, C, y);
+    r[0] = z, r[1] = norm2(y[0]) < norm2(y[1]) ? y[0] : y[1];
+    return 1;
+}
+
+/*
  * The mean over theta of the element where its square has no odd harmonics (so in phi = 2 theta, the
  * sections of fig. 2 and 4: D' normal to A, B and their derivatives), without sampling the dips:
  *
@@ -419,7 +453,7 @@ static double complex polish(double complex b, double complex c, double complex 
  * a root lies on the circle (the element meets 0), the roots do not reproduce P to
  * EV_GUARD, or the rule did not converge. *dip: the least over the largest of the element.
  */
-static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
+static int even_mean(const trig4 *q, const double *e, ev_hint *hint, double *mean, double *dip)
 {
     const double p0 = q->a[0];
     const double complex c1 = 0.5 * (q->a[2] - I * q->b[2]), c2 = 0.5 * (q->a[4] - I * q->b[4]);
@@ -435,29 +469,40 @@ static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
     if (!(lo > 0.0))
         return 0;
     const double complex qb = c1 / c2, qc = p0 / c2, qd = conj(c1) / c2, qe = conj(c2) / c2;
-    double complex r[4], z1, z2;
-    quartic_roots(qb, qc, qd, qe, r);
-    /* the two inside, polished (a root's mirror 1 / conj(z) is one too) */
-    for (int i = 1; i < 4; i++)
-        for (int j = i; j > 0 && norm2(r[j]) < norm2(r[j - 1]); j--) {
-            const double complex t = r[j];
-            r[j] = r[j - 1], r[j - 1] = t;
+    double complex z1, z2, dc1, dc2;
+    double K, dp0, e1, e2_;
+    /* From a root of the last section that took this path (Newton a few steps along w, and the other
+     * pair by deflation), else by Ferrari's formulas: either way checked by P~ - P */
+    for (int warm = hint && hint->ok;; warm = 0) {
+        double complex r[4];
+        if (!(warm && deflated(qb, qc, qd, qe, hint->z, r))) {
+            warm = 0;
+            quartic_roots(qb, qc, qd, qe, r);
+            for (int i = 1; i < 4; i++)   /* the two inside first */
+                for (int j = i; j > 0 && norm2(r[j]) < norm2(r[j - 1]); j--) {
+                    const double complex t = r[j];
+                    r[j] = r[j - 1], r[j - 1] = t;
+                }
         }
-    for (int k = 0; k < 2; k++)
-        if (norm2(r[k] = polish(qb, qc, qd, qe, r[k])) > 1.0)
-            r[k] = 1.0 / conj(r[k]);
-    z1 = norm2(r[0]) <= norm2(r[1]) ? r[0] : r[1], z2 = norm2(r[0]) <= norm2(r[1]) ? r[1] : r[0];
-    if (!(norm2(z2) < 1.0))
-        return 0;
-    const double K = mag(c2) / (mag(z1) * mag(z2));
-    /* The roots' P~ = K |z - z1|^2 |z - z2|^2 (C0 = K): its coefficients, p0 + dp0 and so on; P~ - P is
-     * below the sum of their moduli at every phi */
-    const double complex pr = conj(z1) * conj(z2);
-    const double e1 = 1.0 - norm2(z1), e2_ = 1.0 - norm2(z2), A1 = 2.0 - e1, A2 = 2.0 - e2_;
-    const double dp0 = K * (A1 * A2 + 2.0 * creal(conj(z1) * z2)) - p0;
-    const double complex dc1 = -K * (A1 * conj(z2) + A2 * conj(z1)) - c1, dc2 = K * pr - c2;
-    if (!(fabs(dp0) + 2.0 * (mag(dc1) + mag(dc2)) <= EV_GUARD * big))
-        return 0;
+        /* the two inside, polished (a root's mirror 1 / conj(z) is one too) */
+        for (int k = 0; k < 2; k++)
+            if (norm2(r[k] = polish(qb, qc, qd, qe, r[k])) > 1.0)
+                r[k] = 1.0 / conj(r[k]);
+        z1 = norm2(r[0]) <= norm2(r[1]) ? r[0] : r[1], z2 = norm2(r[0]) <= norm2(r[1]) ? r[1] : r[0];
+        /* The roots' P~ = K |z - z1|^2 |z - z2|^2 (C0 = K): its coefficients, p0 + dp0 and so on; P~ - P
+         * is below the sum of their moduli at every phi */
+        K = mag(c2) / (mag(z1) * mag(z2));
+        e1 = 1.0 - norm2(z1), e2_ = 1.0 - norm2(z2);
+        const double A1 = 2.0 - e1, A2 = 2.0 - e2_;
+        dp0 = K * (A1 * A2 + 2.0 * creal(conj(z1) * z2)) - p0;
+        dc1 = -K * (A1 * conj(z2) + A2 * conj(z1)) - c1, dc2 = K * conj(z1) * conj(z2) - c2;
+        if (norm2(z2) < 1.0 && fabs(dp0) + 2.0 * (mag(dc1) + mag(dc2)) <= EV_GUARD * big)
+            break;
+        if (!warm)
+            return 0;
+    }
+    if (hint)
+        hint->z[0] = z1, hint->z[1] = z2, hint->ok = 1;
     /* P's least also where a root is nearest the circle (a narrow dip between the samples), where the
      * roots must reproduce P to 1e-3 (the correction below is of first order) but for P's rounding */
     for (int k = 0; k < 2; k++) {
@@ -510,7 +555,7 @@ static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
     return 0;
 }
 
-static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
+static double elem_mean(const harm_opts *o, const trig4 *q, ev_hint *hint, double *dip)
 {
     double ev;
     const int per = q->odd ? NT : NT / 2;
@@ -536,13 +581,13 @@ static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
         /* two levels agree; but where the samples dip deep, maybe by chance (the k = 4 stress model's
          * face, at some w: 4.6e-8 off), so even_mean there where it can */
         if (fabs(next - mean) <= TRAP_TOL * next)
-            return q->odd || !(*dip < DEEP) || !even_mean(q, e, &ev, dip) ? next : ev;
+            return q->odd || !(*dip < DEEP) || !even_mean(q, e, hint, &ev, dip) ? next : ev;
         /* slow to converge: a dip, which even_mean takes at a fixed cost */
-        if (!q->odd && stride <= NT / 2 / N0 && fabs(next - mean) > EV_SWITCH * next && even_mean(q, e, &ev, dip))
+        if (!q->odd && stride <= NT / 2 / N0 && fabs(next - mean) > EV_SWITCH * next && even_mean(q, e, hint, &ev, dip))
             return ev;
         mean = next;
     }
-    if (!q->odd && stride <= NT / 2 / N0 && even_mean(q, e, &ev, dip))
+    if (!q->odd && stride <= NT / 2 / N0 && even_mean(q, e, hint, &ev, dip))
         return ev;
     const double period = per * (2.0 * M_PI / NT);
     /* the cuts: every least value of the element, isolated by bounds (minima), not at the least
@@ -640,7 +685,7 @@ double harm_mean(const double v[5][3], const double *x, const double *wt, int n)
     memcpy(q.v, v, sizeof q.v);
     square(&q);
     pthread_once(&trig_once, trig_init);
-    return elem_mean(&o, &q, &dip);
+    return elem_mean(&o, &q, NULL, &dip);
 }
 
 /* At w: val[0] the element's mean over theta, val[1] the flux's; the least of the element over its
@@ -653,7 +698,7 @@ static void at_w(void *arg, double w, double *val)
     trig4 q;
     double dip;
     val[1] = section(H, w, &q);
-    val[0] = elem_mean(H->o, &q, &dip);
+    val[0] = elem_mean(H->o, &q, &H->roots, &dip);
     if (dip < H->dip)
         H->dip = dip, H->dip_at = w;
 }
