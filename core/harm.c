@@ -785,7 +785,8 @@ static double dip_place(harm_ctx *H, double a, double b)
  * Along w, each panel's 10-point Gauss rule, then its 21-point Kronrod extension (QUADPACK's qk21 on
  * [-1, 1]: xgk[1], xgk[3], ... the Gauss rule's nodes, wg its weights): 11 points more where halving
  * took 20, the Gauss points kept for it (wpanel). Where the two differ, the halves' Gauss rules, the
- * children's own. A face of many harmonics (a loft's) against its halves still (outer).
+ * children's own, which keep the Kronrod rule where they agree with it to HALVES_AGREE of the
+ * tolerance. A face of many harmonics (a loft's) against its halves still (outer).
  */
 static const double xgk[11] = { 0.995657163025808080735527280689003, 0.973906528517171720077964012084452,
                                 0.930157491355708226001207180059508, 0.865063366688984510732096688423493,
