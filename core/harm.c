@@ -728,16 +728,19 @@ static double least_at(harm_ctx *H, double w)
  * kink (a section that degenerates), so the parabolas land on w0 in a few steps where golden section
  * took 34 (fig. 2c: 324 points of w for 9 cuts). To DIP_EPS of the interval, or a few ulps of w where
  * the interval is too short for that (nested pieces of a dip: below about 1e-9 it never ended), and
- * in at most DIP_STEPS steps.
+ * in at most DIP_STEPS steps; lo or hi once every point left is below lo or above hi.
  */
 #define DIP_STEPS 48
-static double dip_place(harm_ctx *H, double a, double b)
+static double dip_place(harm_ctx *H, double a, double b, double lo, double hi)
 {
     const double g = 0.5 * (3.0 - sqrt(5.0)), tol = 0.25 * fmax(DIP_EPS * (b - a), 4.0 * DBL_EPSILON * fabs(b));
     double x = a + g * (b - a), w = x, v = x, d = 0.0, e = 0.0, fx = least_at(H, x);
     fx *= fx;
     double fw = fx, fv = fx;
     for (int it = 0; it < DIP_STEPS; it++) {
+        if (b <= lo || a >= hi)   /* the caller's snapping takes it to its end: a cut made before, where
+                                   * it took golden section 20 steps more */
+            return b <= lo ? lo : hi;
         const double mid = 0.5 * (a + b);
         if (fabs(x - mid) <= 2.0 * tol - 0.5 * (b - a))
             break;
@@ -912,8 +915,8 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
     if (split && H->dip < DIP && H->splits > 0) {   /* the Kronrod points' dip: no halves where it is cut */
         H->splits--;
         const double q = 0.125 * (b - a), near = 1e3 * DIP_EPS * (b - a);
-        double w0 = dip_place(H, fmax(a, H->dip_at - q), fmin(b, H->dip_at + q));
-        w0 = w0 - a <= near ? a : b - w0 <= near ? b : w0;
+        double w0 = dip_place(H, fmax(a, H->dip_at - q), fmin(b, H->dip_at + q), a + near, b - near);
+        w0 = w0 <= a + near ? a : w0 >= b - near ? b : w0;
         if (split == 2 || (w0 > a && w0 < b))   /* at an end, graded towards it from one side */
             return (w0 == a || outer_toward(H, w0, a - w0, depth + 1, out)) &&
                    (w0 == b || outer_toward(H, w0, b - w0, depth + 1, out));
