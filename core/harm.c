@@ -40,6 +40,9 @@
 #define U_LEVELS 2      /* ... or, where its width is known, this many such pieces, */
 #define U_NEAR 8.0      /* ... while the distance left is above this of the width, */
 #define U_WIDTH 2.0     /* ... and the rest in panels of u (s = width sinh u) this wide */
+#define HALVES_AGREE 1e-2 /* a panel whose Kronrod rule fails against its Gauss rule keeps it where its halves'
+                          * Gauss rules agree with it to this of the tolerance (at the tolerance itself,
+                          * fig. 4x's area moved by 7.7e-13) */
 #define DIP 0.05        /* a panel of w that fails its halves with the element below this of its largest */
 #define DIP_EPS 1e-7    /* ... is cut at the least place, located to this of the panel, */
 #define W_GRADE 0.1     /* ... and graded towards it, each piece this of the distance left, */
@@ -57,7 +60,7 @@
 #define EV_MAP 0.05     /* ... alpha(beta) where a root lies within this of the circle, else alpha = beta */
 #define EV_SWITCH 1e-3  /* the trapezoidal rule's levels, from N0 points over pi, differ by more than this
                          * relative: even_mean instead of its next levels */
-#define EV_GUARD 1e-8   /* the roots reproduce the element's square at the samples to this of its largest */
+#define EV_GUARD 1e-8   /* the roots reproduce the element's square to this of its largest sample (a bound over the circle) */
 
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
@@ -88,6 +91,12 @@ typedef struct {
     int odd;
 } trig4;
 
+/* even_mean's two roots inside the circle at the last section that took it, to start from */
+typedef struct {
+    double complex z[2];
+    int ok;
+} ev_hint;
+
 typedef struct {
     const harm_opts *o;
     const pde_solution *s;
@@ -99,6 +108,7 @@ typedef struct {
     size_t nodes, next_poll;
     int splits;                /* cuts at a dip of w left */
     int stopped;               /* o->cancel asked to stop */
+    ev_hint roots;             /* even_mean's last roots */
     size_t poll_every, max_nodes;
     /* Many harmonics (the section below): */
     int many, nh;              /* the harmonics along t are hj[0..nh - 1] */
@@ -395,6 +405,33 @@ static double complex polish(double complex b, double complex c, double complex 
 }
 
 /*
+ * Two roots of z^4 + b z^3 + c z^2 + d z + e, not a root's mirror 1 / conj(z), into r[0], r[1], from
+ * start[1] (the last section's root nearest the circle) by Newton, the other pair by deflation:
+ * returns 0 where Newton does not converge in a few steps (Ferrari's formulas then).
+ */
+static int deflated(double complex b, double complex c, double complex d, double complex e, const double complex *start,
+                    double complex *r)
+{
+    double complex z = start[1];
+    for (int it = 0;; it++) {
+        const double complex f = (((z + b) * z + c) * z + d) * z + e, fp = ((4.0 * z + 3.0 * b) * z + 2.0 * c) * z + d;
+        if (it == 12 || fp == 0.0)
+            return 0;
+        const double complex dz = f / fp;
+        z -= dz;
+        if (!(norm2(dz) > 1e-24 * norm2(z)))
+            break;
+    }
+    z = polish(b, c, d, e, z);
+    /* z^4 + ... = (z^2 - sum z + prod) (z^2 + B z + C), sum and prod of z and 1 / conj(z) */
+    const double complex zm = 1.0 / conj(z), sum = z + zm, prod = z * zm, B = b + sum, C = c + sum * B - prod;
+    double complex y[2];
+    quad_roots(B, C, y);
+    r[0] = z, r[1] = norm2(y[0]) < norm2(y[1]) ? y[0] : y[1];
+    return 1;
+}
+
+/*
  * The mean over theta of the element where its square has no odd harmonics (so in phi = 2 theta, the
  * sections of fig. 2 and 4: D' normal to A, B and their derivatives), without sampling the dips:
  *
@@ -413,10 +450,10 @@ static double complex polish(double complex b, double complex c, double complex 
  * the ends) takes that to about its cube root, and the trapezoidal rule in beta, the integrand even
  * and periodic, converges geometrically: EV_N0, 2 EV_N0, ... points until two levels agree. The sign
  * is m0's: positive. Returns 0 (the sampled path then) where c2 is small (a root near 0 or infinity),
- * a root lies on the circle (the element meets 0), the roots do not reproduce P at the samples to
+ * a root lies on the circle (the element meets 0), the roots do not reproduce P to
  * EV_GUARD, or the rule did not converge. *dip: the least over the largest of the element.
  */
-static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
+static int even_mean(const trig4 *q, const double *e, ev_hint *hint, double *mean, double *dip)
 {
     const double p0 = q->a[0];
     const double complex c1 = 0.5 * (q->a[2] - I * q->b[2]), c2 = 0.5 * (q->a[4] - I * q->b[4]);
@@ -432,27 +469,40 @@ static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
     if (!(lo > 0.0))
         return 0;
     const double complex qb = c1 / c2, qc = p0 / c2, qd = conj(c1) / c2, qe = conj(c2) / c2;
-    double complex r[4], z1, z2;
-    quartic_roots(qb, qc, qd, qe, r);
-    /* the two inside, polished (a root's mirror 1 / conj(z) is one too) */
-    for (int i = 1; i < 4; i++)
-        for (int j = i; j > 0 && norm2(r[j]) < norm2(r[j - 1]); j--) {
-            const double complex t = r[j];
-            r[j] = r[j - 1], r[j - 1] = t;
+    double complex z1, z2, dc1, dc2;
+    double K, dp0, e1, e2_;
+    /* From a root of the last section that took this path (Newton a few steps along w, and the other
+     * pair by deflation), else by Ferrari's formulas: either way checked by P~ - P */
+    for (int warm = hint && hint->ok;; warm = 0) {
+        double complex r[4];
+        if (!(warm && deflated(qb, qc, qd, qe, hint->z, r))) {
+            warm = 0;
+            quartic_roots(qb, qc, qd, qe, r);
+            for (int i = 1; i < 4; i++)   /* the two inside first */
+                for (int j = i; j > 0 && norm2(r[j]) < norm2(r[j - 1]); j--) {
+                    const double complex t = r[j];
+                    r[j] = r[j - 1], r[j - 1] = t;
+                }
         }
-    for (int k = 0; k < 2; k++)
-        if (norm2(r[k] = polish(qb, qc, qd, qe, r[k])) > 1.0)
-            r[k] = 1.0 / conj(r[k]);
-    z1 = norm2(r[0]) <= norm2(r[1]) ? r[0] : r[1], z2 = norm2(r[0]) <= norm2(r[1]) ? r[1] : r[0];
-    if (!(norm2(z2) < 1.0))
-        return 0;
-    const double K = mag(c2) / (mag(z1) * mag(z2));
-    for (int i = 0; i < N0; i++) {
-        const double complex z = trig[stride * i][1] + I * trig[stride * i][5];
-        const double d1 = mag(z - z1), d2 = mag(z - z2);
-        if (!(fabs(K * d1 * d1 * d2 * d2 - e2[i]) <= EV_GUARD * big))
+        /* the two inside, polished (a root's mirror 1 / conj(z) is one too) */
+        for (int k = 0; k < 2; k++)
+            if (norm2(r[k] = polish(qb, qc, qd, qe, r[k])) > 1.0)
+                r[k] = 1.0 / conj(r[k]);
+        z1 = norm2(r[0]) <= norm2(r[1]) ? r[0] : r[1], z2 = norm2(r[0]) <= norm2(r[1]) ? r[1] : r[0];
+        /* The roots' P~ = K |z - z1|^2 |z - z2|^2 (C0 = K): its coefficients, p0 + dp0 and so on; P~ - P
+         * is below the sum of their moduli at every phi */
+        K = mag(c2) / (mag(z1) * mag(z2));
+        e1 = 1.0 - norm2(z1), e2_ = 1.0 - norm2(z2);
+        const double A1 = 2.0 - e1, A2 = 2.0 - e2_;
+        dp0 = K * (A1 * A2 + 2.0 * creal(conj(z1) * z2)) - p0;
+        dc1 = -K * (A1 * conj(z2) + A2 * conj(z1)) - c1, dc2 = K * conj(z1) * conj(z2) - c2;
+        if (norm2(z2) < 1.0 && fabs(dp0) + 2.0 * (mag(dc1) + mag(dc2)) <= EV_GUARD * big)
+            break;
+        if (!warm)
             return 0;
     }
+    if (hint)
+        hint->z[0] = z1, hint->z[1] = z2, hint->ok = 1;
     /* P's least also where a root is nearest the circle (a narrow dip between the samples), where the
      * roots must reproduce P to 1e-3 (the correction below is of first order) but for P's rounding */
     for (int k = 0; k < 2; k++) {
@@ -463,11 +513,7 @@ static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
             return 0;
         lo = pk < lo ? pk : lo;
     }
-    const double complex M = 0.5 * (z1 + z2), H = 0.5 * (z1 - z2), pr = conj(z1) * conj(z2);
-    /* The roots' P~ = K |z - z1|^2 |z - z2|^2 (C0 = K): its coefficients, p0 + dp0 and so on */
-    const double e1 = 1.0 - norm2(z1), e2_ = 1.0 - norm2(z2), A1 = 2.0 - e1, A2 = 2.0 - e2_;
-    const double dp0 = K * (A1 * A2 + 2.0 * creal(conj(z1) * z2)) - p0;
-    const double complex dc1 = -K * (A1 * conj(z2) + A2 * conj(z1)) - c1, dc2 = K * pr - c2;
+    const double complex M = 0.5 * (z1 + z2), H = 0.5 * (z1 - z2);
     /* w = (1 - z conj(z1)) (1 - z conj(z2)), each factor from its end, z = z1 - H (1 - cos alpha) =
      * z2 + H (1 + cos alpha): e_k + ..., no cancellation where it is small (a root near the circle) */
     const double complex g1 = conj(z1) * H, g2 = -conj(z2) * H;
@@ -509,7 +555,7 @@ static int even_mean(const trig4 *q, const double *e, double *mean, double *dip)
     return 0;
 }
 
-static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
+static double elem_mean(const harm_opts *o, const trig4 *q, ev_hint *hint, double *dip)
 {
     double ev;
     const int per = q->odd ? NT : NT / 2;
@@ -535,13 +581,13 @@ static double elem_mean(const harm_opts *o, const trig4 *q, double *dip)
         /* two levels agree; but where the samples dip deep, maybe by chance (the k = 4 stress model's
          * face, at some w: 4.6e-8 off), so even_mean there where it can */
         if (fabs(next - mean) <= TRAP_TOL * next)
-            return q->odd || !(*dip < DEEP) || !even_mean(q, e, &ev, dip) ? next : ev;
+            return q->odd || !(*dip < DEEP) || !even_mean(q, e, hint, &ev, dip) ? next : ev;
         /* slow to converge: a dip, which even_mean takes at a fixed cost */
-        if (!q->odd && stride <= NT / 2 / N0 && fabs(next - mean) > EV_SWITCH * next && even_mean(q, e, &ev, dip))
+        if (!q->odd && stride <= NT / 2 / N0 && fabs(next - mean) > EV_SWITCH * next && even_mean(q, e, hint, &ev, dip))
             return ev;
         mean = next;
     }
-    if (!q->odd && stride <= NT / 2 / N0 && even_mean(q, e, &ev, dip))
+    if (!q->odd && stride <= NT / 2 / N0 && even_mean(q, e, hint, &ev, dip))
         return ev;
     const double period = per * (2.0 * M_PI / NT);
     /* the cuts: every least value of the element, isolated by bounds (minima), not at the least
@@ -639,7 +685,7 @@ double harm_mean(const double v[5][3], const double *x, const double *wt, int n)
     memcpy(q.v, v, sizeof q.v);
     square(&q);
     pthread_once(&trig_once, trig_init);
-    return elem_mean(&o, &q, &dip);
+    return elem_mean(&o, &q, NULL, &dip);
 }
 
 /* At w: val[0] the element's mean over theta, val[1] the flux's; the least of the element over its
@@ -652,7 +698,7 @@ static void at_w(void *arg, double w, double *val)
     trig4 q;
     double dip;
     val[1] = section(H, w, &q);
-    val[0] = elem_mean(H->o, &q, &dip);
+    val[0] = elem_mean(H->o, &q, &H->roots, &dip);
     if (dip < H->dip)
         H->dip = dip, H->dip_at = w;
 }
@@ -676,33 +722,74 @@ static double least_at(harm_ctx *H, double w)
     return m;
 }
 
-/* By golden section: where the element's least over theta is least in [a, b]. To DIP_EPS of the interval, or
- * a few ulps of w where the interval is too short for that (nested pieces of a dip: below about 1e-9 it never
- * ended), and in at most DIP_STEPS steps (DIP_EPS takes 34). */
+/*
+ * Where the element's least over theta is least in [a, b], by Brent's minimisation (golden section and
+ * parabolas) of its square: about g^2 (w - w0)^2 + m0^2 there, a parabola where the least itself has a
+ * kink (a section that degenerates), so the parabolas land on w0 in a few steps where golden section
+ * took 34 (fig. 2c: 324 points of w for 9 cuts). To DIP_EPS of the interval, or a few ulps of w where
+ * the interval is too short for that (nested pieces of a dip: below about 1e-9 it never ended), and
+ * in at most DIP_STEPS steps; lo or hi once every point left is below lo or above hi.
+ */
 #define DIP_STEPS 48
-static double dip_place(harm_ctx *H, double a, double b)
+static double dip_place(harm_ctx *H, double a, double b, double lo, double hi)
 {
-    const double g = 0.5 * (3.0 - sqrt(5.0)), len = b - a, stop = fmax(DIP_EPS * len, 4.0 * DBL_EPSILON * fabs(b));
-    double c = a + g * (b - a), d = b - g * (b - a), fc = least_at(H, c), fd = least_at(H, d);
-    for (int it = 0; b - a > stop && it < DIP_STEPS; it++) {
-        if (fc < fd) {
-            b = d, d = c, fd = fc;
-            c = a + g * (b - a);
-            fc = least_at(H, c);
+    const double g = 0.5 * (3.0 - sqrt(5.0)), tol = 0.25 * fmax(DIP_EPS * (b - a), 4.0 * DBL_EPSILON * fabs(b));
+    double x = a + g * (b - a), w = x, v = x, d = 0.0, e = 0.0, fx = least_at(H, x);
+    fx *= fx;
+    double fw = fx, fv = fx;
+    for (int it = 0; it < DIP_STEPS; it++) {
+        if (b <= lo || a >= hi)   /* the caller's snapping takes it to its end: a cut made before, where
+                                   * it took golden section 20 steps more */
+            return b <= lo ? lo : hi;
+        const double mid = 0.5 * (a + b);
+        if (fabs(x - mid) <= 2.0 * tol - 0.5 * (b - a))
+            break;
+        int golden = 1;
+        if (fabs(e) > tol) {   /* the parabola through x, w and v, where it steps inside and shrinks */
+            const double r = (x - w) * (fx - fv), q0 = (x - v) * (fx - fw);
+            double p = (x - v) * q0 - (x - w) * r, q = 2.0 * (q0 - r);
+            if (q > 0.0)
+                p = -p;
+            else
+                q = -q;
+            if (fabs(p) < fabs(0.5 * q * e) && p > q * (a - x) && p < q * (b - x)) {
+                e = d, d = p / q;
+                if (x + d - a < 2.0 * tol || b - (x + d) < 2.0 * tol)
+                    d = x < mid ? tol : -tol;
+                golden = 0;
+            }
+        }
+        if (golden)
+            e = (x < mid ? b : a) - x, d = g * e;
+        const double u = x + (fabs(d) >= tol ? d : d > 0.0 ? tol : -tol);
+        double fu = least_at(H, u);
+        fu *= fu;
+        if (fu <= fx) {
+            if (u < x)
+                b = x;
+            else
+                a = x;
+            v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
         } else {
-            a = c, c = d, fc = fd;
-            d = b - g * (b - a);
-            fd = least_at(H, d);
+            if (u < x)
+                a = u;
+            else
+                b = u;
+            if (fu <= fw || w == x)
+                v = w, fv = fw, w = u, fw = fu;
+            else if (fu <= fv || v == x || v == w)
+                v = u, fv = fu;
         }
     }
-    return fc < fd ? c : d;
+    return x;
 }
 
 /*
  * Along w, each panel's 10-point Gauss rule, then its 21-point Kronrod extension (QUADPACK's qk21 on
  * [-1, 1]: xgk[1], xgk[3], ... the Gauss rule's nodes, wg its weights): 11 points more where halving
  * took 20, the Gauss points kept for it (wpanel). Where the two differ, the halves' Gauss rules, the
- * children's own. A face of many harmonics (a loft's) against its halves still (outer).
+ * children's own, which keep the Kronrod rule where they agree with it to HALVES_AGREE of the
+ * tolerance. A face of many harmonics (a loft's) against its halves still (outer).
  */
 static const double xgk[11] = { 0.995657163025808080735527280689003, 0.973906528517171720077964012084452,
                                 0.930157491355708226001207180059508, 0.865063366688984510732096688423493,
@@ -825,19 +912,27 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
     }
     if (depth >= DEPTH)
         return 0;
-    if (!H->many) {
-        rule_w(H, a, m, &l);
-        rule_w(H, m, b, &r);
-    }
-    if (split && H->dip < DIP && H->splits > 0) {
+    if (split && H->dip < DIP && H->splits > 0) {   /* the Kronrod points' dip: no halves where it is cut */
         H->splits--;
         const double q = 0.125 * (b - a), near = 1e3 * DIP_EPS * (b - a);
-        double w0 = dip_place(H, fmax(a, H->dip_at - q), fmin(b, H->dip_at + q));
-        w0 = w0 - a <= near ? a : b - w0 <= near ? b : w0;
+        double w0 = dip_place(H, fmax(a, H->dip_at - q), fmin(b, H->dip_at + q), a + near, b - near);
+        w0 = w0 <= a + near ? a : w0 >= b - near ? b : w0;
         if (split == 2 || (w0 > a && w0 < b))   /* at an end, graded towards it from one side */
             return (w0 == a || outer_toward(H, w0, a - w0, depth + 1, out)) &&
                    (w0 == b || outer_toward(H, w0, b - w0, depth + 1, out));
         split = 0;   /* the dip is at an end, where a cut was: halves */
+    }
+    if (!H->many) {   /* the halves' Gauss rules, more accurate than the panel's, may confirm K */
+        rule_w(H, a, m, &l);
+        rule_w(H, m, b, &r);
+        ok = 1;
+        for (int k = 0; k < 2; k++)
+            ok &= fabs(K[k] - (l.sum[k] + r.sum[k])) <= HALVES_AGREE * fmax(H->tol[k] * (b - a), NOISE * fabs(K[k]));
+        if (ok) {
+            for (int k = 0; k < 2; k++)
+                out[k] += K[k];
+            return 1;
+        }
     }
     return outer(H, a, m, &l, depth + 1, split, out) && outer(H, m, b, &r, depth + 1, split, out);
 }
