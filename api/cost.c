@@ -62,7 +62,7 @@
 #define K_PT_F32   1.0    /* a sample written as f32 */
 #define K_TABLE_BYTE 0.25 /* a byte of a grid's v-table read from memory, a plane's pass (sweep_work) */
 #define K_FMT_F32  17.0   /* a float32 printed for grid json */
-#define K_VOL_POINT 600.0 /* a point of a volume mesh's build beyond its evaluation (api/volmesh.c) */
+#define K_VOL_POINT 100.0 /* a point of a volume mesh's build beyond its evaluation (api/volmesh.c) */
 #define K_DET      4.0    /* det J of a vts point */
 #define K_WELD     60.0   /* a face sample welded */
 #define K_TRI      40.0   /* a face triangle cleaned, cancelled or indexed, with its normals */
@@ -427,14 +427,17 @@ void api_cost_volmesh(const pde_solution *sol, const unsigned res[3], double wri
     double cells = (double)(res[0] - 1) * (res[1] - 1) * (res[2] - 1);
     comp_stats st[3];
     stats_of(sol, st);
-    /* Every point through pde_eval_d (with its derivatives, for det J), each cell's centre too; the
-     * build's own work beyond the evaluations (merging, cells, folds, the faces' quads: K_VOL_POINT a
-     * point, 50 a cell); then the writer's, write_point a point (its share of the cells included).
-     * Calibrated on fig1a (cheap points) and fig4a at res 80 (docs/BENCHMARKS.md). */
-    c->work = (n + cells) * point_cost(st) + (K_VOL_POINT + write_point) * n + 50.0 * cells;
-    /* Points (24 + 4), cells (32 + 4 + 2), the faces' quads; a writer's piece of text (about 1 MB) and the
-     * output's buffer holding it (bench_cost: fig4a at 33^3 peaks at 5.5 MB). */
-    c->bytes = 28.0 * n + 38.0 * cells + 16.0 * 2.0 * (n / fmax(1.0, res[0])) + (4 << 20);
+    /* The samples (x and its derivatives, for det J) and the cells' centres (the derivatives) through
+     * two pde_grids, rows in double precision (grid_row's contiguous combine); the build's own work
+     * beyond them (merging, cells, folds, the faces' quads: K_VOL_POINT a point, 50 a cell); then the
+     * writer's, write_point a point (its share of the cells included). Calibrated on fig1a (cheap
+     * points) and fig4a at res 80 (docs/BENCHMARKS.md). */
+    const double nu = res[0], nv = res[1], nw = res[2];
+    c->work = sweep_work(st, nu, nv, nw, 4.0, 1) + sweep_work(st, nu - 1.0, nv - 1.0, nw - 1.0, 3.0, 1) +
+              K_DET * (n + cells) + (K_VOL_POINT + write_point) * n + 50.0 * cells;
+    /* Points (24 + 8 + 4), cells (8 + 32 + 4 + 2), the faces' quads, a grid's tables; a writer's piece
+     * of text (about 1 MB) and the output's buffer holding it (bench_cost: fig4a at 33^3 peaks at 5.5 MB). */
+    c->bytes = 36.0 * n + 46.0 * cells + 16.0 * 2.0 * (n / fmax(1.0, nu)) + grid_bytes(st, nu, nv) + (4 << 20);
 }
 
 void api_cost_json(const pde_solution *sol, const unsigned res[3], const api_output_opts *opts, api_cost *c)

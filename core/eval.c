@@ -646,6 +646,23 @@ void pde_grid_plane(pde_grid *g, double w, float *xyz)
     pde_grid_plane_d(g, w, xyz, NULL, NULL, NULL);
 }
 
+void pde_grid_row_d(pde_grid *g, double w, size_t j, double *xyz, double *xu, double *xv, double *xw)
+{
+    double *const outs[4] = { xyz, xu, xv, xw };   /* GRID_X, GRID_XU, GRID_XV, GRID_XW */
+    unsigned want = 0;
+    for (int a = 0; a < 4; a++)
+        want |= outs[a] ? 1u << a : 0u;
+    grid_set_w(g, w);
+    grid_row(g, j, want);
+    for (int a = 0; a < 4; a++) {
+        if (!outs[a])
+            continue;
+        for (int c = 0; c < 3; c++)
+            for (size_t i = 0; i < g->nu; i++)
+                outs[a][3 * i + c] = g->row[(3 * a + c) * g->nu + i];
+    }
+}
+
 pde_status pde_sample(const pde_solution *sol, size_t nu, size_t nv, size_t nw, float *out)
 {
     if (!sol || !out || nu == 0 || nv == 0 || nw == 0)

@@ -283,6 +283,10 @@ void pde_grid_plane_d(pde_grid *grid, double w, float *xyz, float *xu, float *xv
 void pde_grid_rows(pde_grid *grid, double w, size_t j0, size_t j1, float *xyz, float *xu, float *xv,
                    float *xw);
 
+/* Row j of the plane w in double precision, for outputs that keep it (volume meshes): x, y, z
+ * interleaved (3 nu doubles), and dx/du, dx/dv, dx/dw the same way (each may be NULL). */
+void pde_grid_row_d(pde_grid *grid, double w, size_t j, double *xyz, double *xu, double *xv, double *xw);
+
 /* Samples i/(n-1) on each axis (0.5 when n = 1) into out, 3 nu nv nw floats. */
 pde_status pde_sample(const pde_solution *sol, size_t nu, size_t nv, size_t nw, float *out);
 
