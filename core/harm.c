@@ -728,60 +728,35 @@ static double least_at(harm_ctx *H, double w)
  * kink (a section that degenerates), so the parabolas land on w0 in a few steps where golden section
  * took 34 (fig. 2c: 324 points of w for 9 cuts). To DIP_EPS of the interval, or a few ulps of w where
  * the interval is too short for that (nested pieces of a dip: below about 1e-9 it never ended), and
- * in at most DIP_STEPS steps; lo or hi once every point left is below lo or above hi.
+ * in at most DIP_STEPS steps; ended once every point left is below lo or above hi, where the caller's
+ * snapping takes it to the panel's end (a cut made before: golden section took 20 steps more).
  */
 #define DIP_STEPS 48
+struct dip_ctx {
+    harm_ctx *H;
+    double lo, hi;
+};
+
+static double least_sq(void *arg, double w)
+{
+    const double m = least_at(((struct dip_ctx *)arg)->H, w);
+    return m * m;
+}
+
+static int dip_outside(void *arg, double a, double b, double x, double fx)
+{
+    const struct dip_ctx *c = arg;
+    (void)x, (void)fx;
+    return b <= c->lo || a >= c->hi;
+}
+
 static double dip_place(harm_ctx *H, double a, double b, double lo, double hi)
 {
-    const double g = 0.5 * (3.0 - sqrt(5.0)), tol = 0.25 * fmax(DIP_EPS * (b - a), 4.0 * DBL_EPSILON * fabs(b));
-    double x = a + g * (b - a), w = x, v = x, d = 0.0, e = 0.0, fx = least_at(H, x);
-    fx *= fx;
-    double fw = fx, fv = fx;
-    for (int it = 0; it < DIP_STEPS; it++) {
-        if (b <= lo || a >= hi)   /* the caller's snapping takes it to its end: a cut made before, where
-                                   * it took golden section 20 steps more */
-            return b <= lo ? lo : hi;
-        const double mid = 0.5 * (a + b);
-        if (fabs(x - mid) <= 2.0 * tol - 0.5 * (b - a))
-            break;
-        int golden = 1;
-        if (fabs(e) > tol) {   /* the parabola through x, w and v, where it steps inside and shrinks */
-            const double r = (x - w) * (fx - fv), q0 = (x - v) * (fx - fw);
-            double p = (x - v) * q0 - (x - w) * r, q = 2.0 * (q0 - r);
-            if (q > 0.0)
-                p = -p;
-            else
-                q = -q;
-            if (fabs(p) < fabs(0.5 * q * e) && p > q * (a - x) && p < q * (b - x)) {
-                e = d, d = p / q;
-                if (x + d - a < 2.0 * tol || b - (x + d) < 2.0 * tol)
-                    d = x < mid ? tol : -tol;
-                golden = 0;
-            }
-        }
-        if (golden)
-            e = (x < mid ? b : a) - x, d = g * e;
-        const double u = x + (fabs(d) >= tol ? d : d > 0.0 ? tol : -tol);
-        double fu = least_at(H, u);
-        fu *= fu;
-        if (fu <= fx) {
-            if (u < x)
-                b = x;
-            else
-                a = x;
-            v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
-        } else {
-            if (u < x)
-                a = u;
-            else
-                b = u;
-            if (fu <= fw || w == x)
-                v = w, fv = fw, w = u, fw = fu;
-            else if (fu <= fv || v == x || v == w)
-                v = u, fv = fu;
-        }
-    }
-    return x;
+    struct dip_ctx c = { H, lo, hi };
+    const brent_fn fn = { least_sq, dip_outside, &c };
+    const double x = a + 0.5 * (3.0 - sqrt(5.0)) * (b - a), tol = 0.25 * DIP_EPS * (b - a);
+    double fx;
+    return brent_min(&fn, a, b, x, least_sq(&c, x), tol, DIP_STEPS, &fx);
 }
 
 /*

@@ -192,4 +192,20 @@ enum { GRID_X = 1, GRID_XU = 2, GRID_XV = 4, GRID_XW = 8 };
 void grid_set_w(pde_grid *g, double w);
 void grid_row(pde_grid *g, size_t j, unsigned want);
 
+/* search.c: f's root in [a, b], where fa = f(a) and fb = f(b) have opposite signs (Illinois). */
+double illinois(double (*f)(void *, double), void *arg, double a, double b, double fa, double fb);
+
+/* A function to minimise, and an early end: enough(arg, a, b, x, fx), asked before each step with
+ * the bracket [a, b] and the best point so far (NULL: none). */
+typedef struct {
+    double (*f)(void *arg, double t);
+    int (*enough)(void *arg, double a, double b, double x, double fx);
+    void *arg;
+} brent_fn;
+
+/* f's least in [a, b] by Brent's method from x inside (fx = f(x)), to tol + 2 eps |x|, in at most
+ * steps evaluations: returns the place, its value into *fmin. */
+double brent_min(const brent_fn *fn, double a, double b, double x, double fx, double tol, int steps,
+                 double *fmin);
+
 #endif

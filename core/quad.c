@@ -396,32 +396,6 @@ static void add_value(qctx *q, const double x[3], double j, double wt)
     acc[Q_SIGNED] += wt * j;
 }
 
-/* The root of f in [a, b], where fa = f(a) and fb = f(b) have opposite signs (Illinois). */
-static double illinois(double (*f)(void *, double), void *arg, double a, double b, double fa, double fb)
-{
-    double c = 0.5 * (a + b);
-    for (int it = 0, side = 0; it < 100 && b - a > 4 * DBL_EPSILON * fmax(fabs(a), fabs(b)); it++) {
-        c = (a * fb - b * fa) / (fb - fa);
-        if (!(c > a && c < b))
-            c = 0.5 * (a + b);
-        double fc = f(arg, c);
-        if (fc == 0.0)
-            break;
-        if ((fc < 0) == (fa < 0)) {
-            a = c, fa = fc;
-            if (side == -1)
-                fb *= 0.5;
-            side = -1;
-        } else {
-            b = c, fb = fc;
-            if (side == 1)
-                fa *= 0.5;
-            side = 1;
-        }
-    }
-    return c;
-}
-
 static double line_detj(void *arg, double t)
 {
     double x[3];
@@ -1274,6 +1248,23 @@ static double free_root(free_ctx *f, double a, double b, double ga, double gb)
     return r;
 }
 
+struct free_dip_ctx {
+    free_ctx *f;
+    double sign, stop;
+};
+
+static double free_signed(void *arg, double w)
+{
+    const struct free_dip_ctx *c = arg;
+    return c->sign * free_detj(c->f, w);
+}
+
+static int free_crossed(void *arg, double a, double b, double x, double fx)
+{
+    (void)a, (void)b, (void)x;
+    return fx < ((const struct free_dip_ctx *)arg)->stop;
+}
+
 /* The extreme of sign * G between t0 and t2, from the least sample t1 inside (f1 = sign * G there), by
  * Brent's minimiser (golden section, and parabolic steps where they fall inside): to 1e-9 of t2 - t0
  * as line_dip's golden section, in about a quarter of its points where G is smooth at that scale
@@ -1286,56 +1277,15 @@ static int free_dip(free_ctx *f, double t0, double t1, double f1, double t2, dou
             *at = f->dip_at[i], *fat = f->dip_f[i];
             return sign * *fat < -f->q->jtol;
         }
-    const double gold = 0.5 * (3.0 - sqrt(5.0)), tol = 0.25e-9 * (t2 - t0), stop = -f->q->jtol;
-    double a = t0, b = t2, x = t1, w = t1, v = t1, fx = f1, fw = f1, fv = f1, d = 0.0, e = 0.0;
-    for (int it = 0; it < 60 && fx >= stop; it++) {
-        const double m = 0.5 * (a + b), tol1 = tol + 2.0 * DBL_EPSILON * fabs(x), tol2 = 2.0 * tol1;
-        if (fabs(x - m) <= tol2 - 0.5 * (b - a))
-            break;
-        double p = 0.0, q = 0.0, r = 0.0;
-        if (fabs(e) > tol1) {   /* a parabola through x, w, v */
-            r = (x - w) * (fx - fv);
-            q = (x - v) * (fx - fw);
-            p = (x - v) * q - (x - w) * r;
-            q = 2.0 * (q - r);
-            if (q > 0.0)
-                p = -p;
-            else
-                q = -q;
-            r = e;
-            e = d;
-        }
-        if (fabs(p) < fabs(0.5 * q * r) && p > q * (a - x) && p < q * (b - x)) {
-            d = p / q;
-            if (x + d - a < tol2 || b - (x + d) < tol2)
-                d = x < m ? tol1 : -tol1;
-        } else {
-            e = (x < m ? b : a) - x;
-            d = gold * e;
-        }
-        const double u = x + (fabs(d) >= tol1 ? d : d > 0.0 ? tol1 : -tol1), fu = sign * free_detj(f, u);
-        if (fu <= fx) {
-            if (u < x)
-                b = x;
-            else
-                a = x;
-            v = w, fv = fw, w = x, fw = fx, x = u, fx = fu;
-        } else {
-            if (u < x)
-                a = u;
-            else
-                b = u;
-            if (fu <= fw || w == x)
-                v = w, fv = fw, w = u, fw = fu;
-            else if (fu <= fv || v == x || v == w)
-                v = u, fv = fu;
-        }
-    }
+    struct free_dip_ctx c = { f, sign, -f->q->jtol };
+    const brent_fn fn = { free_signed, free_crossed, &c };
+    double fx;
+    const double x = brent_min(&fn, t0, t2, t1, f1, 0.25e-9 * (t2 - t0), 60, &fx);
     *at = x;
     *fat = sign * fx;
     if (f->ndip < FREE_KNOWN)
         f->dip_at[f->ndip] = *at, f->dip_f[f->ndip++] = *fat;
-    return fx < stop;
+    return fx < c.stop;
 }
 
 /* The panel [a, b] of w: G at its ends and rule's nodes, its sign changes and dips located, and each
