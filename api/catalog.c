@@ -9,6 +9,7 @@
 
 #include "catalog.h"
 #include "id.h"
+#include "jsonparse.h"
 #include "loft.h"
 
 char *api_presets_json(void)
@@ -75,7 +76,7 @@ char *api_preset_json(const api_preset *ps)
     for (size_t k = 0; k < n; k++) {
         double v[3];
         int slots = api_params_get(t, &p, info[k].name, v);
-        cJSON_AddItemToObject(params, info[k].name, slots == 3 ? cJSON_CreateDoubleArray(v, 3) : cJSON_CreateNumber(v[0]));
+        cJSON_AddItemToObject(params, info[k].name, slots == 3 ? api_json_exact_array(v, 3) : api_json_exact(v[0]));
     }
     cJSON_AddItemToObject(root, "params", params);
     cJSON_AddItemToObject(root, "model", model ? model : cJSON_CreateNull());
@@ -89,9 +90,7 @@ void api_json_exact_numbers(cJSON *j)
     for (cJSON *c = j->child, *next; c; c = next) {
         next = c->next;
         if (cJSON_IsNumber(c)) {
-            char b[32];
-            snprintf(b, sizeof b, "%.17g", c->valuedouble + 0.0);
-            cJSON *raw = cJSON_CreateRaw(b);
+            cJSON *raw = api_json_exact(c->valuedouble + 0.0);
             if (raw && c->string)
                 cJSON_ReplaceItemInObjectCaseSensitive(j, c->string, raw);   /* keeps the key */
             else if (raw)

@@ -9,8 +9,8 @@
 
 #include "template.h"
 
-/* Every number under j as 17 digits, in place: cJSON prints 15 where they read back within an epsilon, and a
- * document that does not read back exactly would get another id. */
+/* Every number under j in the digits that read back exactly, in place (api_fmt_f64): cJSON prints 15 where
+ * they read back within an epsilon, and a document that does not read back exactly would get another id. */
 void api_json_exact_numbers(cJSON *j);
 
 /* {"presets": [{"name", "template", "caption"}], "templates": [{"name", "title", "params": [...]}]}; malloc'd. */

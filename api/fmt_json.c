@@ -10,14 +10,7 @@
 #include "cost.h"
 #include "describe.h"
 #include "fmt.h"
-
-static cJSON *numbers(const double *v, int n)
-{
-    cJSON *a = cJSON_CreateArray();
-    for (int i = 0; a && i < n; i++)
-        cJSON_AddItemToArray(a, cJSON_CreateNumber(v[i]));
-    return a;
-}
+#include "jsonparse.h"
 
 static int stopped(const pde_cancel *c)
 {
@@ -47,7 +40,7 @@ static int json_open(api_output *o, const pde_cancel *cancel, api_error *err)
             cJSON_AddItemToArray(modes, mo);
             cJSON_AddItemToObject(mo, "u", api_factor_tree(md[m].u));
             cJSON_AddItemToObject(mo, "v", api_factor_tree(md[m].v));
-            cJSON_AddNumberToObject(mo, "e", md[m].e);
+            api_json_add_exact(mo, "e", md[m].e);
             /* A loft's mode is piecewise: "slabs": [{"w": [w0, w1], "h": [...]}] instead of "h". */
             cJSON *slabs = md[m].nslabs > 1 ? cJSON_AddArrayToObject(mo, "slabs") : NULL;
             for (size_t sl = 0; sl < (slabs ? md[m].nslabs : 1); sl++) {
@@ -55,7 +48,7 @@ static int json_open(api_output *o, const pde_cancel *cancel, api_error *err)
                 if (slabs) {
                     holder = cJSON_CreateObject();
                     cJSON_AddItemToArray(slabs, holder);
-                    cJSON_AddItemToObject(holder, "w", numbers(md[m].breaks + sl, 2));
+                    cJSON_AddItemToObject(holder, "w", api_json_exact_array(md[m].breaks + sl, 2));
                 }
                 if (!(terms = cJSON_AddArrayToObject(holder, "h")))
                     continue;
@@ -64,11 +57,11 @@ static int json_open(api_output *o, const pde_cancel *cancel, api_error *err)
                     const pde_wterm *w = &md[m].terms[t];
                     cJSON *to = cJSON_CreateObject();
                     cJSON_AddItemToArray(terms, to);
-                    cJSON_AddNumberToObject(to, "alpha", w->alpha);
-                    cJSON_AddNumberToObject(to, "beta", w->beta);
-                    cJSON_AddNumberToObject(to, "shift", w->shift);
-                    cJSON_AddItemToObject(to, "A", numbers(w->A, w->deg + 1));
-                    cJSON_AddItemToObject(to, "B", numbers(w->B, w->deg + 1));
+                    api_json_add_exact(to, "alpha", w->alpha);
+                    api_json_add_exact(to, "beta", w->beta);
+                    api_json_add_exact(to, "shift", w->shift);
+                    cJSON_AddItemToObject(to, "A", api_json_exact_array(w->A, w->deg + 1));
+                    cJSON_AddItemToObject(to, "B", api_json_exact_array(w->B, w->deg + 1));
                 }
             }
         }

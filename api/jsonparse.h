@@ -1,6 +1,6 @@
 /*
- * jsonparse.h: the pieces of api/'s strict JSON reading that model.c and loft.c share (internal to
- * api/). Each check fills err with a JSON pointer and a sentence (api_fail, API_ERR_DOCUMENT) and returns
+ * jsonparse.h: the pieces of api/'s JSON that its files share (internal to api/): strict reading, and
+ * writing numbers exactly. Each check fills err with a JSON pointer and a sentence (api_fail, API_ERR_DOCUMENT) and returns
  * -1 on failure, 0 on success.
  */
 #ifndef API_JSONPARSE_H
@@ -24,5 +24,13 @@ int api_json_number(const cJSON *j, const char *ptr, double *out, api_error *err
 int api_json_factor(const cJSON *j, const char *ptr, pde_factor *f, api_error *err);
 /* An array of three finite numbers (required). */
 int api_json_vector3(const cJSON *j, const char *ptr, double out[3], api_error *err);
+
+/* v as a JSON number that reads back as v exactly (api_fmt_f64), null when not finite; NULL only
+ * for want of memory. cJSON_CreateNumber would settle for 15 digits. */
+cJSON *api_json_exact(double v);
+/* The same, n of them as an array. */
+cJSON *api_json_exact_array(const double *v, int n);
+/* api_json_exact(v) as obj's key: the item, or NULL for want of memory (as cJSON_AddNumberToObject). */
+cJSON *api_json_add_exact(cJSON *obj, const char *key, double v);
 
 #endif

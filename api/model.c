@@ -15,6 +15,7 @@
 
 #include "model.h"
 #include "jsonparse.h"
+#include "numfmt.h"
 #include "loft.h"
 #include "strict.h"
 #include "template.h"
@@ -635,11 +636,44 @@ int api_eval_parse(const char *text, size_t len, size_t max_points, double **out
     return rc;
 }
 
+cJSON *api_json_exact(double v)
+{
+    char s[API_F64_MAX];
+    if (!isfinite(v))
+        return cJSON_CreateNull();
+    api_fmt_f64(s, v);
+    return cJSON_CreateRaw(s);
+}
+
+cJSON *api_json_exact_array(const double *v, int n)
+{
+    cJSON *a = cJSON_CreateArray();
+    for (int i = 0; a && i < n; i++) {
+        cJSON *x = api_json_exact(v[i]);
+        if (!x || !cJSON_AddItemToArray(a, x)) {
+            cJSON_Delete(x);
+            cJSON_Delete(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+cJSON *api_json_add_exact(cJSON *obj, const char *key, double v)
+{
+    cJSON *x = api_json_exact(v);
+    if (!x || !cJSON_AddItemToObject(obj, key, x)) {
+        cJSON_Delete(x);
+        return NULL;
+    }
+    return x;
+}
+
 cJSON *api_factor_tree(pde_factor f)
 {
     static const char *const kinds[] = { "pow", "sin", "cos", "exp", "sinh", "cosh" };
     cJSON *o = cJSON_CreateObject();
-    if (o && !cJSON_AddNumberToObject(o, kinds[f.kind], f.p)) {
+    if (o && !api_json_add_exact(o, kinds[f.kind], f.p)) {
         cJSON_Delete(o);
         return NULL;
     }
@@ -672,7 +706,7 @@ cJSON *api_model_tree(const pde_model *m)
     }
     static const char *const names[3] = { "a", "b", "c" };
     for (int k = 0; ok && k < 3; k++) {
-        cJSON *arr = cJSON_CreateDoubleArray(abc[k], 3);
+        cJSON *arr = api_json_exact_array(abc[k], 3);
         ok = arr && cJSON_AddItemToObject(pde, names[k], arr);
         if (!ok)
             cJSON_Delete(arr);
@@ -690,9 +724,9 @@ cJSON *api_model_tree(const pde_model *m)
                     cJSON_Delete(o);
                     break;
                 }
-                ok = add_factor(o, "u", t->u) && add_factor(o, "v", t->v) && cJSON_AddNumberToObject(o, "w0", t->w0) &&
-                     cJSON_AddNumberToObject(o, "dw0", t->dw0) && cJSON_AddNumberToObject(o, "w1", t->w1) &&
-                     cJSON_AddNumberToObject(o, "dw1", t->dw1);
+                ok = add_factor(o, "u", t->u) && add_factor(o, "v", t->v) && api_json_add_exact(o, "w0", t->w0) &&
+                     api_json_add_exact(o, "dw0", t->dw0) && api_json_add_exact(o, "w1", t->w1) &&
+                     api_json_add_exact(o, "dw1", t->dw1);
             }
         }
         if (ok && k->nfterms) {
@@ -706,7 +740,7 @@ cJSON *api_model_tree(const pde_model *m)
                     cJSON_Delete(o);
                     break;
                 }
-                ok = cJSON_AddNumberToObject(o, "coef", t->coef) && add_factor(o, "u", t->u) &&
+                ok = api_json_add_exact(o, "coef", t->coef) && add_factor(o, "u", t->u) &&
                      add_factor(o, "v", t->v) && add_factor(o, "w", t->w);
             }
         }

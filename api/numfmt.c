@@ -7,9 +7,14 @@
  * the digits can come from one double multiplication by a power of ten and a
  * rounding to a nine-digit integer, with no shortest-digits search and no
  * printf. Trailing zeros are dropped.
+ *
+ * Doubles (api_fmt_f64) are rarer, a model's numbers and the properties, and
+ * take printf's digits: 15, or 16 or 17 where 15 do not read back.
  */
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "numfmt.h"
@@ -127,4 +132,17 @@ size_t api_fmt_f32(char *out, float v)
         }
     }
     return (size_t)(p - out);
+}
+
+size_t api_fmt_f64(char out[API_F64_MAX], double v)
+{
+    char b[API_F64_MAX];
+    int n = 0;
+    for (int digits = 15; digits <= 17; digits++) {
+        n = snprintf(b, sizeof b, "%.*g", digits, v);
+        if (strtod(b, NULL) == v)
+            break;
+    }
+    memcpy(out, b, (size_t)n + 1);
+    return (size_t)n;
 }

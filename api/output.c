@@ -17,6 +17,7 @@
 #include <cJSON.h>
 
 #include "fmt.h"
+#include "jsonparse.h"
 #include "output.h"
 
 #define API_FORMAT(id, entry) extern const api_format_info entry;
@@ -193,41 +194,18 @@ static const double *prop_at(const pde_props *p, const prop_row *r)
     return (const double *)(const void *)((const char *)p + r->off);
 }
 
-/* v in the fewest digits that read back as v exactly (cJSON_CreateNumber settles for 15 digits within an
- * epsilon, so the last bit of a certified bound could move); null when not finite. */
-static cJSON *prop_number(double v)
-{
-    char s[32];
-    if (!isfinite(v))
-        return cJSON_CreateNull();
-    for (int digits = 15; digits <= 17; digits++) {
-        snprintf(s, sizeof s, "%.*g", digits, v);
-        if (strtod(s, NULL) == v)
-            break;
-    }
-    return cJSON_CreateRaw(s);
-}
-
-static cJSON *prop_numbers(const double *v, int n)
-{
-    cJSON *a = cJSON_CreateArray();
-    for (int i = 0; a && i < n; i++)
-        cJSON_AddItemToArray(a, prop_number(v[i]));
-    return a;
-}
-
 static cJSON *prop_value(const pde_props *p, const prop_row *r)
 {
     const double *v = prop_at(p, r);
     if (r->flag)
         return cJSON_CreateBool(*(const int *)(const void *)v);
     if (r->cols == 1)
-        return prop_number(*v);
+        return api_json_exact(*v);
     if (r->rows == 1)
-        return prop_numbers(v, r->cols);
+        return api_json_exact_array(v, r->cols);
     cJSON *m = cJSON_CreateArray();
     for (int i = 0; m && i < r->rows; i++)
-        cJSON_AddItemToArray(m, prop_numbers(v + i * r->cols, r->cols));
+        cJSON_AddItemToArray(m, api_json_exact_array(v + i * r->cols, r->cols));
     return m;
 }
 

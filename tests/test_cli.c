@@ -389,6 +389,26 @@ static void templates_should_work_from_the_command_line(void **state)
     free(err);
 }
 
+/* --param's number is the double it names, to the last bit: the request was printed by cJSON, which wrote
+ * 0.5609999999999999 as 0.561, another solid (another id) than the same request sent as a file. */
+static void params_should_keep_every_digit(void **state)
+{
+    (void)state;
+    char *a, *b, *c, *err;
+    write_text("exact.json", "{\"preset\":\"fig4a\",\"params\":{\"r0\":0.5609999999999999}}");
+    assert_int_equal(run(1, "solve --preset fig4a --param r0=0.5609999999999999", &a, &err), 0);
+    free(err);
+    assert_int_equal(run(1, "solve exact.json", &b, &err), 0);
+    free(err);
+    assert_int_equal(run(1, "solve --preset fig4a --param r0=0.561", &c, &err), 0);
+    free(err);
+    assert_memory_equal(a, b, strcspn(b, "\n"));
+    assert_memory_not_equal(a, c, strcspn(c, "\n"));
+    free(a);
+    free(b);
+    free(c);
+}
+
 static void presets_and_formats_should_work_from_the_command_line(void **state)
 {
     (void)state;
@@ -966,6 +986,7 @@ int main(void)
         cmocka_unit_test(output_file_should_never_be_ignored),
         cmocka_unit_test(format_and_the_output_extension_should_agree),
         cmocka_unit_test(templates_should_work_from_the_command_line),
+        cmocka_unit_test(params_should_keep_every_digit),
         cmocka_unit_test(eval_should_agree_with_the_independent_solution),
         cmocka_unit_test(solve_should_print_the_closed_form_and_properties),
         cmocka_unit_test(bad_input_should_exit_2_and_name_the_field),

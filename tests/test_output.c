@@ -890,6 +890,24 @@ static void json_should_hold_the_closed_form_properties_and_id(void **state)
     double want[3];
     pde_eval(sol, u, v, w, want);
     assert_rel(x, want[0], 1e-13, 1);
+    /* and every number of it is the solution's to the last bit (cJSON's writer settled for 15 digits) */
+    size_t nm, exact = 0, all = 0;
+    const pde_mode *md = pde_solution_modes(sol, 0, &nm);
+    cJSON *m = modes->child;
+    for (size_t i = 0; i < nm; i++, m = m->next) {
+        all++, exact += cJSON_GetObjectItem(m, "e")->valuedouble == md[i].e;
+        cJSON *t = cJSON_GetObjectItem(m, "h")->child;
+        for (size_t k = 0; k < md[i].nterms; k++, t = t->next) {
+            const pde_wterm *wt = &md[i].terms[k];
+            all += 3, exact += (cJSON_GetObjectItem(t, "alpha")->valuedouble == wt->alpha) +
+                               (cJSON_GetObjectItem(t, "beta")->valuedouble == wt->beta) +
+                               (cJSON_GetObjectItem(t, "shift")->valuedouble == wt->shift);
+            cJSON *ca = cJSON_GetObjectItem(t, "A")->child, *cb = cJSON_GetObjectItem(t, "B")->child;
+            for (int d = 0; d <= wt->deg; d++, ca = ca->next, cb = cb->next)
+                all += 2, exact += (ca->valuedouble == wt->A[d]) + (cb->valuedouble == wt->B[d]);
+        }
+    }
+    assert_int_equal(exact, all);
     assert_non_null(strstr(cJSON_GetObjectItem(j, "closed_form")->valuestring, "x(u,v,w) = sum over 2 modes"));
     cJSON *props = cJSON_GetObjectItem(j, "properties");
     assert_true(cJSON_GetObjectItem(props, "volume")->valuedouble > 0);

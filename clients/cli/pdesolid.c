@@ -220,6 +220,8 @@ static char *request_text(const options *o, size_t *len)
         }
         free(name);
     }
+    if (ok)
+        api_json_exact_numbers(req);   /* --param r0=0.5609999999999999 is that double, not 0.561 */
     char *text = ok ? cJSON_PrintUnformatted(req) : NULL;
     cJSON_Delete(req);
     if (!text)
