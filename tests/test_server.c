@@ -484,6 +484,25 @@ static void wait_for_hits(srv_cache *c, unsigned long long hits)
     assert_int_equal(cs.hits, hits);
 }
 
+/* Starts w's request (fn: solve_waiting or find_waiting) on a's entry, and waits until it waits there: until
+ * the cache counts the hits it then has. */
+static void waiter_start(const cancel_gate *a, cancel_gate *w, void *(*fn)(void *), pthread_t *t,
+                         unsigned long long hits)
+{
+    *w = (cancel_gate){ .cache = a->cache };
+    assert_int_equal(pthread_create(t, NULL, fn, w), 0);
+    wait_for_hits(a->cache, hits);
+}
+
+static void expect_cache_stats(srv_cache *c, unsigned long long hits, unsigned long long misses, size_t entries)
+{
+    srv_cache_stats cs;
+    srv_cache_stats_get(c, &cs);
+    assert_int_equal(cs.hits, hits);
+    assert_int_equal(cs.misses, misses);
+    assert_int_equal(cs.entries, entries);
+}
+
 static void cancel_gate_release(cancel_gate *a, pthread_t t)
 {
     pthread_mutex_lock(&a->m);
@@ -501,23 +520,17 @@ static void cancel_gate_release(cancel_gate *a, pthread_t t)
 static void a_request_waiting_on_a_cancelled_solve_should_solve_for_itself(void **state)
 {
     (void)state;
-    cancel_gate a, b = { 0 };
+    cancel_gate a, b;
     pthread_t t, tb;
     cancel_gate_start(&a, &t);
-    /* b finds a's entry being solved and waits on it. */
-    b.cache = a.cache;
-    assert_int_equal(pthread_create(&tb, NULL, solve_waiting, &b), 0);
-    wait_for_hits(a.cache, 1);
+    waiter_start(&a, &b, solve_waiting, &tb, 1);   /* b finds a's entry being solved and waits on it */
     cancel_gate_release(&a, t);
     pthread_join(tb, NULL);
     if (!b.e)
         fail_msg("the waiting request failed with a's cancellation: %s", b.err.message);
     assert_int_equal(b.calls, 1);
     assert_int_equal(b.hit, 0);
-    srv_cache_stats cs;
-    srv_cache_stats_get(a.cache, &cs);
-    assert_int_equal(cs.hits, 0);
-    assert_int_equal(cs.misses, 2);
+    expect_cache_stats(a.cache, 0, 2, 1);
     srv_cache_release(a.cache, b.e);
     srv_cache_destroy(a.cache);
 }
@@ -528,14 +541,11 @@ static void a_request_waiting_on_a_cancelled_solve_should_solve_for_itself(void 
 static void a_get_waiting_on_a_cancelled_solve_should_get_the_solve_that_takes_it_over(void **state)
 {
     (void)state;
-    cancel_gate a, b = { 0 }, c = { 0 };
+    cancel_gate a, b, c;
     pthread_t t, tb, tc;
     cancel_gate_start(&a, &t);
-    b.cache = c.cache = a.cache;
-    assert_int_equal(pthread_create(&tb, NULL, find_waiting, &b), 0);
-    wait_for_hits(a.cache, 1);
-    assert_int_equal(pthread_create(&tc, NULL, solve_waiting, &c), 0);
-    wait_for_hits(a.cache, 2);
+    waiter_start(&a, &b, find_waiting, &tb, 1);
+    waiter_start(&a, &c, solve_waiting, &tc, 2);
     cancel_gate_release(&a, t);
     pthread_join(tb, NULL);
     pthread_join(tc, NULL);
@@ -544,11 +554,7 @@ static void a_get_waiting_on_a_cancelled_solve_should_get_the_solve_that_takes_i
     assert_ptr_equal(b.e, c.e);
     assert_int_equal(c.calls, 1);
     assert_int_equal(c.hit, 0);
-    srv_cache_stats cs;
-    srv_cache_stats_get(a.cache, &cs);
-    assert_int_equal(cs.hits, 1);
-    assert_int_equal(cs.misses, 2);
-    assert_int_equal(cs.entries, 1);
+    expect_cache_stats(a.cache, 1, 2, 1);
     srv_cache_release(a.cache, b.e);
     srv_cache_release(a.cache, c.e);
     srv_cache_destroy(a.cache);
@@ -559,19 +565,15 @@ static void a_get_waiting_on_a_cancelled_solve_should_get_the_solve_that_takes_i
 static void a_get_waiting_on_a_cancelled_solve_no_one_takes_over_should_learn_it_was_cancelled(void **state)
 {
     (void)state;
-    cancel_gate a, b = { 0 };
+    cancel_gate a, b;
     pthread_t t, tb;
     cancel_gate_start(&a, &t);
-    b.cache = a.cache;
-    assert_int_equal(pthread_create(&tb, NULL, find_waiting, &b), 0);
-    wait_for_hits(a.cache, 1);
+    waiter_start(&a, &b, find_waiting, &tb, 1);
     cancel_gate_release(&a, t);
     pthread_join(tb, NULL);
     assert_null(b.e);
     assert_int_equal(b.err.status, API_ERR_CANCELLED);
-    srv_cache_stats cs;
-    srv_cache_stats_get(a.cache, &cs);
-    assert_int_equal(cs.entries, 0);
+    expect_cache_stats(a.cache, 1, 1, 0);
     api_error err;
     assert_null(srv_cache_find(a.cache, "0123456789abcdef0123456789abcdef", &err));
     assert_int_equal(err.status, API_ERR_NOT_FOUND);
