@@ -219,8 +219,13 @@ int api_volmesh_build(const pde_solution *s, const unsigned res[3], const pde_ca
         st = sample_grid(s, res, 0.5, NULL, g.cdet, cancel);
     if (st == PDE_ERR_CANCELLED)
         goto cancelled;
-    if (st != PDE_OK)
+    if (st == PDE_ERR_NOMEM)
         goto oom;
+    if (st != PDE_OK) {   /* pde_grid_create's refusal of its arguments: PDE_ERR_INVALID, no solution */
+        api_fail(err, api_status_of(st), "", "a volume mesh of %u x %u x %u samples: %s", res[0], res[1], res[2],
+                 pde_strerror(st));
+        goto fail;
+    }
     for (size_t x = 0; x < N; x++) {
         g.rep[x] = (uint32_t)x;
         sum += g.det[x];

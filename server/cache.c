@@ -7,6 +7,11 @@
  * meanwhile wait on its condition variable instead of solving again; the
  * solve itself runs outside the lock. Eviction unlinks entries from the hash
  * and the list; an unlinked entry is freed when its last reference goes.
+ * A solve cancelled for its own request (its deadline, its client gone) is
+ * no answer for the others waiting on it: when one of them can solve (a
+ * srv_cache_get), the entry is ORPHANED and that one takes the solve over,
+ * while those that cannot (srv_cache_find, a GET by id) wait on; with no
+ * such waiter it fails, and is not cached.
  */
 #include <pthread.h>
 #include <stdatomic.h>
@@ -16,15 +21,16 @@
 #include "cache.h"
 #include "output.h"
 
-enum { SOLVING, READY, FAILED };
+enum { SOLVING, ORPHANED, READY, FAILED };   /* ORPHANED: cancelled, for a waiter to solve again */
 
 struct srv_entry {
     char id[API_ID_LEN + 1];
     pde_solution *sol;
     size_t bytes;
     int state, refs, linked;
+    int solvers;                   /* waiters that can solve (srv_cache_get): one takes over an ORPHANED solve */
     api_error err;                 /* FAILED: why */
-    pthread_cond_t done;           /* SOLVING -> READY or FAILED */
+    pthread_cond_t done;           /* SOLVING -> READY, FAILED or ORPHANED; ORPHANED -> SOLVING */
     srv_entry *hnext, *prev, *next;
     pthread_mutex_t props_lock;   /* one computes the properties; the others wait for them */
     pde_props props;
@@ -140,19 +146,21 @@ static srv_entry *lookup(srv_cache *c, const char *id)
     return NULL;
 }
 
-/* Waits while e is being solved; returns e referenced, or NULL (with err) if its solve failed. */
-static srv_entry *await(srv_cache *c, srv_entry *e, api_error *err)
+/* Waits while e is being solved, referencing it. READY: e; FAILED: NULL with err, the reference dropped.
+ * ORPHANED, which only a waiter that can solve (can_solve) returns at: e, for the caller to solve. */
+static srv_entry *await(srv_cache *c, srv_entry *e, int can_solve, api_error *err)
 {
     e->refs++;
-    while (e->state == SOLVING)
+    e->solvers += can_solve;
+    while (e->state == SOLVING || (e->state == ORPHANED && !can_solve))
         pthread_cond_wait(&e->done, &c->lock);
-    if (e->state == READY) {
-        if (e->linked) {
-            lru_unlink(c, e);
-            lru_front(c, e);
-        }
-        return e;
+    e->solvers -= can_solve;
+    if (e->state == READY && e->linked) {
+        lru_unlink(c, e);
+        lru_front(c, e);
     }
+    if (e->state != FAILED)
+        return e;
     if (err)
         *err = e->err;
     if (--e->refs == 0 && !e->linked)
@@ -160,39 +168,17 @@ static srv_entry *await(srv_cache *c, srv_entry *e, api_error *err)
     return NULL;
 }
 
-srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void *arg, int *hit, api_error *err)
+/* A new entry of id, SOLVING and referenced once, in the hash; NULL if out of memory. */
+static srv_entry *entry_new(srv_cache *c, const char *id)
 {
-    pthread_mutex_lock(&c->lock);
-    srv_entry *e;
-    api_error why;
-    while ((e = lookup(c, id))) {
-        c->hits++;
-        *hit = 1;
-        e = await(c, e, &why);
-        /* A solve stopped for its own request (its deadline, its client gone) is no answer for this one:
-         * failures are not cached, so this request solves, under its own cancel. */
-        if (e || why.status != API_ERR_CANCELLED) {
-            if (!e && err)
-                *err = why;
-            pthread_mutex_unlock(&c->lock);
-            return e;
-        }
-        c->hits--;
-    }
-    *hit = 0;
-    c->misses++;
-    e = calloc(1, sizeof *e);
+    srv_entry *e = calloc(1, sizeof *e);
     if (!e || pthread_cond_init(&e->done, NULL)) {
         free(e);
-        e = NULL;
-    } else if (pthread_mutex_init(&e->props_lock, NULL)) {
+        return NULL;
+    }
+    if (pthread_mutex_init(&e->props_lock, NULL)) {
         pthread_cond_destroy(&e->done);
         free(e);
-        e = NULL;
-    }
-    if (!e) {
-        pthread_mutex_unlock(&c->lock);
-        api_fail_nomem(err);
         return NULL;
     }
     memcpy(e->id, id, sizeof e->id);
@@ -204,6 +190,31 @@ srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void 
     e->hnext = c->bucket[b];
     c->bucket[b] = e;
     c->entries++;
+    return e;
+}
+
+srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void *arg, int *hit, api_error *err)
+{
+    pthread_mutex_lock(&c->lock);
+    srv_entry *e = lookup(c, id);
+    *hit = e != NULL;
+    if (e) {
+        c->hits++;
+        e = await(c, e, 1, err);
+        if (!e || e->state == READY) {
+            pthread_mutex_unlock(&c->lock);
+            return e;
+        }
+        /* Its solve was stopped for its own request: this one solves, under its own cancel. */
+        c->hits--;
+        *hit = 0;
+        e->state = SOLVING;
+    } else if (!(e = entry_new(c, id))) {
+        pthread_mutex_unlock(&c->lock);
+        api_fail_nomem(err);
+        return NULL;
+    }
+    c->misses++;
     pthread_mutex_unlock(&c->lock);
 
     pde_solution *sol = NULL;
@@ -211,12 +222,17 @@ srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void 
 
     pthread_mutex_lock(&c->lock);
     if (rc) {
-        e->state = FAILED;
         if (err)
             *err = e->err;
-        pthread_cond_broadcast(&e->done);
         e->refs--;
-        unlink_entry(c, e);     /* failures are not cached: the next request tries again */
+        if (e->err.status == API_ERR_CANCELLED && e->solvers) {
+            e->state = ORPHANED;    /* a waiter that can solve takes it over (await) */
+            pthread_cond_broadcast(&e->done);
+        } else {
+            e->state = FAILED;
+            pthread_cond_broadcast(&e->done);
+            unlink_entry(c, e);     /* failures are not cached: the next request tries again */
+        }
         pthread_mutex_unlock(&c->lock);
         return NULL;
     }
@@ -234,12 +250,16 @@ srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void 
     return e;
 }
 
-srv_entry *srv_cache_find(srv_cache *c, const char *id)
+srv_entry *srv_cache_find(srv_cache *c, const char *id, api_error *err)
 {
     pthread_mutex_lock(&c->lock);
     srv_entry *e = lookup(c, id);
-    if (e)
-        e = await(c, e, NULL);
+    if (e) {
+        c->hits++;
+        e = await(c, e, 0, err);
+    } else {
+        api_fail(err, API_ERR_NOT_FOUND, "", "no solid %s in the cache", id);
+    }
     pthread_mutex_unlock(&c->lock);
     return e;
 }

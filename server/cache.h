@@ -33,11 +33,16 @@ void srv_cache_destroy(srv_cache *c);
  * reference (release it), or NULL with err when the solve failed. *hit tells
  * whether the solution was there (or being solved by another request).
  * When the solve it waited for is cancelled (API_ERR_CANCELLED: that request's
- * deadline, or its client gone), it solves itself rather than fail.
+ * deadline, or its client gone), it takes the solve over rather than fail.
  */
 srv_entry *srv_cache_get(srv_cache *c, const char *id, srv_solve_fn solve, void *arg, int *hit, api_error *err);
-/* The entry of id if it is cached (waiting for a solve under way), else NULL. */
-srv_entry *srv_cache_find(srv_cache *c, const char *id);
+/*
+ * The entry of id if it is cached, waiting for a solve under way (a hit), and
+ * for the one that takes it over if that is cancelled. NULL with err: not
+ * cached (API_ERR_NOT_FOUND); the solve failed; or it was cancelled for its
+ * own request and no request that can solve waited (API_ERR_CANCELLED).
+ */
+srv_entry *srv_cache_find(srv_cache *c, const char *id, api_error *err);
 void srv_cache_release(srv_cache *c, srv_entry *e);
 
 const pde_solution *srv_entry_solution(const srv_entry *e);

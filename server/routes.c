@@ -464,17 +464,31 @@ static srv_entry *restore(srv_req *r, int *missing)
     return solve_cached(r, m, id, 0);
 }
 
+/* The entry of the id in the path: cached, being solved (waited for), or re-solved from the store. NULL with
+ * the problem set: 404 for an id not known here; 503 for one whose solve, for another request, stopped for that
+ * request alone (its deadline, its client gone) with no /solve of the model there to take it over. */
 static srv_entry *find_solid(srv_req *r)
 {
+    api_error err = { .status = API_ERR_NOT_FOUND };
     int valid = api_id_valid(r->arg), missing = 1;
-    srv_entry *e = valid ? srv_cache_find(r->s->cache, r->arg) : NULL;
-    if (!e && valid && r->s->store)
+    srv_entry *e = valid ? srv_cache_find(r->s->cache, r->arg, &err) : NULL;
+    if (!e && valid && r->s->store && (err.status == API_ERR_NOT_FOUND || err.status == API_ERR_CANCELLED))
         e = restore(r, &missing);
-    if (!e && missing)
+    if (e || !missing)
+        return e;
+    if (err.status == API_ERR_CANCELLED)
+        srv_problem(r, 503, NULL,
+                    "the solid %s was being solved for another request, which stopped before the solve ended (its "
+                    "--job-timeout, or its client gone); this server has no model to solve it again: try again, or "
+                    "POST its model to /solve", r->arg);
+    else if (err.status != API_ERR_NOT_FOUND)   /* that solve's own failure; its pointer is into another body */
+        srv_problem(r, srv_http_status(err.status), NULL, "the solve of %s, for another request, failed: %s", r->arg,
+                    err.message);
+    else
         srv_problem(r, 404, NULL,
                     "no solid %s: it was never solved here, or was evicted; POST its model to /solve",
                     valid ? r->arg : "with that id (an id is 32 lowercase hex digits)");
-    return e;
+    return NULL;
 }
 
 /* The request an id came from, as the store kept it (--store): for share links. */

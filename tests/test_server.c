@@ -450,49 +450,133 @@ static void *solve_waiting(void *arg)
     return NULL;
 }
 
+/* A GET /solids/{id}: it cannot solve, only wait. */
+static void *find_waiting(void *arg)
+{
+    cancel_gate *g = arg;
+    g->e = srv_cache_find(g->cache, "0123456789abcdef0123456789abcdef", &g->err);
+    return NULL;
+}
+
+/* Starts a's solve of the id (through the cache), which blocks until cancel_gate_release(a). */
+static void cancel_gate_start(cancel_gate *a, pthread_t *t)
+{
+    *a = (cancel_gate){ .m = PTHREAD_MUTEX_INITIALIZER, .c = PTHREAD_COND_INITIALIZER };
+    a->cache = srv_cache_create(64u << 20);
+    assert_non_null(a->cache);
+    assert_int_equal(pthread_create(t, NULL, get_cancelled, a), 0);
+    pthread_mutex_lock(&a->m);
+    while (!a->entered)
+        pthread_cond_wait(&a->c, &a->m);
+    pthread_mutex_unlock(&a->m);
+}
+
+/* Until the cache has counted hits: each request that finds the entry being solved counts its hit under the
+ * lock, as it starts to wait. */
+static void wait_for_hits(srv_cache *c, unsigned long long hits)
+{
+    srv_cache_stats cs = { 0 };
+    for (int i = 0; i < 5000 && cs.hits < hits; i++) {
+        srv_cache_stats_get(c, &cs);
+        if (cs.hits < hits)
+            usleep(1000);
+    }
+    assert_int_equal(cs.hits, hits);
+}
+
+/* Starts w's request (fn: solve_waiting or find_waiting) on a's entry, and waits until it waits there: until
+ * the cache counts the hits it then has. */
+static void waiter_start(const cancel_gate *a, cancel_gate *w, void *(*fn)(void *), pthread_t *t,
+                         unsigned long long hits)
+{
+    *w = (cancel_gate){ .cache = a->cache };
+    assert_int_equal(pthread_create(t, NULL, fn, w), 0);
+    wait_for_hits(a->cache, hits);
+}
+
+static void expect_cache_stats(srv_cache *c, unsigned long long hits, unsigned long long misses, size_t entries)
+{
+    srv_cache_stats cs;
+    srv_cache_stats_get(c, &cs);
+    assert_int_equal(cs.hits, hits);
+    assert_int_equal(cs.misses, misses);
+    assert_int_equal(cs.entries, entries);
+}
+
+static void cancel_gate_release(cancel_gate *a, pthread_t t)
+{
+    pthread_mutex_lock(&a->m);
+    a->released = 1;
+    pthread_cond_broadcast(&a->c);
+    pthread_mutex_unlock(&a->m);
+    pthread_join(t, NULL);
+    assert_null(a->e);
+    assert_int_equal(a->err.status, API_ERR_CANCELLED);
+}
+
 /* A request that waits for another's solve of the same id, which is then cancelled for that request alone,
  * solves for itself: before, it got the cancellation, and answered 503 "ran past its deadline" with no time
  * spent, so that one client closing its connection could fail the others' identical requests. */
 static void a_request_waiting_on_a_cancelled_solve_should_solve_for_itself(void **state)
 {
     (void)state;
-    cancel_gate a = { .m = PTHREAD_MUTEX_INITIALIZER, .c = PTHREAD_COND_INITIALIZER };
-    cancel_gate b = { 0 };
-    a.cache = srv_cache_create(64u << 20);
-    assert_non_null(a.cache);
-    pthread_t t;
-    assert_int_equal(pthread_create(&t, NULL, get_cancelled, &a), 0);
-    pthread_mutex_lock(&a.m);
-    while (!a.entered)
-        pthread_cond_wait(&a.c, &a.m);
-    pthread_mutex_unlock(&a.m);
-    /* b finds a's entry being solved and waits on it; its hit is counted, under the lock, as it starts to wait. */
-    b.cache = a.cache;
-    pthread_t tb;
-    assert_int_equal(pthread_create(&tb, NULL, solve_waiting, &b), 0);
-    srv_cache_stats cs = { 0 };
-    for (int i = 0; i < 5000 && cs.hits < 1; i++) {
-        srv_cache_stats_get(a.cache, &cs);
-        if (cs.hits < 1)
-            usleep(1000);
-    }
-    assert_int_equal(cs.hits, 1);
-    pthread_mutex_lock(&a.m);
-    a.released = 1;
-    pthread_cond_broadcast(&a.c);
-    pthread_mutex_unlock(&a.m);
-    pthread_join(t, NULL);
+    cancel_gate a, b;
+    pthread_t t, tb;
+    cancel_gate_start(&a, &t);
+    waiter_start(&a, &b, solve_waiting, &tb, 1);   /* b finds a's entry being solved and waits on it */
+    cancel_gate_release(&a, t);
     pthread_join(tb, NULL);
-    assert_null(a.e);
-    assert_int_equal(a.err.status, API_ERR_CANCELLED);
     if (!b.e)
         fail_msg("the waiting request failed with a's cancellation: %s", b.err.message);
     assert_int_equal(b.calls, 1);
     assert_int_equal(b.hit, 0);
-    srv_cache_stats_get(a.cache, &cs);
-    assert_int_equal(cs.hits, 0);
-    assert_int_equal(cs.misses, 2);
+    expect_cache_stats(a.cache, 0, 2, 1);
     srv_cache_release(a.cache, b.e);
+    srv_cache_destroy(a.cache);
+}
+
+/* A GET /solids/{id} (or an eval) that waits for a /solve of the id, which is then cancelled for its own
+ * request, while another /solve of the same model waits too: that one takes the solve over, and the GET gets
+ * its solid. Before, the GET answered 404 "never solved here" for an id that was being solved. */
+static void a_get_waiting_on_a_cancelled_solve_should_get_the_solve_that_takes_it_over(void **state)
+{
+    (void)state;
+    cancel_gate a, b, c;
+    pthread_t t, tb, tc;
+    cancel_gate_start(&a, &t);
+    waiter_start(&a, &b, find_waiting, &tb, 1);
+    waiter_start(&a, &c, solve_waiting, &tc, 2);
+    cancel_gate_release(&a, t);
+    pthread_join(tb, NULL);
+    pthread_join(tc, NULL);
+    if (!b.e)
+        fail_msg("the GET waiting on a cancelled solve found nothing (a 404), while another request re-solved it");
+    assert_ptr_equal(b.e, c.e);
+    assert_int_equal(c.calls, 1);
+    assert_int_equal(c.hit, 0);
+    expect_cache_stats(a.cache, 1, 2, 1);
+    srv_cache_release(a.cache, b.e);
+    srv_cache_release(a.cache, c.e);
+    srv_cache_destroy(a.cache);
+}
+
+/* The same with no request there that can solve: the GET learns why (a 503 "stopped before it ended"), not a
+ * 404 "never solved here"; and the failure is not cached. */
+static void a_get_waiting_on_a_cancelled_solve_no_one_takes_over_should_learn_it_was_cancelled(void **state)
+{
+    (void)state;
+    cancel_gate a, b;
+    pthread_t t, tb;
+    cancel_gate_start(&a, &t);
+    waiter_start(&a, &b, find_waiting, &tb, 1);
+    cancel_gate_release(&a, t);
+    pthread_join(tb, NULL);
+    assert_null(b.e);
+    assert_int_equal(b.err.status, API_ERR_CANCELLED);
+    expect_cache_stats(a.cache, 1, 1, 0);
+    api_error err;
+    assert_null(srv_cache_find(a.cache, "0123456789abcdef0123456789abcdef", &err));
+    assert_int_equal(err.status, API_ERR_NOT_FOUND);
     srv_cache_destroy(a.cache);
 }
 
@@ -1460,6 +1544,8 @@ int main(void)
         cmocka_unit_test(cache_hits_misses_and_evictions_should_show_in_metrics),
         cmocka_unit_test(concurrent_identical_requests_should_solve_once),
         cmocka_unit_test(a_request_waiting_on_a_cancelled_solve_should_solve_for_itself),
+        cmocka_unit_test(a_get_waiting_on_a_cancelled_solve_should_get_the_solve_that_takes_it_over),
+        cmocka_unit_test(a_get_waiting_on_a_cancelled_solve_no_one_takes_over_should_learn_it_was_cancelled),
         cmocka_unit_test(etag_with_if_none_match_should_give_304),
         cmocka_unit_test(sixty_four_concurrent_clients_should_all_get_correct_answers),
         cmocka_unit_test(a_full_queue_should_give_503_with_retry_after),
