@@ -101,7 +101,8 @@ static const flag flags[] = {
     { "--job-timeout", "S", K_REAL, AT(job_timeout), 0, 86400, "2", NULL,
       "wall-clock seconds of solver time one request's\njobs may take in all; past it they are cancelled" },
     { "--request-timeout", "S", K_REAL, AT(request_timeout), 0, 86400, "30", NULL,
-      "seconds from a request's headers to the end of\nits body; past it the connection is closed" },
+      "seconds for a request's head (from the opening\nof its connection or its previous answer) and\n"
+      "again for its body (from the end of its head);\npast either the connection is closed" },
     { "--timeout", "S", K_UNSIGNED, AT(timeout), 1, 86400, "30", NULL,
       "seconds before an idle connection is closed" },
     { "--max-conns-per-ip", "N", K_UNSIGNED, AT(per_ip), 1, 65535, "128", NULL,

@@ -21,6 +21,7 @@
  */
 #include <arpa/inet.h>
 #include <stdarg.h>
+#include <math.h>
 #include <netdb.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -104,6 +105,7 @@ typedef struct {
     int authority;   /* the target, in absolute form, has an authority with userinfo (@) or %-escapes */
     int over;        /* opened beyond --max-conns: its requests are answered 503 */
     size_t target;   /* the current request's target, in bytes as sent */
+    srv_watched w;   /* its head's deadline (watch.h); w.prev NULL when not watched */
 } conn_state;
 
 
@@ -487,6 +489,15 @@ static enum MHD_Result take_body(srv_req *r, const char *upload, size_t n)
  * that one line (the job's own line says why, and the access log has the 499). */
 static _Thread_local int closing_gone;
 
+/* Between a request's head and its answer (busy), the request's deadlines hold, not the head's (watch.h). */
+static void watch_busy(srv_server *s, struct MHD_Connection *conn, int busy)
+{
+    const union MHD_ConnectionInfo *ci = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+    conn_state *cs = ci ? ci->socket_context : NULL;
+    if (cs && cs->w.prev)
+        srv_watch_busy(s->watch, &cs->w, busy);
+}
+
 static enum MHD_Result handler(void *cls, struct MHD_Connection *conn, const char *url, const char *method,
                                const char *version, const char *upload, size_t *upload_size, void **con_cls)
 {
@@ -497,6 +508,7 @@ static enum MHD_Result handler(void *cls, struct MHD_Connection *conn, const cha
         if (!(r = begin(s, conn, url, method, version)))
             return MHD_NO;
         *con_cls = r;
+        watch_busy(s, conn, 1);
         if (admit(r, method))
             return srv_respond_text(r);
         return MHD_YES;
@@ -551,6 +563,7 @@ static void completed(void *cls, struct MHD_Connection *conn, void **con_cls, en
     if (!r)
         return;
     *con_cls = NULL;
+    watch_busy(s, conn, 0);
     double dt = srv_now() - r->t0;
     /* No answer: the client went away (499, as nginx logs it), or its request ran past --timeout or
      * --request-timeout (408); a request that completed without one would be a bug (500). */
@@ -589,18 +602,23 @@ static void completed(void *cls, struct MHD_Connection *conn, void **con_cls, en
 static void connection_event(void *cls, struct MHD_Connection *conn, void **socket_context,
                              enum MHD_ConnectionNotificationCode toe)
 {
-    (void)conn;
     srv_server *s = cls;
     srv_metrics_connection(s->metrics, toe == MHD_CONNECTION_NOTIFY_STARTED ? 1 : -1);
     if (toe == MHD_CONNECTION_NOTIFY_STARTED) {
         unsigned n = atomic_fetch_add(&s->conns, 1) + 1;
         conn_state *cs = calloc(1, sizeof *cs);   /* NULL: %00 goes unnoticed (still kept literal), as may --max-conns */
+        const union MHD_ConnectionInfo *ci = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CONNECTION_FD);
         if (cs)
             cs->over = n > s->cfg.max_conns;
+        if (cs && ci)
+            srv_watch_open(s->watch, &cs->w, ci->connect_fd);
         *socket_context = cs;
     } else {
         atomic_fetch_sub(&s->conns, 1);
-        free(*socket_context);
+        conn_state *cs = *socket_context;
+        if (cs && cs->w.prev)
+            srv_watch_close(s->watch, &cs->w);
+        free(cs);
         *socket_context = NULL;
     }
 }
@@ -672,6 +690,7 @@ static void mhd_logger(void *cls, const char *fmt, va_list ap)
 
 static void free_server(srv_server *s)
 {
+    srv_watch_stop(s->watch);
     srv_pool_destroy(s->pool);
     srv_cache_destroy(s->cache);
     srv_rcache_destroy(s->rcache);
@@ -708,12 +727,14 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
     s->pool = srv_pool_create(c->threads, c->queue, c->max_conns);
     s->log = c->quiet ? NULL : srv_log_create(2, c->log_format);
     s->web = srv_static_load(c->web, err, errlen);
+    /* a head (request line and headers) has --request-timeout, as the whole request; checked 4 times as often */
+    s->watch = srv_watch_start(c->request_timeout, fmin(fmax(c->request_timeout / 4, 0.05), 1.0));
     srv_store_config sc = { .spec = c->store, .max_mb = c->store_mb, .prefix = c->store_prefix, .ttl_s = c->store_ttl };
     if (s->web && !(s->store = srv_store_open(&sc, err, errlen)) && *err) {   /* "" for --store none */
         free_server(s);
         return NULL;
     }
-    if (!s->cache || !s->rcache || !s->metrics || !s->pool || (!c->quiet && !s->log) || !s->web) {
+    if (!s->cache || !s->rcache || !s->metrics || !s->pool || (!c->quiet && !s->log) || !s->web || !s->watch) {
         snprintf(err, errlen, "out of memory, or a solver thread could not start");
         free_server(s);
         return NULL;

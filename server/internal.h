@@ -31,6 +31,7 @@
 #include "rcache.h"
 #include "store.h"
 #include "route.h"
+#include "watch.h"
 
 typedef struct srv_static srv_static;
 typedef struct srv_stream srv_stream;
@@ -45,6 +46,7 @@ struct srv_server {
     srv_store *store;            /* durable ids (--store), or NULL for none */
     srv_static *web;
     srv_log *log;                /* the access log, or NULL (--quiet) */
+    srv_watch *watch;            /* closes connections whose request head is late (--request-timeout) */
     pthread_mutex_t json_lock;   /* cJSON_Parse writes a global */
     pthread_mutex_t lock;        /* with idle: srv_stop waits for in_flight to reach 0 */
     pthread_cond_t idle;

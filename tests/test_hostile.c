@@ -405,14 +405,14 @@ static void a_body_sent_one_byte_each_half_second_should_be_cut_off_at_the_reque
     stop(&d);
 }
 
-static void slow_bodies_at_the_per_address_limit_should_not_lock_the_address_out(void **state)
+/* --max-conns-per-ip connections each sending head (and then a byte every 250 ms, never idle) lock their
+ * address out for --request-timeout at most. */
+static void slow_clients_at_the_limit(const char *head)
 {
-    (void)state;
     daemon_t d;
     start(&d, "--request-timeout 2 --max-conns-per-ip 8");
     enum { N = 8 };
     int fd[N];
-    const char *head = "POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: 1000\r\n\r\n";
     for (int i = 0; i < N; i++) {
         fd[i] = raw_dial(d.port);
         assert_true(fd[i] >= 0);
@@ -438,6 +438,21 @@ static void slow_bodies_at_the_per_address_limit_should_not_lock_the_address_out
     if (ok_at > 3.5)
         fail_msg("/livez first succeeded after %.1f s, over the request timeout + 1 s", ok_at);
     stop(&d);
+}
+
+static void slow_bodies_at_the_per_address_limit_should_not_lock_the_address_out(void **state)
+{
+    (void)state;
+    slow_clients_at_the_limit("POST /solve HTTP/1.1\r\nHost: localhost\r\nContent-Length: 1000\r\n\r\n");
+}
+
+/* The same with heads that never end (slowloris): libmicrohttpd's --timeout is an idle timeout, and the
+ * handler that keeps --request-timeout is called only once a head is whole, so 128 of them locked
+ * localhost out for as long as they trickled (QA: with --timeout 3 --request-timeout 3, still open at 12 s). */
+static void slow_heads_at_the_per_address_limit_should_not_lock_the_address_out(void **state)
+{
+    (void)state;
+    slow_clients_at_the_limit("GET /livez HTTP/1.1\r\nHost: localhost\r\nX-Slow: ");
 }
 
 /* At --max-conns, one more connection is answered at once, a 503 problem with Retry-After, and closed;
@@ -1512,6 +1527,7 @@ int main(void)
         T(livez_should_answer_while_the_only_polling_thread_sends_a_heavy_stream),
         T(a_body_sent_one_byte_each_half_second_should_be_cut_off_at_the_request_timeout),
         T(slow_bodies_at_the_per_address_limit_should_not_lock_the_address_out),
+        T(slow_heads_at_the_per_address_limit_should_not_lock_the_address_out),
         T(a_connection_over_max_conns_should_get_a_prompt_503_while_the_others_are_served),
         T(an_oversized_body_with_expect_100_continue_should_get_413_before_any_byte_of_it),
         T(a_client_that_writes_all_its_body_before_reading_should_read_the_413_20_of_20_times),
