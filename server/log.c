@@ -63,6 +63,18 @@ static char *put_hex(char *o, const char *pre, unsigned c)
     return o;
 }
 
+/* A C1 control (U+0080 to U+009F) or a bidirectional control (U+061C, U+200E, U+200F, U+202A to U+202E,
+ * U+2066 to U+2069: a viewer shows the rest of a line after U+202E reversed), the valid UTF-8 sequence
+ * at p of n bytes: escaped, as C0 controls are. */
+static int unseen(const unsigned char *p, size_t n)
+{
+    if (n == 2)
+        return (p[0] == 0xc2 && p[1] < 0xa0) || (p[0] == 0xd8 && p[1] == 0x9c);
+    return n == 3 && p[0] == 0xe2 &&
+           ((p[1] == 0x80 && (p[2] == 0x8e || p[2] == 0x8f || (p[2] >= 0xaa && p[2] <= 0xae))) ||
+            (p[1] == 0x81 && p[2] >= 0xa6 && p[2] <= 0xa9));
+}
+
 /* At most 4 bytes out per byte in. With space, ' ' is escaped too (for fields outside quotes). */
 static char *esc_text(char *o, const char *s, int space)
 {
@@ -79,9 +91,9 @@ static char *esc_text(char *o, const char *s, int space)
             p++;
         } else {
             size_t n = c >= 0x80 ? utf8_seq(p) : 0;
-            if (n == 2 && c == 0xc2 && p[1] < 0xa0) {   /* a C1 control */
-                o = put_hex(o, "\\x", c);
-                o = put_hex(o, "\\x", p[1]);
+            if (unseen(p, n)) {
+                for (size_t i = 0; i < n; i++)
+                    o = put_hex(o, "\\x", p[i]);
             } else if (n == 0) {
                 o = put_hex(o, "\\x", c);
                 n = 1;
@@ -116,8 +128,10 @@ static char *esc_json(char *o, const char *s)
             p++;
         } else {
             size_t n = utf8_seq(p);
-            if (n == 2 && c == 0xc2 && p[1] < 0xa0) {
-                o = put_hex(o, "\\u00", p[1]);
+            if (unseen(p, n)) {   /* as \\u: U+0080 to U+009F, U+061C, U+20xx */
+                const unsigned cp = n == 2 ? ((c & 0x1fu) << 6) | (p[1] & 0x3fu)
+                                           : ((c & 0x0fu) << 12) | ((p[1] & 0x3fu) << 6) | (p[2] & 0x3fu);
+                o = put_hex(put_hex(o, "\\u", cp >> 8), "", cp & 0xff);
             } else if (n == 0) {
                 memcpy(o, "\xef\xbf\xbd", 3);   /* U+FFFD */
                 o += 3;
