@@ -35,6 +35,6 @@ static void msh_cost(const pde_solution *sol, const unsigned res[3], const api_o
 }
 
 const api_format_info api_format_msh = {
-    .name = "msh", .mime = "text/plain", .ext = ".msh", .mesh = 0,
+    .name = "msh", .mime = "text/plain", .ext = ".msh", .range = API_RANGE_DETJ, .mesh = 0,
     .open = msh_open, .fill = msh_fill, .close = api_vol_close, .cost = msh_cost,
 };

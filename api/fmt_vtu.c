@@ -36,6 +36,6 @@ static void vtu_cost(const pde_solution *sol, const unsigned res[3], const api_o
 }
 
 const api_format_info api_format_vtu = {
-    .name = "vtu", .mime = "application/xml", .ext = ".vtu", .props = 1, .binary = 1,
+    .name = "vtu", .mime = "application/xml", .ext = ".vtu", .range = API_RANGE_DETJ, .props = 1, .binary = 1,
     .open = vtu_open, .fill = vtu_fill, .close = api_vol_close, .cost = vtu_cost,
 };

@@ -359,7 +359,7 @@ static int range_check(const pde_solution *sol, const api_format_info *fi, api_e
         for (int a = 0; a < 3; a++)
             d[c][a] = mag[c][a + 1];
     }
-    if (!(x <= limit))
+    if (!(x <= limit) && fi->range != API_RANGE_DETJ)
         return api_fail(err, API_ERR_DOCUMENT, "", "the solid is too large for %s: its coordinates could reach "
                         "%.3g, beyond the range of float32 (%.3g), in which %s samples them; scale the model's data "
                         "or forces down", fi->name, x, (double)FLT_MAX, fi->name);
@@ -370,10 +370,12 @@ static int range_check(const pde_solution *sol, const api_format_info *fi, api_e
         n[a] = sqrt(d[0][a] * d[0][a] + d[1][a] * d[1][a] + d[2][a] * d[2][a]);
     const double p = fmax(fmax(fmax(n[0] * n[1], n[1] * n[2]), n[0] * n[2]), n[0] * n[1] * n[2]);
     if (!(p <= limit))
-        return api_fail(err, API_ERR_DOCUMENT, "", "the solid is too large for %s: its coordinates fit float32, "
-                        "but its derivatives' products (det J, the skin's normals) could reach %.3g, beyond the "
-                        "range of float32 (%.3g), in which %s writes them; scale the model's data or forces down",
-                        fi->name, p, (double)FLT_MAX, fi->name);
+        return api_fail(err, API_ERR_DOCUMENT, "", "the solid is too large for %s: %s, but its derivatives' "
+                        "products (%s) could reach %.3g, beyond the range of float32 (%.3g), in which %s writes them; "
+                        "scale the model's data or forces down", fi->name,
+                        fi->range == API_RANGE_DETJ ? "its points are written as doubles" : "its coordinates fit float32",
+                        fi->range == API_RANGE_DETJ ? "det J" : "det J, the skin's normals", p, (double)FLT_MAX,
+                        fi->name);
     return 0;
 }
 

@@ -71,6 +71,7 @@ struct api_cost;
 typedef enum {
     API_RANGE_DERIVS = 0,   /* the coordinates and products of derivatives: normals, det J (skins, volumes) */
     API_RANGE_POINTS,       /* the coordinates only (grid, f32) */
+    API_RANGE_DETJ,         /* det J only: the points are doubles (msh, vtu) */
     API_RANGE_DOUBLES,      /* doubles only (json: its properties refuse what overflows a double) */
 } api_range;
 

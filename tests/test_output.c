@@ -1153,6 +1153,34 @@ static void obj_ply_msh_and_vtu_should_read_back_in_meshio(void **state)
     }
 }
 
+/* A solid far from the origin, whose points overflow float32 but whose derivatives do not (x = 1e39 + u):
+ * the formats whose points are doubles (msh, vtu) write it, the others say float32 can't hold its
+ * coordinates (msh refused it "beyond the range of float32, in which msh samples them": QA). */
+static void points_beyond_float32_should_be_refused_only_where_they_are_float32(void **state)
+{
+    (void)state;
+    const char *doc = "{\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], \"c\": [1, 1, 1]}, \"boundary\": {"
+                      "\"x\": [{\"w0\": 1e39, \"w1\": 1e39}, {\"u\": {\"pow\": 1}, \"w0\": 1, \"w1\": 1}],"
+                      " \"y\": [{\"v\": {\"pow\": 1}, \"w0\": 1, \"w1\": 1}], \"z\": [{\"w1\": 1, \"dw0\": 1, \"dw1\": 1}]}}";
+    api_error err;
+    api_model *m = api_model_parse(doc, strlen(doc), &err);
+    assert_non_null(m);
+    pde_solution *sol = NULL;
+    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
+    for (int f = 0; f < API_FMT_COUNT; f++) {
+        const api_format_info *fi = api_format_info_of((api_format)f);
+        const int doubles = f == API_FMT_JSON || f == API_FMT_MSH || f == API_FMT_VTU;
+        memset(&err, 0, sizeof err);
+        const int refused = api_output_check(sol, (api_format)f, NULL, &err) != 0;
+        if (refused == doubles)
+            fail_msg("%s: %s", fi->name, refused ? err.message : "not refused");
+        if (refused && !strstr(err.message, "coordinates could reach 1e+39, beyond the range of float32"))
+            fail_msg("%s: \"%s\"", fi->name, err.message);
+    }
+    pde_solution_free(sol);
+    api_model_free(m);
+}
+
 /* A solid whose integrals overflow a double (fig. 4a with p0 = 1e100) is a document the client can mend,
  * not an out-of-memory 500: every format that carries the properties says why. */
 static void properties_beyond_a_double_should_be_a_document_error(void **state)
@@ -1222,6 +1250,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(properties_beyond_a_double_should_be_a_document_error),
+        cmocka_unit_test(points_beyond_float32_should_be_refused_only_where_they_are_float32),
         cmocka_unit_test(presets_should_carry_the_papers_values),
         cmocka_unit_test(presets_should_be_the_tests_own_transcription),
         cmocka_unit_test(every_preset_should_give_gltf_and_glb_that_the_khronos_validator_passes),
