@@ -105,7 +105,7 @@ typedef struct {
     int authority;   /* the target, in absolute form, has an authority with userinfo (@) or %-escapes */
     int over;        /* opened beyond --max-conns: its requests are answered 503 */
     size_t target;   /* the current request's target, in bytes as sent */
-    srv_watched w;   /* its head's deadline (watch.h); w.prev NULL when not watched */
+    srv_watched w;   /* its head's deadline (watch.h) */
 } conn_state;
 
 
@@ -316,6 +316,15 @@ static int admit(srv_req *r, const char *method)
         srv_problem(r, qs.bad ? 400 : 422, NULL, "%s", qs.msg);
         return 0;
     }
+    const char *ce = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_ENCODING);
+    if (ce && strcasecmp(ce, "identity") && (srv_routes[r->route].flags & SRV_RT_BODY)) {
+        char shown[64];
+        api_text_clean(shown, sizeof shown, ce, strlen(ce));
+        r->decided = 1;   /* RFC 9110 15.5.16: 415 for a content coding not taken (a gzip body read as JSON: 0x1F) */
+        srv_problem(r, 415, NULL, "the body's Content-Encoding is %s; pdesolidd takes bodies uncompressed "
+                    "(identity): send it without the header", shown);
+        return 0;
+    }
     if (!srv_origin_allowed(r)) {
         r->decided = 1;
         srv_problem(r, 403, NULL, "cross-origin requests from %s are not allowed here (--cors-origin)",
@@ -494,7 +503,7 @@ static void watch_busy(srv_server *s, struct MHD_Connection *conn, int busy)
 {
     const union MHD_ConnectionInfo *ci = MHD_get_connection_info(conn, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
     conn_state *cs = ci ? ci->socket_context : NULL;
-    if (cs && cs->w.prev)
+    if (cs)
         srv_watch_busy(s->watch, &cs->w, busy);
 }
 
@@ -616,7 +625,7 @@ static void connection_event(void *cls, struct MHD_Connection *conn, void **sock
     } else {
         atomic_fetch_sub(&s->conns, 1);
         conn_state *cs = *socket_context;
-        if (cs && cs->w.prev)
+        if (cs)
             srv_watch_close(s->watch, &cs->w);
         free(cs);
         *socket_context = NULL;

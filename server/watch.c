@@ -95,18 +95,21 @@ void srv_watch_open(srv_watch *w, srv_watched *c, int fd)
     pthread_mutex_unlock(&w->lock);
 }
 
+/* Both read c->prev under the lock: closing a neighbour writes it. */
 void srv_watch_close(srv_watch *w, srv_watched *c)
 {
     pthread_mutex_lock(&w->lock);
-    c->prev->next = c->next, c->next->prev = c->prev;
-    c->prev = c->next = NULL;
+    if (c->prev) {
+        c->prev->next = c->next, c->next->prev = c->prev;
+        c->prev = c->next = NULL;
+    }
     pthread_mutex_unlock(&w->lock);
 }
 
 void srv_watch_busy(srv_watch *w, srv_watched *c, int busy)
 {
     pthread_mutex_lock(&w->lock);
-    c->busy = busy;
-    c->since = now();
+    if (c->prev)
+        c->busy = busy, c->since = now();
     pthread_mutex_unlock(&w->lock);
 }

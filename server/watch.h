@@ -23,7 +23,8 @@ srv_watch *srv_watch_start(double limit, double period);
 void srv_watch_stop(srv_watch *w);
 
 /* Connection opened on fd (its head's clock starts), closed (before libmicrohttpd closes fd), its head
- * whole (busy), its answer done (the next head's clock starts). */
+ * whole (busy), its answer done (the next head's clock starts). c zeroed and never opened: close and
+ * busy do nothing. */
 void srv_watch_open(srv_watch *w, srv_watched *c, int fd);
 void srv_watch_close(srv_watch *w, srv_watched *c);
 void srv_watch_busy(srv_watch *w, srv_watched *c, int busy);
