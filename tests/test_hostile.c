@@ -1027,6 +1027,27 @@ static void an_unknown_query_parameter_should_be_400_naming_it_and_the_known_one
     stop(&d);
 }
 
+/* A compressed body is a 415 naming the coding (a gzip body was read as JSON: 400 "not the control character
+ * 0x1F": QA); identity, or a route without a body, is served as before. */
+static void a_content_encoded_body_should_be_415_naming_the_coding(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    static const char gz[] = "\x1f\x8b\x08\x00\x00\x00\x00\x00\x00\x03\xab\x56\x2a\x28\x4a\x2d";
+    raw_reply r = ask(&d, "POST", "/solve", "Content-Encoding: gzip\r\n", gz, sizeof gz - 1, 8000);
+    expect_problem(&r, 415, NULL, "Content-Encoding is gzip");
+    raw_reply_free(&r);
+    const char *body = "{\"preset\":\"fig1a\"}";
+    r = ask(&d, "POST", "/solve", "Content-Encoding: identity\r\n", body, strlen(body), 8000);
+    assert_int_equal(r.status, 200);
+    raw_reply_free(&r);
+    r = ask(&d, "GET", "/livez", "Content-Encoding: br\r\n", NULL, 0, 5000);
+    assert_int_equal(r.status, 200);
+    raw_reply_free(&r);
+    stop(&d);
+}
+
 /* ---- framing ---- */
 
 static void bad_framing_should_get_one_error_response_or_a_close_within_2_s(void **state)
@@ -1541,6 +1562,7 @@ int main(void)
         T(eval_far_outside_the_cube_should_be_422_naming_the_point_and_never_write_nan),
         T(the_response_cache_should_key_on_the_whole_query),
         T(nul_in_a_path_query_or_body_should_be_400),
+        T(a_content_encoded_body_should_be_415_naming_the_coding),
         T(invalid_utf8_anywhere_should_give_a_problem_in_valid_json_and_utf8),
         T(an_unknown_query_parameter_should_be_400_naming_it_and_the_known_ones),
         T(bad_framing_should_get_one_error_response_or_a_close_within_2_s),
