@@ -99,6 +99,7 @@ typedef struct srv_req {
     double checked;              /* when a job last looked at fd (srv_now) */
     double queued_at, run_start;
     double work;                 /* seconds the solver threads spent on it before this run */
+    double cpu, cpu_start;       /* the CPU seconds of those runs, and the thread's CPU clock at this run's start */
     srv_entry *heavy;            /* the solid whose output waits apart (--heavy-work), or NULL */
     void (*later)(struct srv_req *r);   /* the heavy remainder, run apart (--heavy-work), or NULL */
     int apart;                   /* running that remainder now: it runs to the end, not deferred again */

@@ -137,6 +137,18 @@ int srv_job_stop(void *arg)
     return r->gone || atomic_load(&r->s->aborting) || r->work + (now - r->run_start) > r->s->cfg.job_timeout;
 }
 
+/* The calling thread's CPU clock, in seconds. */
+static double thread_cpu(void)
+{
+    struct timespec t;
+    return clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t) ? 0.0 : t.tv_sec + t.tv_nsec * 1e-9;
+}
+
+/* A job past --job-timeout that had the CPU to itself most of that time is too much work for this server
+ * (422: the same request would only run out of time again; its estimate was within --max-work); one that
+ * did not got too little of it, the server being busy (503, Retry-After). */
+#define CPU_SHARE 0.75
+
 /* The problem of a job that stopped: shutdown, the deadline, or no problem at all for a client gone (499,
  * nginx's "client closed request": http.c closes the connection without an answer). */
 static void stopped(srv_req *r)
@@ -155,8 +167,17 @@ static void stopped(srv_req *r)
             srv_log_note(s->log, "pdesolidd", msg);
         }
     } else {
-        srv_problem(r, 503, NULL, "the request ran past its deadline of %g s of solver time (--job-timeout)",
-                    s->cfg.job_timeout);
+        const double wall = r->work + (srv_now() - r->run_start), cpu = r->cpu + (thread_cpu() - r->cpu_start);
+        if (cpu >= CPU_SHARE * wall)
+            srv_problem(r, 422, NULL, "the request ran past its deadline of %g s of solver time (--job-timeout), "
+                        "on a CPU of its own (%.2g s of CPU in %.2g s): it is more work than this server takes, "
+                        "though its estimate (%.3g units) was within --max-work; ask for a lower res, or a smaller "
+                        "model (fewer terms, or a loft with fewer sections or grid points)",
+                        s->cfg.job_timeout, cpu, wall, r->cost.work);
+        else
+            srv_problem(r, 503, NULL, "the server is busy: the request ran past its deadline of %g s of solver "
+                        "time (--job-timeout) with %.2g s of CPU in %.2g s; try again shortly", s->cfg.job_timeout,
+                        cpu, wall);
     }
 }
 
@@ -630,6 +651,7 @@ static void run_heavy(void *arg)
     r->apart = 1;
     srv_metrics_heavy(r->s->metrics);
     r->run_start = srv_now();
+    r->cpu_start = thread_cpu();
     r->tm.queue += r->run_start - r->queued_at;
     if (atomic_load(&r->s->aborting) || client_gone(r, r->run_start)) {
         drop_later(r);
@@ -643,6 +665,7 @@ void srv_run_job(void *arg)
 {
     srv_req *r = arg;
     r->run_start = srv_now();
+    r->cpu_start = thread_cpu();
     r->tm.queue = r->run_start - r->queued_at;
     r->cancel = (pde_cancel){ srv_job_stop, r };
     if (atomic_load(&r->s->aborting) || client_gone(r, r->run_start))   /* a client that left while its job was queued */
@@ -661,6 +684,7 @@ static void job_end(srv_req *r)
         stopped(r);
     }
     r->work += srv_now() - r->run_start;
+    r->cpu += thread_cpu() - r->cpu_start;
     if (r->later) {
         r->queued_at = srv_now();
         if (srv_pool_defer_heavy(s->pool, run_heavy, r, s->cfg.heavy_queue) == 0)
