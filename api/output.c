@@ -395,8 +395,10 @@ pde_status api_properties(const pde_solution *sol, const pde_cancel *cancel, pde
     else if (st == PDE_ERR_RANGE)
         api_fail(err, API_ERR_DOCUMENT, "", "the solid is too large: its properties (volume, inertia) exceed "
                  "the range of a double; scale the model's data or forces down");
-    else if (st != PDE_OK)
-        api_fail_nomem(err);   /* the one failure left for a solution (PDE_ERR_INVALID: no solution) */
+    else if (st == PDE_ERR_NOMEM)
+        api_fail_nomem(err);
+    else if (st != PDE_OK)   /* pde_properties' refusal of its arguments: PDE_ERR_INVALID, no solution */
+        api_fail(err, api_status_of(st), "", "the properties: %s", pde_strerror(st));
     return st;
 }
 

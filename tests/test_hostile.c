@@ -785,7 +785,8 @@ static void a_client_gone_while_its_job_runs_should_stop_the_job_and_be_logged_4
 }
 
 /* Bytes that come while a job runs, a request pipelined on the same keep-alive connection, are no close: the job
- * runs to its end (here its deadline, a 503) and both requests are answered, in order. */
+ * runs to its end (here its deadline: a 422, or a 503 where it was starved of CPU) and both requests are
+ * answered, in order. */
 static void a_request_pipelined_while_a_job_runs_should_not_cancel_it(void **state)
 {
     (void)state;
@@ -798,9 +799,11 @@ static void a_request_pipelined_while_a_job_runs_should_not_cancel_it(void **sta
     long n = raw_read_to_close(fd, buf, sizeof buf, 8);
     close(fd);
     const char *first = strstr(buf, "HTTP/1.1 "), *second = first ? strstr(first + 9, "HTTP/1.1 ") : NULL;
-    if (n < 0 || !first || !second || strncmp(first, "HTTP/1.1 503", 12) || strncmp(second, "HTTP/1.1 200", 12))
-        fail_msg("expected the job's 503 (its deadline) and the pipelined request's 200, got (%ld bytes): %s", n,
-                 shown(buf, 0));
+    const int deadline = first && (!strncmp(first, "HTTP/1.1 422", 12) || !strncmp(first, "HTTP/1.1 503", 12)) &&
+                         strstr(first, "ran past its deadline");
+    if (n < 0 || !first || !second || !deadline || strncmp(second, "HTTP/1.1 200", 12))
+        fail_msg("expected the job's deadline (422, or 503 on a busy machine) and the pipelined request's 200, got "
+                 "(%ld bytes): %s", n, shown(buf, 0));
     stop(&d);
     char *log = read_file(d.log, NULL);
     if (log && strstr(log, "closed its connection"))
