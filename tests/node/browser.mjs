@@ -479,7 +479,12 @@ await check('folds: fig4a is red where det J < 0, with a legend; the warning fli
   } else console.log('# skip the fold colouring: this server\'s glb has no _DETJ attribute');
   await page.click('#fold');
   await page.waitForFunction(() => window.pdesolid.state.foldAt, null, { timeout: 10000 });
-  await page.waitForTimeout(900);
+  // the flight is an animation: on a loaded machine it takes longer than its nominal time (a fixed 900 ms wait
+  // caught the camera on its way), so wait for it to arrive, up to 10 s
+  await page.waitForFunction(() => {
+    const s = window.pdesolid.state, [x, y, z] = s.foldAt, g = [x, z, -y];
+    return Math.hypot(...g.map((c, i) => c - s.target[i])) <= 1e-3;
+  }, null, { timeout: 10000 }).catch(() => {});
   const t = await state(), [x, y, z] = t.foldAt, g = [x, z, -y];
   const d = Math.hypot(...g.map((c, i) => c - t.target[i]));
   if (d > 1e-3) throw new Error(`the camera looks at ${t.target}, the minimum is at ${g}`);
