@@ -832,17 +832,58 @@ static void kronrod_w(harm_ctx *H, double a, double b, const wpanel *p, double *
 
 static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int depth, int split, double *out);
 
-/* [c, c + d] (d < 0: [c + d, c]) graded towards c, each piece with outer. */
+/* The Gauss and Kronrod rules over [c, c + d] (d of either sign) in s, w = c + d s^2, into G and K */
+static void rule_sq(harm_ctx *H, double c, double d, double *G, double *K)
+{
+    double v[2];
+    G[0] = G[1] = 0.0;
+    mean_w(H, c + 0.25 * d, v);
+    for (int k = 0; k < 2; k++)
+        K[k] = wgk[10] * 0.5 * v[k];
+    for (int i = 0; i < 10; i++)
+        for (int sd = 0; sd < 2; sd++) {
+            const double s = 0.5 + (sd ? 0.5 : -0.5) * xgk[i];
+            mean_w(H, c + d * s * s, v);
+            for (int k = 0; k < 2; k++) {
+                K[k] += wgk[i] * s * v[k];
+                if (i & 1)
+                    G[k] += wg[i / 2] * s * v[k];
+            }
+        }
+    for (int k = 0; k < 2; k++)   /* dw = 2 |d| s ds, and the rules' half-length 1/2 */
+        G[k] *= fabs(d), K[k] *= fabs(d);
+}
+
+/*
+ * [c, c + d] (d < 0: [c + d, c]) from a cut c at a dip of w. Where the section degenerates at c, the
+ * element's mean is a(w) + b(w) t^2 log|t| (t = w - c; to a segment) or |t| a(w) (to a point), a and b
+ * analytic: w = c + d s^2 takes it to a function of s as smooth as s^5 log s at 0, and one Gauss-Kronrod
+ * rule in s takes the whole side (fig. 4a: its 4 sides within 2e-14 of a fine grading, the Gauss rule's
+ * error 2.5e-11 to 1e-10 against tolerances 1.3e-10 to 1.6e-10). Where it fails its test (the side's far
+ * part: the panel's own scale, another dip), the far piece [c + W_GRADE d, c + d] goes to outer (which
+ * may halve it, or cut it again) and the rest as the side, W_LEVELS times, then the last to outer.
+ */
 static int outer_toward(harm_ctx *H, double c, double d, int depth, double *out)
 {
-    for (int k = 0; k <= W_LEVELS; k++, d *= W_GRADE) {
+    for (int k = 0;; k++, d *= W_GRADE) {
+        double G[2], K[2];
+        int ok = 1;
+        rule_sq(H, c, d, G, K);
+        for (int j = 0; j < 2; j++)
+            ok &= fabs(K[j] - G[j]) <= fmax(H->tol[j] * fabs(d), NOISE * fabs(K[j]));
+        if (ok) {
+            for (int j = 0; j < 2; j++)
+                out[j] += K[j];
+            return 1;
+        }
         const double lo = k < W_LEVELS ? c + W_GRADE * d : c, hi = c + d, a = fmin(lo, hi), b = fmax(lo, hi);
         wpanel coarse;
         rule_w(H, a, b, &coarse);
         if (!outer(H, a, b, &coarse, depth, 1, out))
             return 0;
+        if (k == W_LEVELS)
+            return 1;
     }
-    return 1;
 }
 
 /*
