@@ -871,14 +871,15 @@ static void patterson_w(harm_ctx *H, double a, double b, const wpanel *p, double
     double v[2];
     for (int k = 0; k < 2; k++)
         P[k] = wpk[10] * kv[10][k];
-    for (int i = 0; i < 11; i++)
+    for (int i = 0; i < 5; i++)   /* the Kronrod rule's points */
+        for (int sd = 0; sd < 2; sd++)
+            for (int k = 0; k < 2; k++)
+                P[k] += wpk[2 * i] * kv[2 * i + sd][k] + wpk[2 * i + 1] * p->f[i][sd][k];
+    for (int i = 0; i < 11; i++)   /* and its own */
         for (int sd = 0; sd < 2; sd++) {
             mean_w(H, c + (sd ? h : -h) * xp[i], v);
-            for (int k = 0; k < 2; k++) {
+            for (int k = 0; k < 2; k++)
                 P[k] += wpn[i] * v[k];
-                if (i < 5)
-                    P[k] += wpk[2 * i] * kv[2 * i + sd][k] + wpk[2 * i + 1] * p->f[i][sd][k];
-            }
         }
     for (int k = 0; k < 2; k++)
         P[k] *= h;
