@@ -22,6 +22,7 @@
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#include <stdio.h>
 
 #include "harm.h"
 #include "quad.h"
@@ -45,8 +46,11 @@
                           * Gauss rules agree with it to this of the tolerance (at the tolerance itself,
                           * fig. 4x's area moved by 7.7e-13) */
 #define P43_TRY 1e4     /* ... and Patterson's extension where the two differ by at most this of the tolerance
-                         * (where it agreed with the Kronrod rule, 15000 at most on the presets; beyond, it
-                         * failed but twice, and its 22 points were lost: fig. 2c's layer at w = 0) */
+                         * (beyond, on the presets, it failed but twice, and its 22 points were lost: fig.
+                         * 2c's layer at w = 0), kept where it agrees with the Kronrod rule to HALVES_AGREE
+                         * of the tolerance: at the tolerance itself both were 1.2e-9 off on a fig. 4 model
+                         * (b = 4, c = -10, r0 = 1.16, r1 = 1.13, r'0 = 3.3, r'1 = -1.2, h'0 = 5.8, h'1 = 0.9,
+                         * p0 = 5e5, xi = 7: w in [0.982, 1]), agreeing to 3.4e-2 of it */
 #define P43_CUT 100     /* ... and before a cut at a dip of w where they differ by at most this (fig. 4l's
                          * dips of 0.03 to 0.05 of the largest, 4 to 24 tolerances: cut, they took 94 points
                          * where Patterson's rule took 22) */
@@ -777,9 +781,9 @@ static double dip_place(harm_ctx *H, double a, double b, double lo, double hi)
  * took 20, the Gauss points kept for it (wpanel). Where the two differ, Patterson's 43-point extension
  * of the Kronrod rule (22 points more, xp; wpk its weights at the Kronrod rule's points in xgk's order,
  * wpn at xp; exact for degree 65, computed anew to 60 digits: the Stieltjes polynomials of P_10 and of
- * the Kronrod rule's nodes), kept where it agrees with the Kronrod rule; else the halves' Gauss rules,
- * the children's own, which keep it where they agree with it to HALVES_AGREE of the tolerance. A face
- * of many harmonics (a loft's) against its halves still (outer).
+ * the Kronrod rule's nodes), kept where it agrees with the Kronrod rule to HALVES_AGREE of the
+ * tolerance; else the halves' Gauss rules, the children's own, which keep it where they agree with it
+ * as closely. A face of many harmonics (a loft's) against its halves still (outer).
  */
 static const double xgk[11] = { 0.995657163025808080735527280689003, 0.973906528517171720077964012084452,
                                 0.930157491355708226001207180059508, 0.865063366688984510732096688423493,
@@ -830,14 +834,31 @@ static void mean_w(harm_ctx *H, double w, double *val)
         at_w(H, w, val);
 }
 
-/* The Gauss rule over [a, b] into p */
-static void rule_w(harm_ctx *H, double a, double b, wpanel *p)
+/* A side of a cut in s (outer_toward): w = c + d s^2 */
+typedef struct {
+    double c, d;
+} wmap;
+
+/* The means at x, w = x where sq is NULL, else w = sq's map of x and the means times dw/dx */
+static void mean_at(harm_ctx *H, const wmap *sq, double x, double *val)
+{
+    if (!sq) {
+        mean_w(H, x, val);
+        return;
+    }
+    mean_w(H, sq->c + sq->d * x * x, val);
+    for (int k = 0; k < 2; k++)
+        val[k] *= 2.0 * fabs(sq->d) * x;
+}
+
+/* The Gauss rule over [a, b] (of w, or of s where sq is not NULL) into p */
+static void rule_w(harm_ctx *H, const wmap *sq, double a, double b, wpanel *p)
 {
     const double c = 0.5 * (a + b), h = 0.5 * (b - a);
     p->sum[0] = p->sum[1] = 0.0;
     for (int i = 0; i < 5; i++)
         for (int sd = 0; sd < 2; sd++) {
-            mean_w(H, c + (sd ? h : -h) * xgk[2 * i + 1], p->f[i][sd]);
+            mean_at(H, sq, c + (sd ? h : -h) * xgk[2 * i + 1], p->f[i][sd]);
             for (int k = 0; k < 2; k++)
                 p->sum[k] += wg[i] * p->f[i][sd][k];
         }
@@ -847,15 +868,15 @@ static void rule_w(harm_ctx *H, double a, double b, wpanel *p)
 
 /* The Kronrod rule over [a, b], whose Gauss rule is p, into K; its values at c -+ h xgk[2 i] into
  * kv[2 i + side], at c into kv[10] */
-static void kronrod_w(harm_ctx *H, double a, double b, const wpanel *p, double kv[11][2], double *K)
+static void kronrod_w(harm_ctx *H, const wmap *sq, double a, double b, const wpanel *p, double kv[11][2], double *K)
 {
     const double c = 0.5 * (a + b), h = 0.5 * (b - a);
-    mean_w(H, c, kv[10]);
+    mean_at(H, sq, c, kv[10]);
     for (int k = 0; k < 2; k++)
         K[k] = wgk[10] * kv[10][k];
     for (int i = 0; i < 5; i++) {
         for (int sd = 0; sd < 2; sd++) {
-            mean_w(H, c + (sd ? h : -h) * xgk[2 * i], kv[2 * i + sd]);
+            mean_at(H, sq, c + (sd ? h : -h) * xgk[2 * i], kv[2 * i + sd]);
             for (int k = 0; k < 2; k++)
                 K[k] += wgk[2 * i] * kv[2 * i + sd][k] + wgk[2 * i + 1] * p->f[i][sd][k];
         }
@@ -865,7 +886,7 @@ static void kronrod_w(harm_ctx *H, double a, double b, const wpanel *p, double k
 }
 
 /* Patterson's rule over [a, b], whose Gauss rule is p and Kronrod rule's values kv, into P */
-static void patterson_w(harm_ctx *H, double a, double b, const wpanel *p, double kv[11][2], double *P)
+static void patterson_w(harm_ctx *H, const wmap *sq, double a, double b, const wpanel *p, double kv[11][2], double *P)
 {
     const double c = 0.5 * (a + b), h = 0.5 * (b - a);
     double v[2];
@@ -877,7 +898,7 @@ static void patterson_w(harm_ctx *H, double a, double b, const wpanel *p, double
                 P[k] += wpk[2 * i] * kv[2 * i + sd][k] + wpk[2 * i + 1] * p->f[i][sd][k];
     for (int i = 0; i < 11; i++)   /* and its own */
         for (int sd = 0; sd < 2; sd++) {
-            mean_w(H, c + (sd ? h : -h) * xp[i], v);
+            mean_at(H, sq, c + (sd ? h : -h) * xp[i], v);
             for (int k = 0; k < 2; k++)
                 P[k] += wpn[i] * v[k];
         }
@@ -896,28 +917,6 @@ static int agree(const harm_ctx *H, const double *X, const double *Y, double len
 
 static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int depth, int split, double *out);
 
-/* The Gauss and Kronrod rules over [c, c + d] (d of either sign) in s, w = c + d s^2, into G and K */
-static void rule_sq(harm_ctx *H, double c, double d, double *G, double *K)
-{
-    double v[2];
-    G[0] = G[1] = 0.0;
-    mean_w(H, c + 0.25 * d, v);
-    for (int k = 0; k < 2; k++)
-        K[k] = wgk[10] * 0.5 * v[k];
-    for (int i = 0; i < 10; i++)
-        for (int sd = 0; sd < 2; sd++) {
-            const double s = 0.5 + (sd ? 0.5 : -0.5) * xgk[i];
-            mean_w(H, c + d * s * s, v);
-            for (int k = 0; k < 2; k++) {
-                K[k] += wgk[i] * s * v[k];
-                if (i & 1)
-                    G[k] += wg[i / 2] * s * v[k];
-            }
-        }
-    for (int k = 0; k < 2; k++)   /* dw = 2 |d| s ds, and the rules' half-length 1/2 */
-        G[k] *= fabs(d), K[k] *= fabs(d);
-}
-
 /*
  * [c, c + d] (d < 0: [c + d, c]) from a cut c at a dip of w. Where the section degenerates at c, the
  * element's mean is a(w) + b(w) t^2 log|t| (t = w - c; to a segment) or |t| a(w) (to a point), a and b
@@ -930,16 +929,26 @@ static void rule_sq(harm_ctx *H, double c, double d, double *G, double *K)
 static int outer_toward(harm_ctx *H, double c, double d, int depth, double *out)
 {
     for (int k = 0;; k++, d *= W_GRADE) {
-        double G[2], K[2];
-        rule_sq(H, c, d, G, K);
-        if (agree(H, K, G, fabs(d), 1.0)) {
+        const wmap sq = { c, d };
+        wpanel g;
+        double K[2], kv[11][2], P[2];
+        const double *best = K;
+        rule_w(H, &sq, 0.0, 1.0, &g);
+        kronrod_w(H, &sq, 0.0, 1.0, &g, kv, K);
+        int ok = agree(H, K, g.sum, fabs(d), 1.0);
+        if (!ok && agree(H, K, g.sum, fabs(d), P43_TRY)) {   /* Patterson's rule against K, as outer's */
+            patterson_w(H, &sq, 0.0, 1.0, &g, kv, P);
+            ok = agree(H, P, K, fabs(d), HALVES_AGREE);
+            best = P;
+        }
+        if (ok) {
             for (int j = 0; j < 2; j++)
-                out[j] += K[j];
+                out[j] += best[j];
             return 1;
         }
         const double lo = k < W_LEVELS ? c + W_GRADE * d : c, hi = c + d, a = fmin(lo, hi), b = fmax(lo, hi);
         wpanel coarse;
-        rule_w(H, a, b, &coarse);
+        rule_w(H, NULL, a, b, &coarse);
         if (!outer(H, a, b, &coarse, depth, 1, out))
             return 0;
         if (k == W_LEVELS)
@@ -970,12 +979,12 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
         return 0;   /* the panels then, which bound their work */
     H->dip = INFINITY;
     if (H->many) {   /* a loft's: its halves (the Kronrod rule moved the tower's area by 1.3e-12) */
-        rule_w(H, a, m, &l);
-        rule_w(H, m, b, &r);
+        rule_w(H, NULL, a, m, &l);
+        rule_w(H, NULL, m, b, &r);
         for (int k = 0; k < 2; k++)
             K[k] = l.sum[k] + r.sum[k];
     } else
-        kronrod_w(H, a, b, coarse, kv, K);
+        kronrod_w(H, NULL, a, b, coarse, kv, K);
     if (isnan(K[0]) || isnan(K[1]))
         return 0;   /* no refinement mends it */
     if (agree(H, K, coarse->sum, b - a, 1.0)) {
@@ -989,9 +998,9 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
     double P[2];
     const double *best = K;
     if (!H->many && agree(H, K, coarse->sum, b - a, cut ? P43_CUT : P43_TRY)) {   /* Patterson's rule against K */
-        patterson_w(H, a, b, coarse, kv, P);
+        patterson_w(H, NULL, a, b, coarse, kv, P);
         best = P;
-        if (agree(H, P, K, b - a, 1.0)) {
+        if (agree(H, P, K, b - a, HALVES_AGREE)) {
             for (int k = 0; k < 2; k++)
                 out[k] += P[k];
             return 1;
@@ -1008,8 +1017,8 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
         split = 0;   /* the dip is at an end, where a cut was: halves */
     }
     if (!H->many) {   /* the halves' Gauss rules, the children's own, against the best so far */
-        rule_w(H, a, m, &l);
-        rule_w(H, m, b, &r);
+        rule_w(H, NULL, a, m, &l);
+        rule_w(H, NULL, m, b, &r);
         const double LR[2] = { l.sum[0] + r.sum[0], l.sum[1] + r.sum[1] };
         if (agree(H, best, LR, b - a, HALVES_AGREE)) {
             for (int k = 0; k < 2; k++)
@@ -1422,9 +1431,27 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
         if (flat)
             ok = 2;
     }
+    if (getenv("HSCAN") && ok == 1 && axis < 2 && !H.many) {
+        const double a0 = atof(getenv("HSCAN")), b0 = atof(getenv("HSCANB"));
+        /* composite: 64 pieces of K21 */
+        double tot = 0;
+        for (int j = 0; j < 256; j++) {
+            wpanel g; double K[2], kv[11][2];
+            const double a = a0 + (b0 - a0) * j / 256, b = a0 + (b0 - a0) * (j + 1) / 256;
+            rule_w(&H, NULL, a, b, &g); kronrod_w(&H, NULL, a, b, &g, kv, K); tot += K[0];
+        }
+        wpanel g; double K[2], kv[11][2], P[2];
+        rule_w(&H, NULL, a0, b0, &g); kronrod_w(&H, NULL, a0, b0, &g, kv, K); patterson_w(&H, NULL, a0, b0, &g, kv, P);
+        fprintf(stderr, "fine %.17g G %.17g K %.17g P %.17g  K-fine %.3g P-fine %.3g\n", tot, g.sum[0], K[0], P[0], K[0]-tot, P[0]-tot);
+        for (int j = 0; j <= 40 && getenv("HSCANV"); j++) {
+            double w = a0 + (b0 - a0) * j / 40, v[2]; trig4 q; double dip;
+            section(&H, w, &q); v[0] = elem_mean(o, &q, NULL, &dip);
+            fprintf(stderr, "  w=%.6f F=%.15g dip=%.3g odd=%d\n", w, v[0], dip, q.odd);
+        }
+    }
     for (int i = 0; i < o->np && ok == 1 && axis < 2; i++) {
         wpanel coarse;
-        rule_w(&H, o->edge[i], o->edge[i + 1], &coarse);
+        rule_w(&H, NULL, o->edge[i], o->edge[i + 1], &coarse);
         ok = outer(&H, o->edge[i], o->edge[i + 1], &coarse, 0, 2, sum);
     }
     if (H.fold || H.work > MANY_WORK)
