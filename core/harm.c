@@ -22,7 +22,6 @@
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
-#include <stdio.h>
 
 #include "harm.h"
 #include "quad.h"
@@ -922,9 +921,10 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
  * element's mean is a(w) + b(w) t^2 log|t| (t = w - c; to a segment) or |t| a(w) (to a point), a and b
  * analytic: w = c + d s^2 takes it to a function of s as smooth as s^5 log s at 0, and one Gauss-Kronrod
  * rule in s takes the whole side (fig. 4a: its 4 sides within 2e-14 of a fine grading, the Gauss rule's
- * error 2.5e-11 to 1e-10 against tolerances 1.3e-10 to 1.6e-10). Where it fails its test (the side's far
- * part: the panel's own scale, another dip), the far piece [c + W_GRADE d, c + d] goes to outer (which
- * may halve it, or cut it again) and the rest as the side, W_LEVELS times, then the last to outer.
+ * error 2.5e-11 to 1e-10 against tolerances 1.3e-10 to 1.6e-10), or its Patterson extension as outer's.
+ * Where they fail their tests (the side's far part: the panel's own scale, another dip), the far piece
+ * [c + W_GRADE d, c + d] goes to outer (which may halve it, or cut it again) and the rest as the side,
+ * W_LEVELS times, then the last to outer.
  */
 static int outer_toward(harm_ctx *H, double c, double d, int depth, double *out)
 {
@@ -1430,24 +1430,6 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
             flat = H.mslot[m] < 3 || H.wt[m] == 0.0;
         if (flat)
             ok = 2;
-    }
-    if (getenv("HSCAN") && ok == 1 && axis < 2 && !H.many) {
-        const double a0 = atof(getenv("HSCAN")), b0 = atof(getenv("HSCANB"));
-        /* composite: 64 pieces of K21 */
-        double tot = 0;
-        for (int j = 0; j < 256; j++) {
-            wpanel g; double K[2], kv[11][2];
-            const double a = a0 + (b0 - a0) * j / 256, b = a0 + (b0 - a0) * (j + 1) / 256;
-            rule_w(&H, NULL, a, b, &g); kronrod_w(&H, NULL, a, b, &g, kv, K); tot += K[0];
-        }
-        wpanel g; double K[2], kv[11][2], P[2];
-        rule_w(&H, NULL, a0, b0, &g); kronrod_w(&H, NULL, a0, b0, &g, kv, K); patterson_w(&H, NULL, a0, b0, &g, kv, P);
-        fprintf(stderr, "fine %.17g G %.17g K %.17g P %.17g  K-fine %.3g P-fine %.3g\n", tot, g.sum[0], K[0], P[0], K[0]-tot, P[0]-tot);
-        for (int j = 0; j <= 40 && getenv("HSCANV"); j++) {
-            double w = a0 + (b0 - a0) * j / 40, v[2]; trig4 q; double dip;
-            section(&H, w, &q); v[0] = elem_mean(o, &q, NULL, &dip);
-            fprintf(stderr, "  w=%.6f F=%.15g dip=%.3g odd=%d\n", w, v[0], dip, q.odd);
-        }
     }
     for (int i = 0; i < o->np && ok == 1 && axis < 2; i++) {
         wpanel coarse;
