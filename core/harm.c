@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "harm.h"
+#include "quad.h"
 
 #define NT 256          /* points of theta per 2 pi on the trapezoidal rule's finest level */
 #define N0 16           /* ... on its first */
@@ -43,6 +44,15 @@
 #define HALVES_AGREE 1e-2 /* a panel whose Kronrod rule fails against its Gauss rule keeps it where its halves'
                           * Gauss rules agree with it to this of the tolerance (at the tolerance itself,
                           * fig. 4x's area moved by 7.7e-13) */
+#define P43_TRY 1e4     /* ... and Patterson's extension where the two differ by at most this of the tolerance
+                         * (beyond, on the presets, it failed but twice, and its 22 points were lost: fig.
+                         * 2c's layer at w = 0), kept where it agrees with the Kronrod rule to HALVES_AGREE
+                         * of the tolerance: at the tolerance itself both were 1.2e-9 off on a fig. 4 model
+                         * (b = 4, c = -10, r0 = 1.16, r1 = 1.13, r'0 = 3.3, r'1 = -1.2, h'0 = 5.8, h'1 = 0.9,
+                         * p0 = 5e5, xi = 7: w in [0.982, 1]), agreeing to 3.4e-2 of it */
+#define P43_CUT 100     /* ... and before a cut at a dip of w where they differ by at most this (fig. 4l's
+                         * dips of 0.03 to 0.05 of the largest, 4 to 24 tolerances: cut, they took 94 points
+                         * where Patterson's rule took 22) */
 #define DIP 0.05        /* a panel of w that fails its halves with the element below this of its largest */
 #define DIP_EPS 1e-7    /* ... is cut at the least place, located to this of the panel, */
 #define W_GRADE 0.1     /* ... and graded towards it, each piece this of the distance left, */
@@ -101,7 +111,12 @@ typedef struct {
     const harm_opts *o;
     const pde_solution *s;
     size_t nm;
-    double *wt, *h, *dh;       /* per mode: its factor of the face's fixed parameter at the side; h, h' */
+    double *wt, *h, *dh;       /* per mode: its factor of the face's fixed parameter at the side; per mode
+                                * of hs: h, h' */
+    const pde_solution *hs;    /* the modes whose h(w) are evaluated: s's, or each distinct one once (distinct) */
+    pde_solution distinct;     /* its modes dmodes (quad_same_h; fig. 2 and 4: 3 of 5) */
+    pde_mode *dmodes;
+    unsigned *map;             /* per mode of s: its h's place in h, dh */
     unsigned char *slot;       /* per mode: 3 part + c, part 0 sin (A), 1 cos (B), 2 the factor 1 (D) */
     double kpi, tol[2];
     double dip, dip_at;        /* the least element over its largest at the points of w since reset, and where */
@@ -660,9 +675,9 @@ static void square(trig4 *q)
 static double section(harm_ctx *H, double w, trig4 *q)
 {
     double x[9] = { 0 }, d[9] = { 0 };   /* A, B, D and their w-derivatives, component c of part p at 3 p + c */
-    solution_factors(H->s, 2, w, H->h, H->dh);
+    solution_factors(H->hs, 2, w, H->h, H->dh);
     for (size_t m = 0; m < H->nm; m++)
-        x[H->slot[m]] += H->wt[m] * H->h[m], d[H->slot[m]] += H->wt[m] * H->dh[m];
+        x[H->slot[m]] += H->wt[m] * H->h[H->map[m]], d[H->slot[m]] += H->wt[m] * H->dh[H->map[m]];
     H->nodes++;
     const double *A = x, *B = x + 3, *D = x + 6, *Ap = d, *Bp = d + 3, *Dp = d + 6, s = 0.5 * H->kpi;
     double (*v)[3] = q->v, t[3];
@@ -762,9 +777,12 @@ static double dip_place(harm_ctx *H, double a, double b, double lo, double hi)
 /*
  * Along w, each panel's 10-point Gauss rule, then its 21-point Kronrod extension (QUADPACK's qk21 on
  * [-1, 1]: xgk[1], xgk[3], ... the Gauss rule's nodes, wg its weights): 11 points more where halving
- * took 20, the Gauss points kept for it (wpanel). Where the two differ, the halves' Gauss rules, the
- * children's own, which keep the Kronrod rule where they agree with it to HALVES_AGREE of the
- * tolerance. A face of many harmonics (a loft's) against its halves still (outer).
+ * took 20, the Gauss points kept for it (wpanel). Where the two differ, Patterson's 43-point extension
+ * of the Kronrod rule (22 points more, xp; wpk its weights at the Kronrod rule's points in xgk's order,
+ * wpn at xp; exact for degree 65, computed anew to 60 digits: the Stieltjes polynomials of P_10 and of
+ * the Kronrod rule's nodes), kept where it agrees with the Kronrod rule to HALVES_AGREE of the
+ * tolerance; else the halves' Gauss rules, the children's own, which keep it where they agree with it
+ * as closely. A face of many harmonics (a loft's) against its halves still (outer).
  */
 static const double xgk[11] = { 0.995657163025808080735527280689003, 0.973906528517171720077964012084452,
                                 0.930157491355708226001207180059508, 0.865063366688984510732096688423493,
@@ -781,6 +799,25 @@ static const double wg[5] = { 0.066671344308688137593568809893332, 0.14945134915
                               0.219086362515982043995534934228163, 0.269266719309996355091226921569469,
                               0.295524224714752870173892994651338 };
 
+static const double xp[11] = { 0.999333360901932081394099323919911, 0.987433402908088869795961478381209,
+                               0.954807934814266299257919200290473, 0.900148695748328293625099494069092,
+                               0.825198314983114150847066732588520, 0.732148388989304982612354848755461,
+                               0.622847970537725238641159120344323, 0.499479574071056499952214885499755,
+                               0.364901661346580768043989548502644, 0.222254919776601296498260928066212,
+                               0.0746506174613833220439144357965059 };
+static const double wpk[11] = { 0.00576855605976979618418432790865461, 0.0162967342896665649242819746176625,
+                                0.0273718905932488420812760692891511, 0.0375228761208695014616137958981146,
+                                0.0465608269104288307433391544338236, 0.0546949020582554421472126854650048,
+                                0.0617449952014425644962403360308832, 0.0673554146094780860755531663021745,
+                                0.0713872672686933977685591144255160, 0.0738701996323939534321406952513671,
+                                0.0747221475174030055944251682804227 };
+static const double wpn[11] = { 0.00184447764021241410038910655296516, 0.0107986895858916517404654067412932,
+                                0.0218953638677954281025231230751493, 0.0325974639753456894438822225261371,
+                                0.0421631379351918118476279243279552, 0.0507419396001845777801890200920840,
+                                0.0583793955426192483754753693302063, 0.0647464049514458855446892595175109,
+                                0.0695661979123564845286333150384049, 0.0728244414718332081509395351928418,
+                                0.0745077510141751182735718138428888 };
+
 typedef struct {
     double sum[2];       /* the Gauss rule's, area and flux */
     double f[5][2][2];   /* its values at c -+ h xgk[2 i + 1]: [i][side][area, flux] */
@@ -796,14 +833,31 @@ static void mean_w(harm_ctx *H, double w, double *val)
         at_w(H, w, val);
 }
 
-/* The Gauss rule over [a, b] into p */
-static void rule_w(harm_ctx *H, double a, double b, wpanel *p)
+/* A side of a cut in s (outer_toward): w = c + d s^2 */
+typedef struct {
+    double c, d;
+} wmap;
+
+/* The means at x, w = x where sq is NULL, else w = sq's map of x and the means times dw/dx */
+static void mean_at(harm_ctx *H, const wmap *sq, double x, double *val)
+{
+    if (!sq) {
+        mean_w(H, x, val);
+        return;
+    }
+    mean_w(H, sq->c + sq->d * x * x, val);
+    for (int k = 0; k < 2; k++)
+        val[k] *= 2.0 * fabs(sq->d) * x;
+}
+
+/* The Gauss rule over [a, b] (of w, or of s where sq is not NULL) into p */
+static void rule_w(harm_ctx *H, const wmap *sq, double a, double b, wpanel *p)
 {
     const double c = 0.5 * (a + b), h = 0.5 * (b - a);
     p->sum[0] = p->sum[1] = 0.0;
     for (int i = 0; i < 5; i++)
         for (int sd = 0; sd < 2; sd++) {
-            mean_w(H, c + (sd ? h : -h) * xgk[2 * i + 1], p->f[i][sd]);
+            mean_at(H, sq, c + (sd ? h : -h) * xgk[2 * i + 1], p->f[i][sd]);
             for (int k = 0; k < 2; k++)
                 p->sum[k] += wg[i] * p->f[i][sd][k];
         }
@@ -811,38 +865,95 @@ static void rule_w(harm_ctx *H, double a, double b, wpanel *p)
         p->sum[k] *= h;
 }
 
-/* The Kronrod rule over [a, b], whose Gauss rule is p, into K */
-static void kronrod_w(harm_ctx *H, double a, double b, const wpanel *p, double *K)
+/* The Kronrod rule over [a, b], whose Gauss rule is p, into K; its values at c -+ h xgk[2 i] into
+ * kv[2 i + side], at c into kv[10] */
+static void kronrod_w(harm_ctx *H, const wmap *sq, double a, double b, const wpanel *p, double kv[11][2], double *K)
 {
     const double c = 0.5 * (a + b), h = 0.5 * (b - a);
-    double v[2];
-    mean_w(H, c, v);
+    mean_at(H, sq, c, kv[10]);
     for (int k = 0; k < 2; k++)
-        K[k] = wgk[10] * v[k];
+        K[k] = wgk[10] * kv[10][k];
     for (int i = 0; i < 5; i++) {
         for (int sd = 0; sd < 2; sd++) {
-            mean_w(H, c + (sd ? h : -h) * xgk[2 * i], v);
+            mean_at(H, sq, c + (sd ? h : -h) * xgk[2 * i], kv[2 * i + sd]);
             for (int k = 0; k < 2; k++)
-                K[k] += wgk[2 * i] * v[k] + wgk[2 * i + 1] * p->f[i][sd][k];
+                K[k] += wgk[2 * i] * kv[2 * i + sd][k] + wgk[2 * i + 1] * p->f[i][sd][k];
         }
     }
     for (int k = 0; k < 2; k++)
         K[k] *= h;
 }
 
+/* Patterson's rule over [a, b], whose Gauss rule is p and Kronrod rule's values kv, into P */
+static void patterson_w(harm_ctx *H, const wmap *sq, double a, double b, const wpanel *p, double kv[11][2], double *P)
+{
+    const double c = 0.5 * (a + b), h = 0.5 * (b - a);
+    double v[2];
+    for (int k = 0; k < 2; k++)
+        P[k] = wpk[10] * kv[10][k];
+    for (int i = 0; i < 5; i++)   /* the Kronrod rule's points */
+        for (int sd = 0; sd < 2; sd++)
+            for (int k = 0; k < 2; k++)
+                P[k] += wpk[2 * i] * kv[2 * i + sd][k] + wpk[2 * i + 1] * p->f[i][sd][k];
+    for (int i = 0; i < 11; i++)   /* and its own */
+        for (int sd = 0; sd < 2; sd++) {
+            mean_at(H, sq, c + (sd ? h : -h) * xp[i], v);
+            for (int k = 0; k < 2; k++)
+                P[k] += wpn[i] * v[k];
+        }
+    for (int k = 0; k < 2; k++)
+        P[k] *= h;
+}
+
+/* X and Y (area, flux) over a length len agree to f of the tolerances per unit length, or of NOISE of X */
+static int agree(const harm_ctx *H, const double *X, const double *Y, double len, double f)
+{
+    int ok = 1;
+    for (int k = 0; k < 2; k++)
+        ok &= fabs(X[k] - Y[k]) <= f * fmax(H->tol[k] * len, NOISE * fabs(X[k]));
+    return ok;
+}
+
 static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int depth, int split, double *out);
 
-/* [c, c + d] (d < 0: [c + d, c]) graded towards c, each piece with outer. */
+/*
+ * [c, c + d] (d < 0: [c + d, c]) from a cut c at a dip of w. Where the section degenerates at c, the
+ * element's mean is a(w) + b(w) t^2 log|t| (t = w - c; to a segment) or |t| a(w) (to a point), a and b
+ * analytic: w = c + d s^2 takes it to a function of s as smooth as s^5 log s at 0, and one Gauss-Kronrod
+ * rule in s takes the whole side (fig. 4a: its 4 sides within 2e-14 of a fine grading, the Gauss rule's
+ * error 2.5e-11 to 1e-10 against tolerances 1.3e-10 to 1.6e-10), or its Patterson extension as outer's.
+ * Where they fail their tests (the side's far part: the panel's own scale, another dip), the far piece
+ * [c + W_GRADE d, c + d] goes to outer (which may halve it, or cut it again) and the rest as the side,
+ * W_LEVELS times, then the last to outer.
+ */
 static int outer_toward(harm_ctx *H, double c, double d, int depth, double *out)
 {
-    for (int k = 0; k <= W_LEVELS; k++, d *= W_GRADE) {
+    for (int k = 0;; k++, d *= W_GRADE) {
+        const wmap sq = { c, d };
+        wpanel g;
+        double K[2], kv[11][2], P[2];
+        const double *best = K;
+        rule_w(H, &sq, 0.0, 1.0, &g);
+        kronrod_w(H, &sq, 0.0, 1.0, &g, kv, K);
+        int ok = agree(H, K, g.sum, fabs(d), 1.0);
+        if (!ok && agree(H, K, g.sum, fabs(d), P43_TRY)) {   /* Patterson's rule against K, as outer's */
+            patterson_w(H, &sq, 0.0, 1.0, &g, kv, P);
+            ok = agree(H, P, K, fabs(d), HALVES_AGREE);
+            best = P;
+        }
+        if (ok) {
+            for (int j = 0; j < 2; j++)
+                out[j] += best[j];
+            return 1;
+        }
         const double lo = k < W_LEVELS ? c + W_GRADE * d : c, hi = c + d, a = fmin(lo, hi), b = fmax(lo, hi);
         wpanel coarse;
-        rule_w(H, a, b, &coarse);
+        rule_w(H, NULL, a, b, &coarse);
         if (!outer(H, a, b, &coarse, depth, 1, out))
             return 0;
+        if (k == W_LEVELS)
+            return 1;
     }
-    return 1;
 }
 
 /*
@@ -858,7 +969,7 @@ static int outer_toward(harm_ctx *H, double c, double d, int depth, double *out)
 static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int depth, int split, double *out)
 {
     const double m = 0.5 * (a + b);
-    double K[2];
+    double K[2], kv[11][2];
     wpanel l, r;
     if (H->nodes >= H->next_poll) {   /* a dip's points of w may take a few ms */
         H->next_poll = H->nodes + H->poll_every;
@@ -868,26 +979,34 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
         return 0;   /* the panels then, which bound their work */
     H->dip = INFINITY;
     if (H->many) {   /* a loft's: its halves (the Kronrod rule moved the tower's area by 1.3e-12) */
-        rule_w(H, a, m, &l);
-        rule_w(H, m, b, &r);
+        rule_w(H, NULL, a, m, &l);
+        rule_w(H, NULL, m, b, &r);
         for (int k = 0; k < 2; k++)
             K[k] = l.sum[k] + r.sum[k];
     } else
-        kronrod_w(H, a, b, coarse, K);
-    int ok = 1;
-    for (int k = 0; k < 2; k++) {
-        if (isnan(K[k]))
-            return 0;   /* no refinement mends it */
-        ok &= fabs(K[k] - coarse->sum[k]) <= fmax(H->tol[k] * (b - a), NOISE * fabs(K[k]));
-    }
-    if (ok) {
+        kronrod_w(H, NULL, a, b, coarse, kv, K);
+    if (isnan(K[0]) || isnan(K[1]))
+        return 0;   /* no refinement mends it */
+    if (agree(H, K, coarse->sum, b - a, 1.0)) {
         for (int k = 0; k < 2; k++)
             out[k] += K[k];
         return 1;
     }
     if (depth >= DEPTH)
         return 0;
-    if (split && H->dip < DIP && H->splits > 0) {   /* the Kronrod points' dip: no halves where it is cut */
+    const int cut = split && H->dip < DIP && H->splits > 0;   /* the Kronrod points' dip */
+    double P[2];
+    const double *best = K;
+    if (!H->many && agree(H, K, coarse->sum, b - a, cut ? P43_CUT : P43_TRY)) {   /* Patterson's rule against K */
+        patterson_w(H, NULL, a, b, coarse, kv, P);
+        best = P;
+        if (agree(H, P, K, b - a, HALVES_AGREE)) {
+            for (int k = 0; k < 2; k++)
+                out[k] += P[k];
+            return 1;
+        }
+    }
+    if (cut) {   /* no halves where it is cut */
         H->splits--;
         const double q = 0.125 * (b - a), near = 1e3 * DIP_EPS * (b - a);
         double w0 = dip_place(H, fmax(a, H->dip_at - q), fmin(b, H->dip_at + q), a + near, b - near);
@@ -897,15 +1016,13 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
                    (w0 == b || outer_toward(H, w0, b - w0, depth + 1, out));
         split = 0;   /* the dip is at an end, where a cut was: halves */
     }
-    if (!H->many) {   /* the halves' Gauss rules, more accurate than the panel's, may confirm K */
-        rule_w(H, a, m, &l);
-        rule_w(H, m, b, &r);
-        ok = 1;
-        for (int k = 0; k < 2; k++)
-            ok &= fabs(K[k] - (l.sum[k] + r.sum[k])) <= HALVES_AGREE * fmax(H->tol[k] * (b - a), NOISE * fabs(K[k]));
-        if (ok) {
+    if (!H->many) {   /* the halves' Gauss rules, the children's own, against the best so far */
+        rule_w(H, NULL, a, m, &l);
+        rule_w(H, NULL, m, b, &r);
+        const double LR[2] = { l.sum[0] + r.sum[0], l.sum[1] + r.sum[1] };
+        if (agree(H, best, LR, b - a, HALVES_AGREE)) {
             for (int k = 0; k < 2; k++)
-                out[k] += K[k];
+                out[k] += best[k];
             return 1;
         }
     }
@@ -1145,10 +1262,10 @@ static void many_at_w(void *arg, double w, double *val)
     harm_ctx *H = arg;
     double *cf = H->cf;
     memset(cf, 0, 6 * (2 * (size_t)H->nh + 1) * sizeof *cf);
-    solution_factors(H->s, 2, w, H->h, H->dh);
+    solution_factors(H->hs, 2, w, H->h, H->dh);
     for (size_t m = 0; m < H->nm; m++) {
         const int sl = H->mslot[m], at = 6 * (sl / 3) + sl % 3;
-        cf[at] += H->wt[m] * H->h[m], cf[at + 3] += H->wt[m] * H->dh[m];
+        cf[at] += H->wt[m] * H->h[H->map[m]], cf[at + 3] += H->wt[m] * H->dh[H->map[m]];
     }
     H->nodes++;
     many_mean(H, val);
@@ -1269,7 +1386,9 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
     H.kpi = k * M_PI;
     H.wt = malloc(3 * H.nm * sizeof *H.wt);
     H.slot = malloc(H.nm);
-    int ok = H.wt && H.slot && (!H.many || (!over && many_form(s, axis == 1, seen, &H)));
+    H.dmodes = malloc(H.nm * sizeof *H.dmodes);
+    H.map = malloc(H.nm * sizeof *H.map);
+    int ok = H.wt && H.slot && H.dmodes && H.map && (!H.many || (!over && many_form(s, axis == 1, seen, &H)));
     if (H.many)   /* no cuts of w at dips: least_at's one harmonic */
         H.splits = 0, H.poll_every = MANY_POLL, H.max_nodes = MANY_NODES;
     if (ok) {
@@ -1285,6 +1404,20 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
                     H.wt[m] = -H.wt[m];
                 H.slot[m] = (unsigned char)(3 * part + c);
             }
+        size_t nd = 0;
+        for (int c = 0, m = 0; c < 3; c++)
+            for (size_t i = 0; i < s->comp[c].nmodes; i++, m++) {
+                unsigned j = 0;
+                while (j < nd && !quad_same_h(&H.dmodes[j], &s->comp[c].modes[i]))
+                    j++;
+                if (j == nd)
+                    H.dmodes[nd++] = s->comp[c].modes[i];
+                H.map[m] = j;
+            }
+        H.distinct = *s;
+        H.distinct.comp[0].modes = H.dmodes, H.distinct.comp[0].nmodes = nd;
+        H.distinct.comp[1].nmodes = H.distinct.comp[2].nmodes = 0;
+        H.hs = &H.distinct;
         pthread_once(&trig_once, trig_init);
         H.tol[0] = o->tol, H.tol[1] = o->tol * o->size;
     }
@@ -1300,7 +1433,7 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
     }
     for (int i = 0; i < o->np && ok == 1 && axis < 2; i++) {
         wpanel coarse;
-        rule_w(&H, o->edge[i], o->edge[i + 1], &coarse);
+        rule_w(&H, NULL, o->edge[i], o->edge[i + 1], &coarse);
         ok = outer(&H, o->edge[i], o->edge[i + 1], &coarse, 0, 2, sum);
     }
     if (H.fold || H.work > MANY_WORK)
@@ -1309,6 +1442,8 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
         ok = -1;
     free(H.wt);
     free(H.slot);
+    free(H.dmodes);
+    free(H.map);
     free(H.hj);
     free(H.mslot);
     free(H.cf);

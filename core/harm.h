@@ -11,8 +11,10 @@
  * periods of both: the face's area is the integral over w of the element's mean over theta (the
  * trapezoidal rule, geometric where the element keeps away from 0; adaptive between its located
  * least values where it dips), and its flux x . (x_t x x_w) the integral of a mean known exactly from
- * the coefficients. A, B, D and their w-derivatives come from every mode's h(w) once per point of w;
- * a point of theta costs a dozen flops (docs/MATH.md, "A face of one harmonic").
+ * the coefficients. A, B, D and their w-derivatives come from every distinct h(w) once per point of
+ * w; a point of theta costs a dozen flops. Along w, Gauss-Kronrod(-Patterson) rules on panels, each
+ * side of a degenerate section by one rule in s, w = w0 + d s^2 (docs/MATH.md, "A face of one
+ * harmonic").
  *
  * Faces of 4 or more harmonics along t (a loft's skin u = 1: its profile's Fourier series) the same
  * way, the mean over theta by the trapezoidal rule on 2^n points from the coefficients at each w, cut
