@@ -144,6 +144,51 @@ static inline double min2(double a, double b)
     return b < a ? b : a;
 }
 
+/* The factor along axis a (0: u, 1: v) of a component's k-th mode, then of its force terms (force = 1)
+ * or its boundary terms (force = 0). */
+static pde_factor term_factor(const comp_solution *cs, int a, int force, size_t k)
+{
+    if (k < cs->nmodes)
+        return a ? cs->modes[k].v : cs->modes[k].u;
+    k -= cs->nmodes;
+    if (force)
+        return a ? cs->fterms[k].v : cs->fterms[k].u;
+    return a ? cs->bterms[k].v : cs->bterms[k].u;
+}
+
+/*
+ * The residuals' samples t[0 .. n - 1] along axis a that decide their largest values. Where every
+ * mode of cs and every term (force terms for the PDE, force = 1; boundary terms for the conditions)
+ * has the same factor f along a, the residual and each of its terms and scales are |f(t_i)| times
+ * a function of the two other parameters (for the PDE, where f'''' = lambda f: every factor but t^n
+ * with n >= 4), and so are their sums of absolute values; the largest over the samples is then at
+ * the sample of largest |f|, which alone is taken (fig. 2's x, y and z: the PDE residual at 9 of
+ * its 729 points, both residuals at the same values up to the rounding of the other samples).
+ * Returns the number of samples to take, from *i0 on: n from 0, or 1.
+ */
+static size_t residual_samples(const comp_solution *cs, int a, int force, const double *t, size_t n, size_t *i0)
+{
+    const size_t nt = cs->nmodes + (force ? cs->nfterms : cs->nbterms);
+    *i0 = 0;
+    if (nt == 0)
+        return 1;
+    const pde_factor f = term_factor(cs, a, force, 0);
+    if (force && f.kind == PDE_POW && f.p >= 4.0)
+        return n;
+    for (size_t k = 1; k < nt; k++) {
+        const pde_factor g = term_factor(cs, a, force, k);
+        if (g.kind != f.kind || g.p != f.p)
+            return n;
+    }
+    double big = -1.0;
+    for (size_t i = 0; i < n; i++) {
+        const double v = fabs(factor_deriv(f, t[i], 0));
+        if (v > big)
+            big = v, *i0 = i;
+    }
+    return 1;
+}
+
 /*
  * The boundary residual: the largest error of x and x_w on res x res points of w = 0 and w = 1,
  * relative to the size of the problem, which must not be the solution's size alone:
@@ -157,10 +202,10 @@ static inline double min2(double a, double b)
  *   own size, own[c] = max |x_c| over the solid.
  *
  * So scale = max(data, min(drive, own)), data and drive as sums of the absolute values of their
- * terms at each point; own alone for a component with neither.
+ * terms at each point; own alone for a component with neither. The closed form on w = 0 and 1 is
+ * the sum over modes of f_u f_v times h(0), h'(0), h(1), h'(1), each mode's four values once; along u
+ * and v it is sampled where residual_samples says (one sample where every term has the same factor).
  */
-#define BC_ROWS 32   /* rows of w = 0 and 1 at a time: one h(w) per side and block, in bounded memory */
-
 static pde_status bc_residual(const pde_solution *s, int res, const double own_size[3], poller *pl,
                               double *out)
 {
@@ -169,87 +214,67 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
         return PDE_OK;
     }
     const size_t n = (size_t)res;
-    const size_t nb = s->comp[0].nbterms + s->comp[1].nbterms + s->comp[2].nbterms;
-    const size_t nj = n < BC_ROWS ? n : BC_ROWS;
-    double *uni = malloc((n + 2 * nb * n + 12 * n * nj) * sizeof *uni);
+    size_t nt = 0;
+    for (int c = 0; c < 3; c++)
+        nt = nt > s->comp[c].nmodes + s->comp[c].nbterms ? nt : s->comp[c].nmodes + s->comp[c].nbterms;
+    /* per term (modes, then boundary terms) its factors at the samples; per mode h, h' at w = 0, 1 */
+    double *uni = malloc((n + 2 * nt * n + 4 * nt) * sizeof *uni);
     if (!uni)
         return PDE_ERR_NOMEM;
-    /* The boundary terms' factors at the samples, all components' terms in a row; x, x_w of both sides
-     * in rows j of a block of BC_ROWS (12 n each), each side's h(w) once a block. */
-    double *fu = uni + n, *fv = fu + nb * n, *rows = fv + nb * n;
+    double *fu = uni + n, *fv = fu + nt * n, *hb = fv + nt * n;
     for (size_t i = 0; i < n; i++)
         uni[i] = (double)i / (double)(n - 1);
-    for (size_t c = 0, t0 = 0; c < 3; t0 += s->comp[c++].nbterms)
-        for (size_t t = 0; t < s->comp[c].nbterms; t++)
-            for (size_t i = 0; i < n; i++) {
-                fu[(t0 + t) * n + i] = factor_deriv(s->comp[c].bterms[t].u, uni[i], 0);
-                fv[(t0 + t) * n + i] = factor_deriv(s->comp[c].bterms[t].v, uni[i], 0);
-            }
-    pde_grid *g;
-    pde_status st = pde_grid_create(s, uni, n, uni, n, &g);
-    if (st != PDE_OK) {
-        free(uni);
-        return st;
-    }
-    double err[3] = { 0, 0, 0 }, scale[3] = { 0, 0, 0 };
-    for (size_t j = 0; j < n && st == PDE_OK; j++) {
-        for (int side = 0; side < 2 && j % BC_ROWS == 0; side++) {
-            grid_set_w(g, side);
-            for (size_t jb = j; jb < j + nj && jb < n; jb++) {
-                double *row = rows + 12 * n * (jb - j);
-                grid_row(g, jb, GRID_X | GRID_XW);
-                for (int c = 0; c < 3; c++)
-                    for (size_t i = 0; i < n; i++) {
-                        row[(6 * side + c) * n + i] = g->row[c * n + i];
-                        row[(6 * side + 3 + c) * n + i] = g->row[(9 + c) * n + i];
-                    }
-            }
+    double worst = 0.0;
+    for (int c = 0; c < 3; c++) {
+        const comp_solution *cs = &s->comp[c];
+        const size_t nm = cs->nmodes, nb = cs->nbterms;
+        size_t i0, j0;
+        const size_t ni = residual_samples(cs, 0, 0, uni, n, &i0), nj = residual_samples(cs, 1, 0, uni, n, &j0);
+        for (size_t t = 0; t < nm + nb; t++) {
+            for (size_t i = i0; i < i0 + ni; i++)
+                fu[t * n + i] = factor_deriv(term_factor(cs, 0, 0, t), uni[i], 0);
+            for (size_t j = j0; j < j0 + nj; j++)
+                fv[t * n + j] = factor_deriv(term_factor(cs, 1, 0, t), uni[j], 0);
         }
-        const double *row = rows + 12 * n * (j % BC_ROWS);
-        for (size_t c = 0, t0 = 0; c < 3; t0 += s->comp[c++].nbterms) {
-            const comp_solution *cs = &s->comp[c];
-            if (poll_after(pl, (2 * cs->nmodes + cs->nbterms) * (n + 2) / 4 + 1)) {
-                st = PDE_ERR_CANCELLED;
-                break;
+        for (size_t m = 0; m < nm; m++) {
+            mode_h(&cs->modes[m], 0.0, &hb[4 * m], &hb[4 * m + 1]);
+            mode_h(&cs->modes[m], 1.0, &hb[4 * m + 2], &hb[4 * m + 3]);
+        }
+        double err = 0.0, scale = 0.0;
+        for (size_t j = j0; j < j0 + nj; j++) {
+            if (poll_after(pl, (2 * nm + nb) * (ni + 2) / 4 + 1)) {
+                free(uni);
+                return PDE_ERR_CANCELLED;
             }
-            for (size_t i = 0; i < n; i++) {
-                double d[4] = { 0, 0, 0, 0 }, dabs[4] = { 0, 0, 0, 0 }, sc = 0.0;
-                for (size_t t = 0; t < cs->nbterms; t++) {
+            for (size_t i = i0; i < i0 + ni; i++) {
+                double x[4] = { 0, 0, 0, 0 }, d[4] = { 0, 0, 0, 0 }, dabs[4] = { 0, 0, 0, 0 };
+                double drive[4] = { 0, 0, 0, 0 };
+                for (size_t m = 0; m < nm; m++) {
+                    const double f = fu[m * n + i] * fv[m * n + j];
+                    for (int k = 0; k < 4; k++) {
+                        x[k] += hb[4 * m + k] * f;
+                        drive[k] += fabs(cs->drive[m][k] * f);
+                    }
+                }
+                for (size_t t = 0; t < nb; t++) {
                     const pde_bterm *b = &cs->bterms[t];
-                    double f = fu[(t0 + t) * n + i] * fv[(t0 + t) * n + j];
+                    const double f = fu[(nm + t) * n + i] * fv[(nm + t) * n + j];
                     const double bv[4] = { b->w0, b->dw0, b->w1, b->dw1 };
                     for (int k = 0; k < 4; k++) {
                         d[k] += bv[k] * f;
                         dabs[k] += fabs(bv[k] * f);
                     }
                 }
-                double drive[4] = { 0, 0, 0, 0 };
-                for (size_t m = 0; m < cs->nmodes; m++) {
-                    double f = g->phi[c][g->group[c][m] * n + i] * g->psi[c][m * n + j];
-                    for (int k = 0; k < 4; k++)
-                        drive[k] += fabs(cs->drive[m][k] * f);
+                for (int k = 0; k < 4; k++) {
+                    err = max2(err, fabs(x[k] - d[k]));
+                    scale = max2(scale, max2(dabs[k], min2(drive[k], own_size[c])));
                 }
-                for (int k = 0; k < 4; k++)
-                    drive[k] = min2(drive[k], own_size[c]);
-                for (int side = 0; side < 2; side++) {
-                    double x = row[(6 * side + c) * n + i], xw = row[(6 * side + 3 + c) * n + i];
-                    err[c] = max2(err[c], max2(fabs(x - d[2 * side]), fabs(xw - d[2 * side + 1])));
-                }
-                for (int k = 0; k < 4; k++)
-                    sc = max2(sc, max2(dabs[k], drive[k]));
-                scale[c] = max2(scale[c], sc);
             }
         }
+        const double sc = scale > 0.0 ? scale : own_size[c];
+        worst = fmax(worst, sc > 0.0 ? err / sc : err);
     }
-    pde_grid_free(g);
     free(uni);
-    if (st != PDE_OK)
-        return st;
-    double worst = 0.0;
-    for (int c = 0; c < 3; c++) {
-        double sc = scale[c] > 0.0 ? scale[c] : own_size[c];
-        worst = fmax(worst, sc > 0.0 ? err[c] / sc : err[c]);
-    }
     *out = worst;
     return PDE_OK;
 }
@@ -269,9 +294,11 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
     double worst = 0.0;
     /* h and h'''' of every mode at the samples, x's modes then y's and z's: a mode with the same h(w) as
      * an earlier one (fig. 4: each of x's again in y) copies its rows */
-    double *hall = malloc((2 * mt * n + 1) * sizeof *hall);
+    double *hall = malloc((2 * mt * n + n) * sizeof *hall), *ts = hall + 2 * mt * n;
     if (!hall)
         return PDE_ERR_NOMEM;
+    for (size_t i = 0; i < n; i++)
+        ts[i] = (i + 0.5) / res;
     for (size_t o = 0, c = 0, m = 0; o < mt; o++, m++) {
         while (m >= s->comp[c].nmodes)
             c++, m = 0;
@@ -292,7 +319,7 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
             if (tw < o)
                 h0 = hall[tw * n + i], hw = hall[(mt + tw) * n + i];
             else {
-                const double t = (i + 0.5) / res;
+                const double t = ts[i];
                 size_t k0, k1;
                 mode_slab(md, t, &k0, &k1);   /* a loft's slab of t */
                 for (size_t k = k0; k < k1; k++) {
@@ -321,26 +348,26 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
         double *fu = tab, *fu4 = fu + nm * n, *fv = fu4 + nm * n, *fv4 = fv + nm * n, *uv = fv4 + nm * n;
         const double *h = hall + off * n, *h4 = hall + (mt + off) * n;
         double *pu = uv + 3 * nm, *pv = pu + nf * n, *pw = pv + nf * n, *puv = pw + nf * n;
-        for (size_t t = 0; t < nf; t++)
+        size_t i0, j0;
+        const size_t ni = residual_samples(cs, 0, 1, ts, n, &i0), nj = residual_samples(cs, 1, 1, ts, n, &j0);
+        for (size_t t = 0; t < nf; t++) {
+            const pde_fterm *ft = &cs->fterms[t];
             for (size_t i = 0; i < n; i++) {
-                const pde_fterm *ft = &cs->fterms[t];
-                pu[t * n + i] = factor_deriv(ft->u, (i + 0.5) / res, 0);
-                pv[t * n + i] = factor_deriv(ft->v, (i + 0.5) / res, 0);
-                pw[t * n + i] = factor_deriv(ft->w, (i + 0.5) / res, 0);
-            }
-        for (size_t m = 0; m < nm; m++) {
-            const pde_mode *md = &cs->modes[m];
-            for (size_t i = 0; i < n; i++) {
-                double t = (i + 0.5) / res;
-                fu[m * n + i] = factor_deriv(md->u, t, 0);
-                fu4[m * n + i] = factor_deriv(md->u, t, 4);
-                fv[m * n + i] = factor_deriv(md->v, t, 0);
-                fv4[m * n + i] = factor_deriv(md->v, t, 4);
+                pu[t * n + i] = i >= i0 && i < i0 + ni ? factor_deriv(ft->u, ts[i], 0) : 0.0;
+                pv[t * n + i] = i >= j0 && i < j0 + nj ? factor_deriv(ft->v, ts[i], 0) : 0.0;
+                pw[t * n + i] = factor_deriv(ft->w, ts[i], 0);
             }
         }
+        for (size_t m = 0; m < nm; m++) {
+            const pde_mode *md = &cs->modes[m];
+            for (size_t i = i0; i < i0 + ni; i++)
+                fu[m * n + i] = factor_deriv(md->u, ts[i], 0), fu4[m * n + i] = factor_deriv(md->u, ts[i], 4);
+            for (size_t j = j0; j < j0 + nj; j++)
+                fv[m * n + j] = factor_deriv(md->v, ts[j], 0), fv4[m * n + j] = factor_deriv(md->v, ts[j], 4);
+        }
         double err = 0.0, scale = 0.0;
-        for (size_t i = 0; i < n; i++)
-            for (size_t j = 0; j < n; j++) {
+        for (size_t i = i0; i < i0 + ni; i++)
+            for (size_t j = j0; j < j0 + nj; j++) {
                 if (poll_after(pl, n * (nm + cs->nfterms))) {
                     free(tab);
                     free(hall);
