@@ -1085,6 +1085,21 @@ static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, i
 }
 
 /*
+ * Whether every extreme comes from a search in w alone, as on fig. 2 and 4: each component of w
+ * alone, harmonic, or of one mode, and det J by detj_line on the separable face. The sample then only
+ * seeds those searches (a w each) and sets their tolerances, and a coarser one does (pde_properties).
+ */
+static int extremes_in_w(const pde_solution *s, const quad_sep *sp)
+{
+    harmonic hc;
+    detj_line dl;
+    for (int c = 0; c < 3; c++)
+        if (!(s->comp[c].nmodes && w_only(&s->comp[c])) && !harmonic_of(s, c, &hc) && s->comp[c].nmodes != 1)
+            return 0;
+    return sp->axis >= 0 && sp->free >= 0 && detj_line_of(s, &dl) && dl.h[0].a == sp->axis;
+}
+
+/*
  * Lofts (api/loft.c): a component whose modes each have the factors 1 along u and v (its centre
  * C_c(w)) or the factor t^n along one of them, axis a, the same n >= 1 for all (its profile, t^n
  * P_c(s, w), s the other parameter): x_c = C_c(w) + t^n P_c(s, w). Returns a, or -1 where the
@@ -1449,20 +1464,27 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         }
     if (res < 2 || res > 1025)
         return PDE_ERR_INVALID;
-    double *uni = malloc((size_t)res * sizeof *uni);
+    double *uni = malloc(2 * (size_t)res * sizeof *uni);
     if (!uni)
         return PDE_ERR_NOMEM;
     for (int i = 0; i < res; i++)
         uni[i] = (double)i / (res - 1);
     extremes e;
     extremes_init(&e);
-    /* A polynomial solid: its extremes from Bernstein coefficients, where a sample is of no help. */
+    quad_sep sp;
+    quad_separate(s, &sp);
+    /* A polynomial solid: its extremes from Bernstein coefficients, where a sample is of no help. Where
+     * every extreme is a search in w, every other sample along u and v (fig. 2a: 225 points, not 729). */
     poly_objs *po = poly_objs_new(s);
     pde_status st = PDE_OK;
+    const int step = res >= 5 && res % 2 && extremes_in_w(s, &sp) ? 2 : 1;   /* odd: the ends kept */
+    double *sub = uni + res;
+    for (int i = 0; i < res; i += step)
+        sub[i / step] = uni[i];
     if (po)
         poly_sample(po, &e);
     else
-        st = sweep(s, uni, res, uni, res, uni, res, &pl, &e);
+        st = sweep(s, sub, (res - 1) / step + 1, sub, (res - 1) / step + 1, uni, res, &pl, &e);
     if (st == PDE_OK)
         st = beyond_double(s, uni, res, &pl, &e);
     free(uni);
@@ -1485,8 +1507,6 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     scales(best, &size, &jscale);
     /* Certify each extreme by branch and bound from its sampled point (a compass search polishing it
      * first cost more than it saved: the boxes' centres converge on the extreme as fast). */
-    quad_sep sp;
-    quad_separate(s, &sp);
     double jlow[2], jat[2][3];   /* det J's certified lower bounds of +det J, -det J, without the pad */
     int single[3] = { 0, 0, 0 };   /* components of one mode: both extremes from single_mode_extremes */
     const size_t jbudget = sp.axis < 0 && radial_detj_axis(s) >= 0 ? RADIAL_BOXES : pde_properties_detj_boxes(s);
