@@ -651,16 +651,20 @@ typedef struct {
 typedef struct {
     double key;   /* first: bb_heap's; the parent's lower bound */
     double w0, w1;
+    double v0, v1;   /* sign f at w0 and w1 where known (a slab's end, a parent's centre), else NaN */
 } lbox;
 
 /*
  * min over [0, 1] of sign f by branch and bound over intervals of w (a loft's slabs first: a model
  * holds within one), from start: *lower certified (for the exact closed form), *best = sign f(*wbest),
  * best - lower <= tol / 2 (a margin for the caller's pad) unless `budget` intervals ran out. An
- * interval's model is about the best point found when it holds it (else its centre), and its bound
- * is the model's least value with the rest pointwise, so the interval holding the minimum closes as
- * soon as the quadratic dominates the rest there, not when the rest falls below tol. The quadratic's
- * own argmin is evaluated too: a Newton step, the best point converging as fast.
+ * interval's model is about the best point found when it holds it, else about an end where f is
+ * known to be as low (within tol: a second minimum, as fig. 2's det J = 0 at w = 1 beside the best
+ * point w = 0, where Z' = 0 at both), else about its centre; its bound is the model's least value
+ * with the rest pointwise, so the interval holding the minimum closes as soon as the quadratic
+ * dominates the rest there, not when the rest falls below tol (about a minimum at an end, the slope
+ * away from it dominates: fig. 2a's det J closed on w = 1 in 2 intervals where centres took 11). The
+ * quadratic's own argmin is evaluated too: a Newton step, the best point converging as fast.
  */
 static pde_status line_minimise(const pde_solution *s, const line_fn *f, double sign, double start, double tol,
                                 size_t budget, const pde_cancel *cancel, double *lower, double *best, double *wbest)
@@ -672,7 +676,7 @@ static pde_status line_minimise(const pde_solution *s, const line_fn *f, double 
     const double *br = solution_breaks(s, &nslabs);
     pde_status st = PDE_OK;
     for (size_t k = 0; k < nslabs && st == PDE_OK; k++) {
-        const lbox l = { -INFINITY, br[k], br[k + 1] };
+        const lbox l = { -INFINITY, br[k], br[k + 1], NAN, NAN };
         if (bb_heap_push(&h, &l))
             st = PDE_ERR_NOMEM;
     }
@@ -686,7 +690,24 @@ static pde_status line_minimise(const pde_solution *s, const line_fn *f, double 
         bb_heap_pop(&h, &top);
         /* about the best point where it lies inside (a loft's slab ends belong to the next slab) */
         const double mid = 0.5 * (top.w0 + top.w1), wb = *wbest;
-        const double c = (wb > top.w0 && wb < top.w1) || (nslabs == 1 && wb >= top.w0 && wb <= top.w1) ? wb : mid;
+        double c = mid;
+        if ((wb > top.w0 && wb < top.w1) || (nslabs == 1 && wb >= top.w0 && wb <= top.w1))
+            c = wb;
+        else {
+            /* where the best point is an end of [0, 1], the other end evaluated when first needed (once:
+             * the children keep it): a minimum at both ends is no coincidence (fig. 2's det J) */
+            for (int e = 0; e < 2; e++) {
+                double *v = e ? &top.v1 : &top.v0;
+                const double we = e ? top.w1 : top.w0;
+                if (isnan(*v) && we == br[e ? nslabs : 0] && wb == br[e ? 0 : nslabs]) {
+                    *v = sign * f->value(f->ctx, we);
+                    if (*v < b)
+                        b = *v, *wbest = we;
+                }
+            }
+        }
+        if (c == mid && (top.v0 <= b + tol || top.v1 <= b + tol))
+            c = top.v0 <= top.v1 || !(top.v1 <= b + tol) ? top.w0 : top.w1;
         tm1 m;
         f->model(f->ctx, top.w0, top.w1, c, &m);
         const double q0 = sign * m.p[0], q1 = sign * m.p[1], q2 = sign * m.p[2];
@@ -710,7 +731,8 @@ static pde_status line_minimise(const pde_solution *s, const line_fn *f, double 
             low = fmin(low, lb);
             continue;
         }
-        const lbox lo = { lb, top.w0, mid }, hi = { lb, mid, top.w1 };
+        const double vm = c == mid ? q0 : NAN;
+        const lbox lo = { lb, top.w0, mid, top.v0, vm }, hi = { lb, mid, top.w1, vm, top.v1 };
         if (bb_heap_push(&h, &lo) || bb_heap_push(&h, &hi))
             st = PDE_ERR_NOMEM;
     }
