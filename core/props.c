@@ -972,6 +972,7 @@ typedef struct {
 } detj_memo;
 
 typedef struct {
+    const pde_solution *sol;
     harmonic h[2];
     const comp_solution *zc;   /* z */
     double scale;         /* sigma n k pi */
@@ -995,6 +996,7 @@ static int detj_line_of(const pde_solution *s, detj_line *d)
         /* sigma: the determinant with beta = gamma = 1, alpha = delta = 0, n = k pi = Z' = 1 */
         double M[3][3] = { { 0 } };
         M[c0][a->a] = 1.0, M[c1][a->b] = 1.0, M[z][2] = 1.0;
+        d->sol = s;
         d->zc = zc;
         d->scale = det3(M[0], M[1], M[2]) * a->n * a->k * M_PI;
         d->twins[0] = d->twins[1] = NULL;
@@ -1055,6 +1057,39 @@ static double detj_line_value(const void *ctx, double w)
         zp += dh;
     }
     return d->scale * zp * (ab[1] * gd[0] - ab[0] * gd[1]);
+}
+
+/* g's certified sign on [w0, w1] beyond -tol (+1: g >= -tol; -1: g <= tol), else 0: its model about the
+ * centre, or about an end where g is within tol of 0 (g0, g1: g at the ends, NaN where unknown; fig. 4's
+ * g = 0 at w = 0, where Z' = 0: about the centre, the rest there exceeds g's slope), else its halves'
+ * (down to two halvings) with one sign. */
+static int detj_line_span(const detj_line *d, double w0, double w1, double g0, double g1, double tol, int depth)
+{
+    const double mid = 0.5 * (w0 + w1), c = fabs(g0) <= tol ? w0 : fabs(g1) <= tol ? w1 : mid;
+    tm1 m;
+    detj_line_model(d, w0, w1, c, &m);
+    for (int sg = 1; sg >= -1; sg -= 2) {
+        const double q0 = sg * m.p[0], q1 = sg * m.p[1], q2 = sg * m.p[2];
+        if (fmin(cubic_min(q0, q1, q2, m.k, w1 - c), cubic_min(q0, -q1, q2, m.k, c - w0)) >= -tol)
+            return sg;
+    }
+    if (depth >= 2)
+        return 0;
+    const double gm = c == mid ? m.p[0] : NAN;
+    const int a = detj_line_span(d, w0, mid, g0, gm, tol, depth + 1);
+    return a && detj_line_span(d, mid, w1, gm, g1, tol, depth + 1) == a ? a : 0;
+}
+
+/* quad_wsign's certificate (quad.h) from g's models, within one slab of w (a model holds within one). */
+static int detj_line_sign(const void *ctx, double w0, double w1, double g0, double g1, double tol)
+{
+    const detj_line *d = ctx;
+    size_t nslabs;
+    const double *br = solution_breaks(d->sol, &nslabs);
+    for (size_t k = 1; k < nslabs; k++)
+        if (br[k] > w0 && br[k] < w1)
+            return 0;
+    return detj_line_span(d, w0, w1, g0, g1, tol, 0);
 }
 
 /*
@@ -1635,8 +1670,13 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         x0[c] = 0.5 * (best[2 * c] + best[2 * c + 1]);
         vol_scale *= fmax(best[2 * c + 1] - best[2 * c], 1e-3 * size);
     }
+    /* det J = t^p g(w) (fig. 2, 4): g's sign certified panel by panel of w where it folds elsewhere */
+    detj_line dl;
+    const int line = !jsign && sp.axis >= 0 && sp.free >= 0 && detj_line_of(s, &dl) && dl.h[0].a == sp.axis;
+    dl.memo = jmemo;
+    const quad_wsign ws = { detj_line_sign, &dl };
     quad_result q, qa;
-    if ((st = quad_solid(s, x0, jscale, vol_scale, 1, jsign, cancel, &q)) != PDE_OK ||
+    if ((st = quad_solid_signs(s, x0, jscale, vol_scale, 1, jsign, line ? &ws : NULL, cancel, &q)) != PDE_OK ||
         (st = quad_area(s, size, cancel, &r.surface_area, &qa)) != PDE_OK)
         return st;
     mass_properties(&q, x0, &r);

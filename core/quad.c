@@ -156,6 +156,7 @@ typedef struct {
     int line_sig, line_mixed;    /* poly_line: the first line's signs and roots in panel_lines, and whether
                                   * another line's differ */
     int jsign;                   /* det J's sign where certified over the whole solid (quad_solid), or 0 */
+    const quad_wsign *wsign;     /* free_solid's certificates of G's sign on a panel of w, or NULL */
     int free;                    /* the face's parameter det J does not depend on (quad_sep), or -1 */
     /* The axis whose panels take the uniform (midpoint) rule, quad_solid's periodic path, or -1; the
      * signature of its first line along u (poly_line), and whether a line had another or a root; the
@@ -1289,8 +1290,11 @@ static int free_dip(free_ctx *f, double t0, double t1, double f1, double t2, dou
 }
 
 /* The panel [a, b] of w: G at its ends and rule's nodes, its sign changes and dips located, and each
- * piece between them with its own rule (none: the nodes are the rule). Returns the roots found. */
-static int free_rule(free_ctx *f, double a, double b, double acc[Q_N])
+ * piece between them with its own rule (none: the nodes are the rule). Where *definite is not NULL,
+ * a panel whose points all have one sign asks q->wsign for a certificate of it, and 1 into *definite
+ * where G's sign is certified, by it or over the whole solid (jsign): then no roots or dips are
+ * sought. Returns the roots found. */
+static int free_rule(free_ctx *f, double a, double b, int *definite, double acc[Q_N])
 {
     qctx *q = f->q;
     const int n = axis_points(q, 2, b - a), m = n + 1;
@@ -1301,8 +1305,17 @@ static int free_rule(free_ctx *f, double a, double b, double acc[Q_N])
         t[i] = a + (b - a) * q->gx[n][i - 1];
     for (int i = 0; i <= m; i++)
         g[i] = free_point(f, t[i], i && i < m ? mv[i] : NULL);
+    int sure = q->jsign != 0;
+    if (!sure && definite && q->wsign) {
+        int pos = 0, neg = 0;
+        for (int i = 0; i <= m; i++)
+            pos |= g[i] > q->jtol, neg |= g[i] < -q->jtol;
+        sure = !(pos && neg) && q->wsign->sign(q->wsign->ctx, a, b, g[0], g[m], q->jtol) != 0;
+    }
+    if (definite)
+        *definite = sure;
     int ncut = 0, last = 0;
-    for (int i = 0; i <= m && !q->jsign && off_budget(q); i++) {
+    for (int i = 0; i <= m && !sure && off_budget(q); i++) {
         /* A least |G| among the samples, the panel's ends included: a lobe next to a panel's edge,
          * where |G| is least, has samples on one side only in each panel. An end counts where |G|
          * grows beyond it too (a sample as far outside, none beyond [0, 1]), not on a slope. */
@@ -1348,8 +1361,8 @@ static void free_span(free_ctx *f, double a, double b, const double coarse[Q_N],
     qctx *q = f->q;
     const double mid = 0.5 * (a + b);
     double half[2][Q_N];
-    free_rule(f, a, mid, half[0]);
-    free_rule(f, mid, b, half[1]);
+    free_rule(f, a, mid, NULL, half[0]);
+    free_rule(f, mid, b, NULL, half[1]);
     const double fine = half[0][Q_VOL] + half[1][Q_VOL];
     const int agreed = fabs(fine - coarse[Q_VOL]) <= ROW_TOL * q->vscale;
     if (agreed || depth + 1 >= FREE_SPAN_DEPTH || poll(q) || q->r.evals * q->modes >= REFINE_WORK) {
@@ -1462,8 +1475,11 @@ static int free_solid(qctx *q, const qplan *p, int flat, int sa)
         const double lo = p->edge[2][l], hi = p->edge[2][l + 1];
         double coarse[Q_N], acc[Q_N];
         f.nroot = f.ndip = 0;
-        free_rule(&f, lo, hi, coarse);
-        if (q->jsign)
+        /* G's sign certified on the panel (the whole solid's, or the caller's 1-D models): no root, no
+         * dip, and |G| as smooth as G, which the rule integrates (fig. 4a: 3 of its 6 panels) */
+        int definite;
+        free_rule(&f, lo, hi, &definite, coarse);
+        if (definite)
             memcpy(acc, coarse, sizeof acc);
         else {
             q->r.lined++;
@@ -2171,11 +2187,13 @@ static void mid_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
 }
 
 static pde_status solid_run(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
-                            int jsign, const pde_cancel *cancel, int periodic, quad_result *out, int *rough)
+                            int jsign, const quad_wsign *ws, const pde_cancel *cancel, int periodic, quad_result *out,
+                            int *rough)
 {
     qctx *q = qctx_new(s, cancel);
     if (!q)
         return PDE_ERR_NOMEM;
+    q->wsign = ws;
     quad_sep sp = { .axis = -1, .free = -1 };
     if (separate)
         quad_separate(s, &sp);
@@ -2774,18 +2792,24 @@ static int fold_solid(const pde_solution *s, const double x0[3], double vscale, 
     return 1;
 }
 
-pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
-                      int jsign, const pde_cancel *cancel, quad_result *out)
+pde_status quad_solid_signs(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
+                            int jsign, const quad_wsign *ws, const pde_cancel *cancel, quad_result *out)
 {
     int rough = 0;
     pde_status st;
     /* a loft whose det J may change sign: root-split rows (fold_solid), where it has that form */
     if (!jsign && separate == 1 && fold_solid(s, x0, vscale, cancel, out, &st))
         return st;
-    st = solid_run(s, x0, jscale, vscale, separate, jsign, cancel, 1, out, &rough);
+    st = solid_run(s, x0, jscale, vscale, separate, jsign, ws, cancel, 1, out, &rough);
     if (st == PDE_OK && rough)   /* det J's sign changes along u: the general path */
-        st = solid_run(s, x0, jscale, vscale, separate, jsign, cancel, 0, out, &rough);
+        st = solid_run(s, x0, jscale, vscale, separate, jsign, ws, cancel, 0, out, &rough);
     return st;
+}
+
+pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
+                      int jsign, const pde_cancel *cancel, quad_result *out)
+{
+    return quad_solid_signs(s, x0, jscale, vscale, separate, jsign, NULL, cancel, out);
 }
 
 /* ---- the skin ---- */
