@@ -1293,7 +1293,8 @@ static int free_dip(free_ctx *f, double t0, double t1, double f1, double t2, dou
  * piece between them with its own rule (none: the nodes are the rule). Where *definite is not NULL,
  * a panel whose points all have one sign asks q->wsign for a certificate of it, and 1 into *definite
  * where G's sign is certified, by it or over the whole solid (jsign): then no roots or dips are
- * sought. Returns the roots found. */
+ * sought; or where they were, and q->wsign certifies the sign of every piece between them. Returns
+ * the roots found. */
 static int free_rule(free_ctx *f, double a, double b, int *definite, double acc[Q_N])
 {
     qctx *q = f->q;
@@ -1344,13 +1345,21 @@ static int free_rule(free_ctx *f, double a, double b, int *definite, double acc[
             free_add(acc, mv[i], g[i], (b - a) * q->gw[n][i - 1]);
         return 0;
     }
-    double t0 = a;
-    for (int c = 0; c < ncut; c++)
-        if (cut[c] > t0) {
-            free_gauss(f, t0, cut[c], acc);
-            t0 = cut[c];
-        }
-    free_gauss(f, t0, b, acc);
+    /* Each piece between roots with its own rule; where q->wsign certifies G's sign on every piece
+     * (G = 0 at the roots, about which its models go), no root or lobe was missed, and the panel is as
+     * sure as one of one sign (fig. 4a's two panels with a root each: their halves agreed to the bit). */
+    int pieces = definite && q->wsign && !q->jsign;
+    double t0 = a, g0 = g[0];
+    for (int c = 0; c <= ncut; c++) {
+        const double t1 = c < ncut ? cut[c] : b;
+        if (!(t1 > t0))
+            continue;
+        free_gauss(f, t0, t1, acc);
+        pieces = pieces && q->wsign->sign(q->wsign->ctx, t0, t1, g0, c < ncut ? 0.0 : g[m], q->jtol) != 0;
+        t0 = t1, g0 = 0.0;
+    }
+    if (definite)
+        *definite = pieces;
     return ncut;
 }
 
@@ -1478,11 +1487,12 @@ static int free_solid(qctx *q, const qplan *p, int flat, int sa)
         /* G's sign certified on the panel (the whole solid's, or the caller's 1-D models): no root, no
          * dip, and |G| as smooth as G, which the rule integrates (fig. 4a: 3 of its 6 panels) */
         int definite;
-        free_rule(&f, lo, hi, &definite, coarse);
+        const int roots = free_rule(&f, lo, hi, &definite, coarse);
+        if (roots || !definite)   /* det J may change sign: integral_error's 1e-12 stands */
+            q->r.lined++;
         if (definite)
             memcpy(acc, coarse, sizeof acc);
         else {
-            q->r.lined++;
             free_span(&f, lo, hi, coarse, 0, acc);
             q->r.refined++;
             q->r.refine_change += fabs(acc[Q_VOL] - coarse[Q_VOL]);
