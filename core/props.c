@@ -857,12 +857,14 @@ typedef struct {
     size_t budget;
 } harmonic_memo;
 
-static pde_status harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
-                                    const pde_cancel *cancel, harmonic_memo *memo, double bound[2], double best[2],
-                                    double at[2][3])
+static pde_status harmonic_extremes(const pde_solution *s, int c, const harmonic *known, double start, double tol,
+                                    size_t budget, const pde_cancel *cancel, harmonic_memo *memo, double bound[2],
+                                    double best[2], double at[2][3])
 {
     harmonic hc;
-    if (!harmonic_of(s, c, &hc))
+    if (known)
+        hc = *known;
+    else if (!harmonic_of(s, c, &hc))
         return PDE_ERR_INVALID;
     double up, w, ab[2];
     const harmonic *p = memo && memo->done ? &memo->hc : NULL;
@@ -890,7 +892,7 @@ static pde_status harmonic_extremes(const pde_solution *s, int c, double start, 
 pde_status props_harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
                                    const pde_cancel *cancel, double bound[2], double best[2], double at[2][3])
 {
-    return harmonic_extremes(s, c, start, tol, budget, cancel, NULL, bound, best, at);
+    return harmonic_extremes(s, c, NULL, start, tol, budget, cancel, NULL, bound, best, at);
 }
 
 /* Non-zero when every mode of the component has the factors 1 along u and v: x_c = Z(w) (fig. 2's and 4's z). */
@@ -973,6 +975,7 @@ typedef struct {
 
 typedef struct {
     const pde_solution *sol;
+    int c[2];             /* the components of h[0], h[1] */
     harmonic h[2];
     const comp_solution *zc;   /* z */
     double scale;         /* sigma n k pi */
@@ -997,6 +1000,7 @@ static int detj_line_of(const pde_solution *s, detj_line *d)
         double M[3][3] = { { 0 } };
         M[c0][a->a] = 1.0, M[c1][a->b] = 1.0, M[z][2] = 1.0;
         d->sol = s;
+        d->c[0] = c0, d->c[1] = c1;
         d->zc = zc;
         d->scale = det3(M[0], M[1], M[2]) * a->n * a->k * M_PI;
         d->twins[0] = d->twins[1] = NULL;
@@ -1102,7 +1106,7 @@ static int detj_line_sign(const void *ctx, double w0, double w1, double g0, doub
  */
 static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, int what, double sign,
                                     const double start[3], double tol, size_t budget, const pde_cancel *cancel,
-                                    detj_memo *memo, bb_result *out)
+                                    const detj_line *dl, bb_result *out)
 {
     pbox face = { { 0, 0, 0 }, { 1, 1, 1 } };
     face.lo[sp->axis] = 1.0;
@@ -1122,10 +1126,8 @@ static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, i
     }
     bb_result b = { .at = { at[0], at[1], at[2] } };
     pde_status st = PDE_ERR_INVALID;
-    detj_line dl;
-    if (what == 3 && sp->free >= 0 && detj_line_of(s, &dl) && dl.h[0].a == sp->axis) {
-        dl.memo = memo;
-        const line_fn f = { detj_line_model, detj_line_value, &dl };   /* g(w) alone */
+    if (what == 3 && dl) {
+        const line_fn f = { detj_line_model, detj_line_value, dl };   /* g(w) alone */
         st = line_minimise(s, &f, sign, at[2], tol, budget, cancel, &b.lower, &b.best, &b.at[2]);
     }
     if (st == PDE_ERR_INVALID)
@@ -1139,21 +1141,6 @@ static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, i
     }
     *out = b;
     return PDE_OK;
-}
-
-/*
- * Whether every extreme comes from a search in w alone, as on fig. 2 and 4: each component of w
- * alone, harmonic, or of one mode, and det J by detj_line on the separable face. The sample then only
- * seeds those searches (a w each) and sets their tolerances, and a coarser one does (pde_properties).
- */
-static int extremes_in_w(const pde_solution *s, const quad_sep *sp)
-{
-    harmonic hc;
-    detj_line dl;
-    for (int c = 0; c < 3; c++)
-        if (!(s->comp[c].nmodes && w_only(&s->comp[c])) && !harmonic_of(s, c, &hc) && s->comp[c].nmodes != 1)
-            return 0;
-    return sp->axis >= 0 && sp->free >= 0 && detj_line_of(s, &dl) && dl.h[0].a == sp->axis;
 }
 
 /*
@@ -1371,10 +1358,10 @@ size_t pde_properties_detj_boxes(const pde_solution *s)
 
 /* The extreme of sign * det J by branch and bound, over the face where det J separates. */
 static pde_status what_detj(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
-                            double tol, size_t budget, const pde_cancel *cancel, detj_memo *memo, bb_result *out)
+                            double tol, size_t budget, const pde_cancel *cancel, const detj_line *dl, bb_result *out)
 {
     if (sp->axis >= 0)
-        return separable_extreme(s, sp, 3, sign, start, tol, budget, cancel, memo, out);
+        return separable_extreme(s, sp, 3, sign, start, tol, budget, cancel, dl, out);
     const int a = radial_detj_axis(s);
     if (a >= 0)
         return radial_extreme(s, a, 3, sign, start, tol, budget, cancel, out);
@@ -1530,13 +1517,22 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     extremes_init(&e);
     quad_sep sp;
     quad_separate(s, &sp);
+    /* det J = t^p g(w), x and y harmonic alike, z = Z(w) (fig. 2, 4): g's models for det J's searches
+     * and quad_solid's certificates, and the harmonics' bounds, once (their memo across the searches) */
+    detj_memo jm;
+    for (size_t i = 0; i < DL_MEMO; i++)
+        jm.key[i][0] = NAN;
+    detj_line dl;
+    const int line = sp.axis >= 0 && sp.free >= 0 && detj_line_of(s, &dl) && dl.h[0].a == sp.axis;
+    dl.memo = &jm;
     /* A polynomial solid: its extremes from Bernstein coefficients, where a sample is of no help. Where
-     * every extreme is a search in w, the face t = 1 alone (x_c = t^n X_c and det J = t^p g take their
+     * every extreme is a search in w (det J's, and each component's: x, y harmonic and z = Z(w), with
+     * modes), the face t = 1 alone (x_c = t^n X_c and det J = t^p g take their
      * extremes there, or 0 at t = 0, which the searches add), every other point along its other
      * parameter (fig. 2a: 45 points, not 729). */
     poly_objs *po = poly_objs_new(s);
     pde_status st = PDE_OK;
-    const int inw = res >= 5 && res % 2 && extremes_in_w(s, &sp);   /* odd: the ends kept */
+    const int inw = res >= 5 && res % 2 && line && dl.zc->nmodes;   /* odd: the ends kept */
     const double one = 1.0, *ax[2] = { uni, uni };
     double *sub = uni + res;
     size_t na[2] = { (size_t)res, (size_t)res };
@@ -1578,9 +1574,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     double rn;
     bb_result sb[3][2];
     harmonic_memo hmemo = { 0 };
-    detj_memo jm, *jmemo = &jm;
-    for (size_t i = 0; i < DL_MEMO; i++)
-        jm.key[i][0] = NAN;
+    const detj_line *jl = line ? &dl : NULL;
     double magnitude = 0.0;
     for (int o = 0; o < 8; o++) {
         const int what = o < 6 ? o / 2 : 3;
@@ -1598,7 +1592,8 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             const double *starts[2] = { lo, hi };
             st = s->comp[what].nmodes && w_only(&s->comp[what])
                      ? w_only_extremes(s, what, starts, tol, cancel, bd, bs, ba)
-                     : harmonic_extremes(s, what, fabs(best[o]) > fabs(best[o + 1]) ? lo[2] : hi[2], tol,
+                     : harmonic_extremes(s, what, line && dl.c[0] == what ? &dl.h[0] : line && dl.c[1] == what ? &dl.h[1] : NULL,
+                                         fabs(best[o]) > fabs(best[o + 1]) ? lo[2] : hi[2], tol,
                                          PDE_PROPS_BOXES, cancel, &hmemo, bd, bs, ba);
             if (st == PDE_ERR_INVALID && s->comp[what].nmodes == 1)
                 st = single_mode_extremes(s, what, tol, cancel, bd, bs, ba);
@@ -1615,7 +1610,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             (void)0;
         else if (what < 3 && single[what])
             b = sb[what][o & 1];
-        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, jbudget, cancel, jmemo, &b)
+        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, jbudget, cancel, jl, &b)
                        : sp.axis >= 0 ? separable_extreme(s, &sp, what, sign, at[o], tol, PDE_PROPS_BOXES, cancel, NULL, &b)
                        : (ra = radial_axis(&s->comp[what], &rn)) >= 0
                            ? radial_extreme(s, ra, what, sign, at[o], tol, RADIAL_BOXES, cancel, &b)
@@ -1656,7 +1651,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         if (jlow[k] < -jtol && fabs(best[6 + k]) <= 1e-9 * jscale) {
             bb_result b;
             st = po ? poly_minimise(&po->b[3], sign, 0.5 * jtol, SIGN_BOXES, &b)
-                    : what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, jmemo, &b);
+                    : what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, jl, &b);
             if (st != PDE_OK) {
                 free(po);
                 return st;
@@ -1678,12 +1673,9 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         vol_scale *= fmax(best[2 * c + 1] - best[2 * c], 1e-3 * size);
     }
     /* det J = t^p g(w) (fig. 2, 4): g's sign certified panel by panel of w where it folds elsewhere */
-    detj_line dl;
-    const int line = !jsign && sp.axis >= 0 && sp.free >= 0 && detj_line_of(s, &dl) && dl.h[0].a == sp.axis;
-    dl.memo = jmemo;
     const quad_wsign ws = { detj_line_sign, &dl };
     quad_result q, qa;
-    if ((st = quad_solid_signs(s, x0, jscale, vol_scale, 1, jsign, line ? &ws : NULL, cancel, &q)) != PDE_OK ||
+    if ((st = quad_solid_signs(s, x0, jscale, vol_scale, 1, jsign, line && !jsign ? &ws : NULL, cancel, &q)) != PDE_OK ||
         (st = quad_area(s, size, cancel, &r.surface_area, &qa)) != PDE_OK)
         return st;
     mass_properties(&q, x0, &r);
