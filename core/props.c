@@ -1069,13 +1069,18 @@ static double detj_line_value(const void *ctx, double w)
  * (down to two halvings) with one sign. */
 static int detj_line_span(const detj_line *d, double w0, double w1, double g0, double g1, double tol, int depth)
 {
-    const double mid = 0.5 * (w0 + w1), c = fabs(g0) <= tol ? w0 : fabs(g1) <= tol ? w1 : mid;
-    tm1 m;
-    detj_line_model(d, w0, w1, c, &m);
-    for (int sg = 1; sg >= -1; sg -= 2) {
-        const double q0 = sg * m.p[0], q1 = sg * m.p[1], q2 = sg * m.p[2];
-        if (fmin(cubic_min(q0, q1, q2, m.k, w1 - c), cubic_min(q0, -q1, q2, m.k, c - w0)) >= -tol)
-            return sg;
+    const int z0 = fabs(g0) <= tol, z1 = fabs(g1) <= tol;
+    const double mid = 0.5 * (w0 + w1), c = z0 ? w0 : z1 ? w1 : mid;
+    tm1 m = { { NAN, NAN, NAN }, NAN };
+    /* g = 0 at both ends (a lobe between two roots): about either, the rest there exceeds g's value at
+     * the other, 0; its halves only */
+    if (!(z0 && z1) || depth >= 2) {
+        detj_line_model(d, w0, w1, c, &m);
+        for (int sg = 1; sg >= -1; sg -= 2) {
+            const double q0 = sg * m.p[0], q1 = sg * m.p[1], q2 = sg * m.p[2];
+            if (fmin(cubic_min(q0, q1, q2, m.k, w1 - c), cubic_min(q0, -q1, q2, m.k, c - w0)) >= -tol)
+                return sg;
+        }
     }
     if (depth >= 2)
         return 0;
