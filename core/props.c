@@ -144,6 +144,51 @@ static inline double min2(double a, double b)
     return b < a ? b : a;
 }
 
+/* The factor along axis a (0: u, 1: v) of a component's k-th mode, then of its force terms (force = 1)
+ * or its boundary terms (force = 0). */
+static pde_factor term_factor(const comp_solution *cs, int a, int force, size_t k)
+{
+    if (k < cs->nmodes)
+        return a ? cs->modes[k].v : cs->modes[k].u;
+    k -= cs->nmodes;
+    if (force)
+        return a ? cs->fterms[k].v : cs->fterms[k].u;
+    return a ? cs->bterms[k].v : cs->bterms[k].u;
+}
+
+/*
+ * The residuals' samples t[0 .. n - 1] along axis a that decide their largest values. Where every
+ * mode of cs and every term (force terms for the PDE, force = 1; boundary terms for the conditions)
+ * has the same factor f along a, the residual and each of its terms and scales are |f(t_i)| times
+ * a function of the two other parameters (for the PDE, where f'''' = lambda f: every factor but t^n
+ * with n >= 4), and so are their sums of absolute values; the largest over the samples is then at
+ * the sample of largest |f|, which alone is taken (fig. 2's x, y and z: the PDE residual at 9 of
+ * its 729 points, both residuals at the same values up to the rounding of the other samples).
+ * Returns the number of samples to take, from *i0 on: n from 0, or 1.
+ */
+static size_t residual_samples(const comp_solution *cs, int a, int force, const double *t, size_t n, size_t *i0)
+{
+    const size_t nt = cs->nmodes + (force ? cs->nfterms : cs->nbterms);
+    *i0 = 0;
+    if (nt == 0)
+        return 1;
+    const pde_factor f = term_factor(cs, a, force, 0);
+    if (force && f.kind == PDE_POW && f.p >= 4.0)
+        return n;
+    for (size_t k = 1; k < nt; k++) {
+        const pde_factor g = term_factor(cs, a, force, k);
+        if (g.kind != f.kind || g.p != f.p)
+            return n;
+    }
+    double big = -1.0;
+    for (size_t i = 0; i < n; i++) {
+        const double v = fabs(factor_deriv(f, t[i], 0));
+        if (v > big)
+            big = v, *i0 = i;
+    }
+    return 1;
+}
+
 /*
  * The boundary residual: the largest error of x and x_w on res x res points of w = 0 and w = 1,
  * relative to the size of the problem, which must not be the solution's size alone:
@@ -157,10 +202,10 @@ static inline double min2(double a, double b)
  *   own size, own[c] = max |x_c| over the solid.
  *
  * So scale = max(data, min(drive, own)), data and drive as sums of the absolute values of their
- * terms at each point; own alone for a component with neither.
+ * terms at each point; own alone for a component with neither. The closed form on w = 0 and 1 is
+ * the sum over modes of f_u f_v times h(0), h'(0), h(1), h'(1), each mode's four values once; along u
+ * and v it is sampled where residual_samples says (one sample where every term has the same factor).
  */
-#define BC_ROWS 32   /* rows of w = 0 and 1 at a time: one h(w) per side and block, in bounded memory */
-
 static pde_status bc_residual(const pde_solution *s, int res, const double own_size[3], poller *pl,
                               double *out)
 {
@@ -169,87 +214,67 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
         return PDE_OK;
     }
     const size_t n = (size_t)res;
-    const size_t nb = s->comp[0].nbterms + s->comp[1].nbterms + s->comp[2].nbterms;
-    const size_t nj = n < BC_ROWS ? n : BC_ROWS;
-    double *uni = malloc((n + 2 * nb * n + 12 * n * nj) * sizeof *uni);
+    size_t nt = 0;
+    for (int c = 0; c < 3; c++)
+        nt = nt > s->comp[c].nmodes + s->comp[c].nbterms ? nt : s->comp[c].nmodes + s->comp[c].nbterms;
+    /* per term (modes, then boundary terms) its factors at the samples; per mode h, h' at w = 0, 1 */
+    double *uni = malloc((n + 2 * nt * n + 4 * nt) * sizeof *uni);
     if (!uni)
         return PDE_ERR_NOMEM;
-    /* The boundary terms' factors at the samples, all components' terms in a row; x, x_w of both sides
-     * in rows j of a block of BC_ROWS (12 n each), each side's h(w) once a block. */
-    double *fu = uni + n, *fv = fu + nb * n, *rows = fv + nb * n;
+    double *fu = uni + n, *fv = fu + nt * n, *hb = fv + nt * n;
     for (size_t i = 0; i < n; i++)
         uni[i] = (double)i / (double)(n - 1);
-    for (size_t c = 0, t0 = 0; c < 3; t0 += s->comp[c++].nbterms)
-        for (size_t t = 0; t < s->comp[c].nbterms; t++)
-            for (size_t i = 0; i < n; i++) {
-                fu[(t0 + t) * n + i] = factor_deriv(s->comp[c].bterms[t].u, uni[i], 0);
-                fv[(t0 + t) * n + i] = factor_deriv(s->comp[c].bterms[t].v, uni[i], 0);
-            }
-    pde_grid *g;
-    pde_status st = pde_grid_create(s, uni, n, uni, n, &g);
-    if (st != PDE_OK) {
-        free(uni);
-        return st;
-    }
-    double err[3] = { 0, 0, 0 }, scale[3] = { 0, 0, 0 };
-    for (size_t j = 0; j < n && st == PDE_OK; j++) {
-        for (int side = 0; side < 2 && j % BC_ROWS == 0; side++) {
-            grid_set_w(g, side);
-            for (size_t jb = j; jb < j + nj && jb < n; jb++) {
-                double *row = rows + 12 * n * (jb - j);
-                grid_row(g, jb, GRID_X | GRID_XW);
-                for (int c = 0; c < 3; c++)
-                    for (size_t i = 0; i < n; i++) {
-                        row[(6 * side + c) * n + i] = g->row[c * n + i];
-                        row[(6 * side + 3 + c) * n + i] = g->row[(9 + c) * n + i];
-                    }
-            }
+    double worst = 0.0;
+    for (int c = 0; c < 3; c++) {
+        const comp_solution *cs = &s->comp[c];
+        const size_t nm = cs->nmodes, nb = cs->nbterms;
+        size_t i0, j0;
+        const size_t ni = residual_samples(cs, 0, 0, uni, n, &i0), nj = residual_samples(cs, 1, 0, uni, n, &j0);
+        for (size_t t = 0; t < nm + nb; t++) {
+            for (size_t i = i0; i < i0 + ni; i++)
+                fu[t * n + i] = factor_deriv(term_factor(cs, 0, 0, t), uni[i], 0);
+            for (size_t j = j0; j < j0 + nj; j++)
+                fv[t * n + j] = factor_deriv(term_factor(cs, 1, 0, t), uni[j], 0);
         }
-        const double *row = rows + 12 * n * (j % BC_ROWS);
-        for (size_t c = 0, t0 = 0; c < 3; t0 += s->comp[c++].nbterms) {
-            const comp_solution *cs = &s->comp[c];
-            if (poll_after(pl, (2 * cs->nmodes + cs->nbterms) * (n + 2) / 4 + 1)) {
-                st = PDE_ERR_CANCELLED;
-                break;
+        for (size_t m = 0; m < nm; m++) {
+            mode_h(&cs->modes[m], 0.0, &hb[4 * m], &hb[4 * m + 1]);
+            mode_h(&cs->modes[m], 1.0, &hb[4 * m + 2], &hb[4 * m + 3]);
+        }
+        double err = 0.0, scale = 0.0;
+        for (size_t j = j0; j < j0 + nj; j++) {
+            if (poll_after(pl, (2 * nm + nb) * (ni + 2) / 4 + 1)) {
+                free(uni);
+                return PDE_ERR_CANCELLED;
             }
-            for (size_t i = 0; i < n; i++) {
-                double d[4] = { 0, 0, 0, 0 }, dabs[4] = { 0, 0, 0, 0 }, sc = 0.0;
-                for (size_t t = 0; t < cs->nbterms; t++) {
+            for (size_t i = i0; i < i0 + ni; i++) {
+                double x[4] = { 0, 0, 0, 0 }, d[4] = { 0, 0, 0, 0 }, dabs[4] = { 0, 0, 0, 0 };
+                double drive[4] = { 0, 0, 0, 0 };
+                for (size_t m = 0; m < nm; m++) {
+                    const double f = fu[m * n + i] * fv[m * n + j];
+                    for (int k = 0; k < 4; k++) {
+                        x[k] += hb[4 * m + k] * f;
+                        drive[k] += fabs(cs->drive[m][k] * f);
+                    }
+                }
+                for (size_t t = 0; t < nb; t++) {
                     const pde_bterm *b = &cs->bterms[t];
-                    double f = fu[(t0 + t) * n + i] * fv[(t0 + t) * n + j];
+                    const double f = fu[(nm + t) * n + i] * fv[(nm + t) * n + j];
                     const double bv[4] = { b->w0, b->dw0, b->w1, b->dw1 };
                     for (int k = 0; k < 4; k++) {
                         d[k] += bv[k] * f;
                         dabs[k] += fabs(bv[k] * f);
                     }
                 }
-                double drive[4] = { 0, 0, 0, 0 };
-                for (size_t m = 0; m < cs->nmodes; m++) {
-                    double f = g->phi[c][g->group[c][m] * n + i] * g->psi[c][m * n + j];
-                    for (int k = 0; k < 4; k++)
-                        drive[k] += fabs(cs->drive[m][k] * f);
+                for (int k = 0; k < 4; k++) {
+                    err = max2(err, fabs(x[k] - d[k]));
+                    scale = max2(scale, max2(dabs[k], min2(drive[k], own_size[c])));
                 }
-                for (int k = 0; k < 4; k++)
-                    drive[k] = min2(drive[k], own_size[c]);
-                for (int side = 0; side < 2; side++) {
-                    double x = row[(6 * side + c) * n + i], xw = row[(6 * side + 3 + c) * n + i];
-                    err[c] = max2(err[c], max2(fabs(x - d[2 * side]), fabs(xw - d[2 * side + 1])));
-                }
-                for (int k = 0; k < 4; k++)
-                    sc = max2(sc, max2(dabs[k], drive[k]));
-                scale[c] = max2(scale[c], sc);
             }
         }
+        const double sc = scale > 0.0 ? scale : own_size[c];
+        worst = fmax(worst, sc > 0.0 ? err / sc : err);
     }
-    pde_grid_free(g);
     free(uni);
-    if (st != PDE_OK)
-        return st;
-    double worst = 0.0;
-    for (int c = 0; c < 3; c++) {
-        double sc = scale[c] > 0.0 ? scale[c] : own_size[c];
-        worst = fmax(worst, sc > 0.0 ? err[c] / sc : err[c]);
-    }
     *out = worst;
     return PDE_OK;
 }
@@ -269,9 +294,11 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
     double worst = 0.0;
     /* h and h'''' of every mode at the samples, x's modes then y's and z's: a mode with the same h(w) as
      * an earlier one (fig. 4: each of x's again in y) copies its rows */
-    double *hall = malloc((2 * mt * n + 1) * sizeof *hall);
+    double *hall = malloc((2 * mt * n + n) * sizeof *hall), *ts = hall + 2 * mt * n;
     if (!hall)
         return PDE_ERR_NOMEM;
+    for (size_t i = 0; i < n; i++)
+        ts[i] = (i + 0.5) / res;
     for (size_t o = 0, c = 0, m = 0; o < mt; o++, m++) {
         while (m >= s->comp[c].nmodes)
             c++, m = 0;
@@ -292,7 +319,7 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
             if (tw < o)
                 h0 = hall[tw * n + i], hw = hall[(mt + tw) * n + i];
             else {
-                const double t = (i + 0.5) / res;
+                const double t = ts[i];
                 size_t k0, k1;
                 mode_slab(md, t, &k0, &k1);   /* a loft's slab of t */
                 for (size_t k = k0; k < k1; k++) {
@@ -321,26 +348,26 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
         double *fu = tab, *fu4 = fu + nm * n, *fv = fu4 + nm * n, *fv4 = fv + nm * n, *uv = fv4 + nm * n;
         const double *h = hall + off * n, *h4 = hall + (mt + off) * n;
         double *pu = uv + 3 * nm, *pv = pu + nf * n, *pw = pv + nf * n, *puv = pw + nf * n;
-        for (size_t t = 0; t < nf; t++)
+        size_t i0, j0;
+        const size_t ni = residual_samples(cs, 0, 1, ts, n, &i0), nj = residual_samples(cs, 1, 1, ts, n, &j0);
+        for (size_t t = 0; t < nf; t++) {
+            const pde_fterm *ft = &cs->fterms[t];
             for (size_t i = 0; i < n; i++) {
-                const pde_fterm *ft = &cs->fterms[t];
-                pu[t * n + i] = factor_deriv(ft->u, (i + 0.5) / res, 0);
-                pv[t * n + i] = factor_deriv(ft->v, (i + 0.5) / res, 0);
-                pw[t * n + i] = factor_deriv(ft->w, (i + 0.5) / res, 0);
-            }
-        for (size_t m = 0; m < nm; m++) {
-            const pde_mode *md = &cs->modes[m];
-            for (size_t i = 0; i < n; i++) {
-                double t = (i + 0.5) / res;
-                fu[m * n + i] = factor_deriv(md->u, t, 0);
-                fu4[m * n + i] = factor_deriv(md->u, t, 4);
-                fv[m * n + i] = factor_deriv(md->v, t, 0);
-                fv4[m * n + i] = factor_deriv(md->v, t, 4);
+                pu[t * n + i] = i >= i0 && i < i0 + ni ? factor_deriv(ft->u, ts[i], 0) : 0.0;
+                pv[t * n + i] = i >= j0 && i < j0 + nj ? factor_deriv(ft->v, ts[i], 0) : 0.0;
+                pw[t * n + i] = factor_deriv(ft->w, ts[i], 0);
             }
         }
+        for (size_t m = 0; m < nm; m++) {
+            const pde_mode *md = &cs->modes[m];
+            for (size_t i = i0; i < i0 + ni; i++)
+                fu[m * n + i] = factor_deriv(md->u, ts[i], 0), fu4[m * n + i] = factor_deriv(md->u, ts[i], 4);
+            for (size_t j = j0; j < j0 + nj; j++)
+                fv[m * n + j] = factor_deriv(md->v, ts[j], 0), fv4[m * n + j] = factor_deriv(md->v, ts[j], 4);
+        }
         double err = 0.0, scale = 0.0;
-        for (size_t i = 0; i < n; i++)
-            for (size_t j = 0; j < n; j++) {
+        for (size_t i = i0; i < i0 + ni; i++)
+            for (size_t j = j0; j < j0 + nj; j++) {
                 if (poll_after(pl, n * (nm + cs->nfterms))) {
                     free(tab);
                     free(hall);
@@ -624,16 +651,20 @@ typedef struct {
 typedef struct {
     double key;   /* first: bb_heap's; the parent's lower bound */
     double w0, w1;
+    double v0, v1;   /* sign f at w0 and w1 where known (a slab's end, a parent's centre), else NaN */
 } lbox;
 
 /*
  * min over [0, 1] of sign f by branch and bound over intervals of w (a loft's slabs first: a model
  * holds within one), from start: *lower certified (for the exact closed form), *best = sign f(*wbest),
  * best - lower <= tol / 2 (a margin for the caller's pad) unless `budget` intervals ran out. An
- * interval's model is about the best point found when it holds it (else its centre), and its bound
- * is the model's least value with the rest pointwise, so the interval holding the minimum closes as
- * soon as the quadratic dominates the rest there, not when the rest falls below tol. The quadratic's
- * own argmin is evaluated too: a Newton step, the best point converging as fast.
+ * interval's model is about the best point found when it holds it, else about an end where f is
+ * known to be as low (within tol: a second minimum, as fig. 2's det J = 0 at w = 1 beside the best
+ * point w = 0, where Z' = 0 at both), else about its centre; its bound is the model's least value
+ * with the rest pointwise, so the interval holding the minimum closes as soon as the quadratic
+ * dominates the rest there, not when the rest falls below tol (about a minimum at an end, the slope
+ * away from it dominates: fig. 2a's det J closed on w = 1 in 2 intervals where centres took 11). The
+ * quadratic's own argmin is evaluated too: a Newton step, the best point converging as fast.
  */
 static pde_status line_minimise(const pde_solution *s, const line_fn *f, double sign, double start, double tol,
                                 size_t budget, const pde_cancel *cancel, double *lower, double *best, double *wbest)
@@ -645,7 +676,7 @@ static pde_status line_minimise(const pde_solution *s, const line_fn *f, double 
     const double *br = solution_breaks(s, &nslabs);
     pde_status st = PDE_OK;
     for (size_t k = 0; k < nslabs && st == PDE_OK; k++) {
-        const lbox l = { -INFINITY, br[k], br[k + 1] };
+        const lbox l = { -INFINITY, br[k], br[k + 1], NAN, NAN };
         if (bb_heap_push(&h, &l))
             st = PDE_ERR_NOMEM;
     }
@@ -659,7 +690,24 @@ static pde_status line_minimise(const pde_solution *s, const line_fn *f, double 
         bb_heap_pop(&h, &top);
         /* about the best point where it lies inside (a loft's slab ends belong to the next slab) */
         const double mid = 0.5 * (top.w0 + top.w1), wb = *wbest;
-        const double c = (wb > top.w0 && wb < top.w1) || (nslabs == 1 && wb >= top.w0 && wb <= top.w1) ? wb : mid;
+        double c = mid;
+        if ((wb > top.w0 && wb < top.w1) || (nslabs == 1 && wb >= top.w0 && wb <= top.w1))
+            c = wb;
+        else {
+            /* where the best point is an end of [0, 1], the other end evaluated when first needed (once:
+             * the children keep it): a minimum at both ends is no coincidence (fig. 2's det J) */
+            for (int e = 0; e < 2; e++) {
+                double *v = e ? &top.v1 : &top.v0;
+                const double we = e ? top.w1 : top.w0;
+                if (isnan(*v) && we == br[e ? nslabs : 0] && wb == br[e ? 0 : nslabs]) {
+                    *v = sign * f->value(f->ctx, we);
+                    if (*v < b)
+                        b = *v, *wbest = we;
+                }
+            }
+        }
+        if (c == mid && (top.v0 <= b + tol || top.v1 <= b + tol))
+            c = top.v0 <= top.v1 || !(top.v1 <= b + tol) ? top.w0 : top.w1;
         tm1 m;
         f->model(f->ctx, top.w0, top.w1, c, &m);
         const double q0 = sign * m.p[0], q1 = sign * m.p[1], q2 = sign * m.p[2];
@@ -683,7 +731,8 @@ static pde_status line_minimise(const pde_solution *s, const line_fn *f, double 
             low = fmin(low, lb);
             continue;
         }
-        const lbox lo = { lb, top.w0, mid }, hi = { lb, mid, top.w1 };
+        const double vm = c == mid ? q0 : NAN;
+        const lbox lo = { lb, top.w0, mid, top.v0, vm }, hi = { lb, mid, top.w1, vm, top.v1 };
         if (bb_heap_push(&h, &lo) || bb_heap_push(&h, &hi))
             st = PDE_ERR_NOMEM;
     }
@@ -808,12 +857,14 @@ typedef struct {
     size_t budget;
 } harmonic_memo;
 
-static pde_status harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
-                                    const pde_cancel *cancel, harmonic_memo *memo, double bound[2], double best[2],
-                                    double at[2][3])
+static pde_status harmonic_extremes(const pde_solution *s, int c, const harmonic *known, double start, double tol,
+                                    size_t budget, const pde_cancel *cancel, harmonic_memo *memo, double bound[2],
+                                    double best[2], double at[2][3])
 {
     harmonic hc;
-    if (!harmonic_of(s, c, &hc))
+    if (known)
+        hc = *known;
+    else if (!harmonic_of(s, c, &hc))
         return PDE_ERR_INVALID;
     double up, w, ab[2];
     const harmonic *p = memo && memo->done ? &memo->hc : NULL;
@@ -841,7 +892,7 @@ static pde_status harmonic_extremes(const pde_solution *s, int c, double start, 
 pde_status props_harmonic_extremes(const pde_solution *s, int c, double start, double tol, size_t budget,
                                    const pde_cancel *cancel, double bound[2], double best[2], double at[2][3])
 {
-    return harmonic_extremes(s, c, start, tol, budget, cancel, NULL, bound, best, at);
+    return harmonic_extremes(s, c, NULL, start, tol, budget, cancel, NULL, bound, best, at);
 }
 
 /* Non-zero when every mode of the component has the factors 1 along u and v: x_c = Z(w) (fig. 2's and 4's z). */
@@ -923,6 +974,8 @@ typedef struct {
 } detj_memo;
 
 typedef struct {
+    const pde_solution *sol;
+    int c[2];             /* the components of h[0], h[1] */
     harmonic h[2];
     const comp_solution *zc;   /* z */
     double scale;         /* sigma n k pi */
@@ -946,6 +999,8 @@ static int detj_line_of(const pde_solution *s, detj_line *d)
         /* sigma: the determinant with beta = gamma = 1, alpha = delta = 0, n = k pi = Z' = 1 */
         double M[3][3] = { { 0 } };
         M[c0][a->a] = 1.0, M[c1][a->b] = 1.0, M[z][2] = 1.0;
+        d->sol = s;
+        d->c[0] = c0, d->c[1] = c1;
         d->zc = zc;
         d->scale = det3(M[0], M[1], M[2]) * a->n * a->k * M_PI;
         d->twins[0] = d->twins[1] = NULL;
@@ -1008,6 +1063,44 @@ static double detj_line_value(const void *ctx, double w)
     return d->scale * zp * (ab[1] * gd[0] - ab[0] * gd[1]);
 }
 
+/* g's certified sign on [w0, w1] beyond -tol (+1: g >= -tol; -1: g <= tol), else 0: its model about the
+ * centre, or about an end where g is within tol of 0 (g0, g1: g at the ends, NaN where unknown; fig. 4's
+ * g = 0 at w = 0, where Z' = 0: about the centre, the rest there exceeds g's slope), else its halves'
+ * (down to two halvings) with one sign. */
+static int detj_line_span(const detj_line *d, double w0, double w1, double g0, double g1, double tol, int depth)
+{
+    const int z0 = fabs(g0) <= tol, z1 = fabs(g1) <= tol;
+    const double mid = 0.5 * (w0 + w1), c = z0 ? w0 : z1 ? w1 : mid;
+    tm1 m = { { NAN, NAN, NAN }, NAN };
+    /* g = 0 at both ends (a lobe between two roots): about either, the rest there exceeds g's value at
+     * the other, 0; its halves only */
+    if (!(z0 && z1) || depth >= 2) {
+        detj_line_model(d, w0, w1, c, &m);
+        for (int sg = 1; sg >= -1; sg -= 2) {
+            const double q0 = sg * m.p[0], q1 = sg * m.p[1], q2 = sg * m.p[2];
+            if (fmin(cubic_min(q0, q1, q2, m.k, w1 - c), cubic_min(q0, -q1, q2, m.k, c - w0)) >= -tol)
+                return sg;
+        }
+    }
+    if (depth >= 2)
+        return 0;
+    const double gm = c == mid ? m.p[0] : NAN;
+    const int a = detj_line_span(d, w0, mid, g0, gm, tol, depth + 1);
+    return a && detj_line_span(d, mid, w1, gm, g1, tol, depth + 1) == a ? a : 0;
+}
+
+/* quad_wsign's certificate (quad.h) from g's models, within one slab of w (a model holds within one). */
+static int detj_line_sign(const void *ctx, double w0, double w1, double g0, double g1, double tol)
+{
+    const detj_line *d = ctx;
+    size_t nslabs;
+    const double *br = solution_breaks(d->sol, &nslabs);
+    for (size_t k = 1; k < nslabs; k++)
+        if (br[k] > w0 && br[k] < w1)
+            return 0;
+    return detj_line_span(d, w0, w1, g0, g1, tol, 0);
+}
+
 /*
  * The extreme of sign * det J (what 3) or of a coordinate where det J separates (quad.h: det J =
  * t^p D1, D1 det J on the face t = 1, p = n ns - 1; x_c = t^(n in[c]) X_c): branch and bound over
@@ -1018,7 +1111,7 @@ static double detj_line_value(const void *ctx, double w)
  */
 static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, int what, double sign,
                                     const double start[3], double tol, size_t budget, const pde_cancel *cancel,
-                                    detj_memo *memo, bb_result *out)
+                                    const detj_line *dl, bb_result *out)
 {
     pbox face = { { 0, 0, 0 }, { 1, 1, 1 } };
     face.lo[sp->axis] = 1.0;
@@ -1038,10 +1131,8 @@ static pde_status separable_extreme(const pde_solution *s, const quad_sep *sp, i
     }
     bb_result b = { .at = { at[0], at[1], at[2] } };
     pde_status st = PDE_ERR_INVALID;
-    detj_line dl;
-    if (what == 3 && sp->free >= 0 && detj_line_of(s, &dl) && dl.h[0].a == sp->axis) {
-        dl.memo = memo;
-        const line_fn f = { detj_line_model, detj_line_value, &dl };   /* g(w) alone */
+    if (what == 3 && dl) {
+        const line_fn f = { detj_line_model, detj_line_value, dl };   /* g(w) alone */
         st = line_minimise(s, &f, sign, at[2], tol, budget, cancel, &b.lower, &b.best, &b.at[2]);
     }
     if (st == PDE_ERR_INVALID)
@@ -1272,10 +1363,10 @@ size_t pde_properties_detj_boxes(const pde_solution *s)
 
 /* The extreme of sign * det J by branch and bound, over the face where det J separates. */
 static pde_status what_detj(const pde_solution *s, const quad_sep *sp, double sign, const double start[3],
-                            double tol, size_t budget, const pde_cancel *cancel, detj_memo *memo, bb_result *out)
+                            double tol, size_t budget, const pde_cancel *cancel, const detj_line *dl, bb_result *out)
 {
     if (sp->axis >= 0)
-        return separable_extreme(s, sp, 3, sign, start, tol, budget, cancel, memo, out);
+        return separable_extreme(s, sp, 3, sign, start, tol, budget, cancel, dl, out);
     const int a = radial_detj_axis(s);
     if (a >= 0)
         return radial_extreme(s, a, 3, sign, start, tol, budget, cancel, out);
@@ -1422,20 +1513,43 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         }
     if (res < 2 || res > 1025)
         return PDE_ERR_INVALID;
-    double *uni = malloc((size_t)res * sizeof *uni);
+    double *uni = malloc(2 * (size_t)res * sizeof *uni);
     if (!uni)
         return PDE_ERR_NOMEM;
     for (int i = 0; i < res; i++)
         uni[i] = (double)i / (res - 1);
     extremes e;
     extremes_init(&e);
-    /* A polynomial solid: its extremes from Bernstein coefficients, where a sample is of no help. */
+    quad_sep sp;
+    quad_separate(s, &sp);
+    /* det J = t^p g(w), x and y harmonic alike, z = Z(w) (fig. 2, 4): g's models for det J's searches
+     * and quad_solid's certificates, and the harmonics' bounds, once (their memo across the searches) */
+    detj_memo jm;
+    for (size_t i = 0; i < DL_MEMO; i++)
+        jm.key[i][0] = NAN;
+    detj_line dl;
+    const int line = sp.axis >= 0 && sp.free >= 0 && detj_line_of(s, &dl) && dl.h[0].a == sp.axis;
+    dl.memo = &jm;
+    /* A polynomial solid: its extremes from Bernstein coefficients, where a sample is of no help. Where
+     * every extreme is a search in w (det J's, and each component's: x, y harmonic and z = Z(w), with
+     * modes), the face t = 1 alone (x_c = t^n X_c and det J = t^p g take their
+     * extremes there, or 0 at t = 0, which the searches add), every other point along its other
+     * parameter (fig. 2a: 45 points, not 729). */
     poly_objs *po = poly_objs_new(s);
     pde_status st = PDE_OK;
+    const int inw = res >= 5 && res % 2 && line && dl.zc->nmodes;   /* odd: the ends kept */
+    const double one = 1.0, *ax[2] = { uni, uni };
+    double *sub = uni + res;
+    size_t na[2] = { (size_t)res, (size_t)res };
+    for (int a = 0; a < 2 && inw; a++) {
+        for (int i = 0; i < res; i += 2)
+            sub[i / 2] = uni[i];
+        ax[a] = a == sp.axis ? &one : sub, na[a] = a == sp.axis ? 1 : (size_t)(res - 1) / 2 + 1;
+    }
     if (po)
         poly_sample(po, &e);
     else
-        st = sweep(s, uni, res, uni, res, uni, res, &pl, &e);
+        st = sweep(s, ax[0], na[0], ax[1], na[1], uni, res, &pl, &e);
     if (st == PDE_OK)
         st = beyond_double(s, uni, res, &pl, &e);
     free(uni);
@@ -1458,8 +1572,6 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     scales(best, &size, &jscale);
     /* Certify each extreme by branch and bound from its sampled point (a compass search polishing it
      * first cost more than it saved: the boxes' centres converge on the extreme as fast). */
-    quad_sep sp;
-    quad_separate(s, &sp);
     double jlow[2], jat[2][3];   /* det J's certified lower bounds of +det J, -det J, without the pad */
     int single[3] = { 0, 0, 0 };   /* components of one mode: both extremes from single_mode_extremes */
     const size_t jbudget = sp.axis < 0 && radial_detj_axis(s) >= 0 ? RADIAL_BOXES : pde_properties_detj_boxes(s);
@@ -1467,9 +1579,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     double rn;
     bb_result sb[3][2];
     harmonic_memo hmemo = { 0 };
-    detj_memo jm, *jmemo = &jm;
-    for (size_t i = 0; i < DL_MEMO; i++)
-        jm.key[i][0] = NAN;
+    const detj_line *jl = line ? &dl : NULL;
     double magnitude = 0.0;
     for (int o = 0; o < 8; o++) {
         const int what = o < 6 ? o / 2 : 3;
@@ -1487,7 +1597,8 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             const double *starts[2] = { lo, hi };
             st = s->comp[what].nmodes && w_only(&s->comp[what])
                      ? w_only_extremes(s, what, starts, tol, cancel, bd, bs, ba)
-                     : harmonic_extremes(s, what, fabs(best[o]) > fabs(best[o + 1]) ? lo[2] : hi[2], tol,
+                     : harmonic_extremes(s, what, line && dl.c[0] == what ? &dl.h[0] : line && dl.c[1] == what ? &dl.h[1] : NULL,
+                                         fabs(best[o]) > fabs(best[o + 1]) ? lo[2] : hi[2], tol,
                                          PDE_PROPS_BOXES, cancel, &hmemo, bd, bs, ba);
             if (st == PDE_ERR_INVALID && s->comp[what].nmodes == 1)
                 st = single_mode_extremes(s, what, tol, cancel, bd, bs, ba);
@@ -1504,7 +1615,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
             (void)0;
         else if (what < 3 && single[what])
             b = sb[what][o & 1];
-        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, jbudget, cancel, jmemo, &b)
+        else if ((st = what == 3        ? what_detj(s, &sp, sign, at[o], tol, jbudget, cancel, jl, &b)
                        : sp.axis >= 0 ? separable_extreme(s, &sp, what, sign, at[o], tol, PDE_PROPS_BOXES, cancel, NULL, &b)
                        : (ra = radial_axis(&s->comp[what], &rn)) >= 0
                            ? radial_extreme(s, ra, what, sign, at[o], tol, RADIAL_BOXES, cancel, &b)
@@ -1545,7 +1656,7 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         if (jlow[k] < -jtol && fabs(best[6 + k]) <= 1e-9 * jscale) {
             bb_result b;
             st = po ? poly_minimise(&po->b[3], sign, 0.5 * jtol, SIGN_BOXES, &b)
-                    : what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, jmemo, &b);
+                    : what_detj(s, &sp, sign, jat[k], 0.5 * jtol, SIGN_BOXES, cancel, jl, &b);
             if (st != PDE_OK) {
                 free(po);
                 return st;
@@ -1566,8 +1677,10 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
         x0[c] = 0.5 * (best[2 * c] + best[2 * c + 1]);
         vol_scale *= fmax(best[2 * c + 1] - best[2 * c], 1e-3 * size);
     }
+    /* det J = t^p g(w) (fig. 2, 4): g's sign certified panel by panel of w where it folds elsewhere */
+    const quad_wsign ws = { detj_line_sign, &dl };
     quad_result q, qa;
-    if ((st = quad_solid(s, x0, jscale, vol_scale, 1, jsign, cancel, &q)) != PDE_OK ||
+    if ((st = quad_solid_signs(s, x0, jscale, vol_scale, 1, jsign, line && !jsign ? &ws : NULL, cancel, &q)) != PDE_OK ||
         (st = quad_area(s, size, cancel, &r.surface_area, &qa)) != PDE_OK)
         return st;
     mass_properties(&q, x0, &r);

@@ -156,6 +156,7 @@ typedef struct {
     int line_sig, line_mixed;    /* poly_line: the first line's signs and roots in panel_lines, and whether
                                   * another line's differ */
     int jsign;                   /* det J's sign where certified over the whole solid (quad_solid), or 0 */
+    const quad_wsign *wsign;     /* free_solid's certificates of G's sign on a panel of w, or NULL */
     int free;                    /* the face's parameter det J does not depend on (quad_sep), or -1 */
     /* The axis whose panels take the uniform (midpoint) rule, quad_solid's periodic path, or -1; the
      * signature of its first line along u (poly_line), and whether a line had another or a root; the
@@ -1289,8 +1290,12 @@ static int free_dip(free_ctx *f, double t0, double t1, double f1, double t2, dou
 }
 
 /* The panel [a, b] of w: G at its ends and rule's nodes, its sign changes and dips located, and each
- * piece between them with its own rule (none: the nodes are the rule). Returns the roots found. */
-static int free_rule(free_ctx *f, double a, double b, double acc[Q_N])
+ * piece between them with its own rule (none: the nodes are the rule). Where *definite is not NULL,
+ * a panel whose points all have one sign asks q->wsign for a certificate of it, and 1 into *definite
+ * where G's sign is certified, by it or over the whole solid (jsign): then no roots or dips are
+ * sought; or where they were, and q->wsign certifies the sign of every piece between them. Returns
+ * the roots found. */
+static int free_rule(free_ctx *f, double a, double b, int *definite, double acc[Q_N])
 {
     qctx *q = f->q;
     const int n = axis_points(q, 2, b - a), m = n + 1;
@@ -1301,8 +1306,17 @@ static int free_rule(free_ctx *f, double a, double b, double acc[Q_N])
         t[i] = a + (b - a) * q->gx[n][i - 1];
     for (int i = 0; i <= m; i++)
         g[i] = free_point(f, t[i], i && i < m ? mv[i] : NULL);
+    int sure = q->jsign != 0;
+    if (!sure && definite && q->wsign) {
+        int pos = 0, neg = 0;
+        for (int i = 0; i <= m; i++)
+            pos |= g[i] > q->jtol, neg |= g[i] < -q->jtol;
+        sure = !(pos && neg) && q->wsign->sign(q->wsign->ctx, a, b, g[0], g[m], q->jtol) != 0;
+    }
+    if (definite)
+        *definite = sure;
     int ncut = 0, last = 0;
-    for (int i = 0; i <= m && !q->jsign && off_budget(q); i++) {
+    for (int i = 0; i <= m && !sure && off_budget(q); i++) {
         /* A least |G| among the samples, the panel's ends included: a lobe next to a panel's edge,
          * where |G| is least, has samples on one side only in each panel. An end counts where |G|
          * grows beyond it too (a sample as far outside, none beyond [0, 1]), not on a slope. */
@@ -1331,13 +1345,21 @@ static int free_rule(free_ctx *f, double a, double b, double acc[Q_N])
             free_add(acc, mv[i], g[i], (b - a) * q->gw[n][i - 1]);
         return 0;
     }
-    double t0 = a;
-    for (int c = 0; c < ncut; c++)
-        if (cut[c] > t0) {
-            free_gauss(f, t0, cut[c], acc);
-            t0 = cut[c];
-        }
-    free_gauss(f, t0, b, acc);
+    /* Each piece between roots with its own rule; where q->wsign certifies G's sign on every piece
+     * (G = 0 at the roots, about which its models go), no root or lobe was missed, and the panel is as
+     * sure as one of one sign (fig. 4a's two panels with a root each: their halves agreed to the bit). */
+    int pieces = definite && q->wsign && !q->jsign;
+    double t0 = a, g0 = g[0];
+    for (int c = 0; c <= ncut; c++) {
+        const double t1 = c < ncut ? cut[c] : b;
+        if (!(t1 > t0))
+            continue;
+        free_gauss(f, t0, t1, acc);
+        pieces = pieces && q->wsign->sign(q->wsign->ctx, t0, t1, g0, c < ncut ? 0.0 : g[m], q->jtol) != 0;
+        t0 = t1, g0 = 0.0;
+    }
+    if (definite)
+        *definite = pieces;
     return ncut;
 }
 
@@ -1348,8 +1370,8 @@ static void free_span(free_ctx *f, double a, double b, const double coarse[Q_N],
     qctx *q = f->q;
     const double mid = 0.5 * (a + b);
     double half[2][Q_N];
-    free_rule(f, a, mid, half[0]);
-    free_rule(f, mid, b, half[1]);
+    free_rule(f, a, mid, NULL, half[0]);
+    free_rule(f, mid, b, NULL, half[1]);
     const double fine = half[0][Q_VOL] + half[1][Q_VOL];
     const int agreed = fabs(fine - coarse[Q_VOL]) <= ROW_TOL * q->vscale;
     if (agreed || depth + 1 >= FREE_SPAN_DEPTH || poll(q) || q->r.evals * q->modes >= REFINE_WORK) {
@@ -1462,11 +1484,15 @@ static int free_solid(qctx *q, const qplan *p, int flat, int sa)
         const double lo = p->edge[2][l], hi = p->edge[2][l + 1];
         double coarse[Q_N], acc[Q_N];
         f.nroot = f.ndip = 0;
-        free_rule(&f, lo, hi, coarse);
-        if (q->jsign)
+        /* G's sign certified on the panel (the whole solid's, or the caller's 1-D models): no root, no
+         * dip, and |G| as smooth as G, which the rule integrates (fig. 4a: 3 of its 6 panels) */
+        int definite;
+        const int roots = free_rule(&f, lo, hi, &definite, coarse);
+        if (roots || !definite)   /* det J may change sign: integral_error's 1e-12 stands */
+            q->r.lined++;
+        if (definite)
             memcpy(acc, coarse, sizeof acc);
         else {
-            q->r.lined++;
             free_span(&f, lo, hi, coarse, 0, acc);
             q->r.refined++;
             q->r.refine_change += fabs(acc[Q_VOL] - coarse[Q_VOL]);
@@ -2171,11 +2197,13 @@ static void mid_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
 }
 
 static pde_status solid_run(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
-                            int jsign, const pde_cancel *cancel, int periodic, quad_result *out, int *rough)
+                            int jsign, const quad_wsign *ws, const pde_cancel *cancel, int periodic, quad_result *out,
+                            int *rough)
 {
     qctx *q = qctx_new(s, cancel);
     if (!q)
         return PDE_ERR_NOMEM;
+    q->wsign = ws;
     quad_sep sp = { .axis = -1, .free = -1 };
     if (separate)
         quad_separate(s, &sp);
@@ -2774,18 +2802,24 @@ static int fold_solid(const pde_solution *s, const double x0[3], double vscale, 
     return 1;
 }
 
-pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
-                      int jsign, const pde_cancel *cancel, quad_result *out)
+pde_status quad_solid_signs(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
+                            int jsign, const quad_wsign *ws, const pde_cancel *cancel, quad_result *out)
 {
     int rough = 0;
     pde_status st;
     /* a loft whose det J may change sign: root-split rows (fold_solid), where it has that form */
     if (!jsign && separate == 1 && fold_solid(s, x0, vscale, cancel, out, &st))
         return st;
-    st = solid_run(s, x0, jscale, vscale, separate, jsign, cancel, 1, out, &rough);
+    st = solid_run(s, x0, jscale, vscale, separate, jsign, ws, cancel, 1, out, &rough);
     if (st == PDE_OK && rough)   /* det J's sign changes along u: the general path */
-        st = solid_run(s, x0, jscale, vscale, separate, jsign, cancel, 0, out, &rough);
+        st = solid_run(s, x0, jscale, vscale, separate, jsign, ws, cancel, 0, out, &rough);
     return st;
+}
+
+pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
+                      int jsign, const pde_cancel *cancel, quad_result *out)
+{
+    return quad_solid_signs(s, x0, jscale, vscale, separate, jsign, NULL, cancel, out);
 }
 
 /* ---- the skin ---- */
@@ -2817,9 +2851,21 @@ static void face_point(const pde_solution *s, const poly3 *px, int axis, int sid
         ta[c] = d[o[0]][c], tb[c] = d[o[1]][c];
 }
 
-/* Faces (axis, 0) and (axis, 1) are the same surface (the seam of a solid of revolution). */
+/* Faces (axis, 0) and (axis, 1) are the same surface (the seam of a solid of revolution). Along u
+ * or v, where every mode's factor is 1 or a whole harmonic, sin or cos(k pi t) with k even (fig. 2
+ * and 4's v, a loft's), the closed form takes the same values on both: they coincide exactly, and
+ * no samples are needed (the 49 pairs of pde_eval_d were fig. 2a's 0.17 M instructions a call).
+ * Otherwise the faces are compared at 7 x 7 points. */
 static int faces_coincide(const pde_solution *s, const poly3 *px, int axis, double size)
 {
+    int periodic = axis < 2;
+    for (int c = 0; c < 3 && periodic; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes && periodic; m++) {
+            const int k = harmonic(axis ? s->comp[c].modes[m].v : s->comp[c].modes[m].u);
+            periodic = k >= 0 && k % 2 == 0;
+        }
+    if (periodic)
+        return 1;
     for (int i = 0; i <= 6; i++)
         for (int j = 0; j <= 6; j++) {
             double x0[3], x1[3], ta[3], tb[3];
@@ -3200,6 +3246,62 @@ static int face_separates(const pde_solution *s, const quad_sep *sp, int axis, d
 }
 
 /*
+ * An end cap w = side where two components are harmonic alike and the third is a function of w alone
+ * (fig. 2 and 4): x_a = t^n (alpha(w) S + beta(w) C), x_b = t^n (gamma(w) S + delta(w) C), S, C =
+ * sin, cos(k pi s), the same t (u or v), n >= 1 and k for both, x_z = Z(w). On the cap the element
+ * x_u x x_v has only its z component, the (u, v) minor of rows a, b: +-n k pi t^(2n-1) (beta gamma -
+ * alpha delta) (S^2 + C^2 = 1), so the cap's area is |k pi (beta gamma - alpha delta)| / 2 (the
+ * integral of n t^(2n-1) is 1/2) and its flux Z times the signed same, exactly: the panels' lines and
+ * their check against quarters took fig. 4a's two caps 0.12 M instructions. Returns 0 where the
+ * solid is not so.
+ */
+static int face_cap(const pde_solution *s, int side, double *area, double *flux)
+{
+    int zc = -1, nab = 0, t = -1;
+    double n = 0.0, k = 0.0, co[2][2] = { { 0, 0 }, { 0, 0 } }, Z = 0.0;   /* co[i]: alpha, beta of ab[i] */
+    for (int c = 0; c < 3; c++) {
+        const comp_solution *cs = &s->comp[c];
+        int wonly = 1;
+        for (size_t m = 0; m < cs->nmodes && wonly; m++)
+            wonly = cs->modes[m].u.kind == PDE_POW && cs->modes[m].u.p == 0.0 && cs->modes[m].v.kind == PDE_POW &&
+                    cs->modes[m].v.p == 0.0;
+        if (wonly && zc < 0) {
+            zc = c;
+            continue;
+        }
+        if (nab == 2 || cs->nmodes == 0)
+            return 0;
+        for (size_t m = 0; m < cs->nmodes; m++) {
+            const pde_mode *md = &cs->modes[m];
+            if (t < 0)
+                t = md->u.kind == PDE_POW ? 0 : 1, n = (t ? md->v : md->u).p, k = (t ? md->u : md->v).p;
+            const pde_factor ft = t ? md->v : md->u, fs = t ? md->u : md->v;
+            if (ft.kind != PDE_POW || ft.p != n || n < 1.0 || (fs.kind != PDE_SIN && fs.kind != PDE_COS) ||
+                fs.p != k || k == 0.0)
+                return 0;
+            double h, dh;
+            mode_h(md, side, &h, &dh);
+            co[nab][fs.kind == PDE_COS] += h;
+        }
+        nab++;
+    }
+    if (zc < 0 || nab != 2)
+        return 0;
+    for (size_t m = 0; m < s->comp[zc].nmodes; m++) {
+        double h, dh;
+        mode_h(&s->comp[zc].modes[m], side, &h, &dh);
+        Z += h;
+    }
+    /* the (u, v) minor of the harmonic rows a < b: +(x_t y_s - y_t x_s) with t = u; the element's
+     * component zc has the sign of the permutation (a, b, zc) */
+    const double minor = k * M_PI * (co[0][1] * co[1][0] - co[0][0] * co[1][1]) * (t ? -1.0 : 1.0);
+    const double eps = zc == 1 ? -1.0 : 1.0;
+    *area = 0.5 * fabs(minor);
+    *flux = 0.5 * eps * Z * minor;
+    return 1;
+}
+
+/*
  * A face along whose parameters the solution is a polynomial, of degrees d0 and d1 (within one slab):
  * its element c = x_a x x_b is a polynomial of degree at most 2 d - 1 along each, so when c x nu
  * vanishes on a grid of (2 d + 1)^2 points, to rounding, nu a unit vector, it vanishes everywhere:
@@ -3457,7 +3559,8 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
                 continue;
             double ascale = 1.0, fscale = 1.0, face = 0.0, fflux = 0.0;
             const int d[2] = { q->poly[o[0]], q->poly[o[1]] };
-            if ((d[0] >= 0 && d[1] >= 0 && (axis == 2 || nslabs == 1) && face_planar(s, px, axis, side, d, &face, &fflux)) ||
+            if ((axis == 2 && nslabs == 1 && face_cap(s, side, &face, &fflux)) ||
+                (d[0] >= 0 && d[1] >= 0 && (axis == 2 || nslabs == 1) && face_planar(s, px, axis, side, d, &face, &fflux)) ||
                 (px && face_poly(px, axis, side, c->tol, &face, &fflux))) {
                 flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fflux;
                 total += face;

@@ -69,6 +69,21 @@ void quad_separate(const pde_solution *s, quad_sep *sep);
 pde_status quad_solid(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
                       int jsign, const pde_cancel *cancel, quad_result *out);
 
+/* Where det J does not depend on the face's other parameter (quad_sep's free: det J = n t^p g(w)), a
+ * certificate of g's sign over a span of w: sign(ctx, w0, w1, g0, g1, tol), g0 and g1 g's values at w0
+ * and w1, is +1 where g >= -tol is certified on [w0, w1], -1 where g <= tol is, else 0 (pde_properties:
+ * g's Taylor models). A panel of w so
+ * certified takes its rule alone, with no roots or dips sought and no halves to check it against, as
+ * every panel does where jsign certifies the whole cube. quad_solid_signs: quad_solid with it (ws
+ * NULL: none). */
+typedef struct {
+    int (*sign)(const void *ctx, double w0, double w1, double g0, double g1, double tol);
+    const void *ctx;
+} quad_wsign;
+
+pde_status quad_solid_signs(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
+                            int jsign, const quad_wsign *ws, const pde_cancel *cancel, quad_result *out);
+
 /* The area of the skin; size: the solid's extent, for deciding that two faces coincide. Its panels
  * are the solid's, and so is its rules' error; a face that repeats itself along u or v, reflected or
  * turned about an axis, over one period (or half of one, mirrored) times its copies (quad.c's
