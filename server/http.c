@@ -183,6 +183,25 @@ static enum MHD_Result find_nul(void *cls, enum MHD_ValueKind kind, const char *
     return MHD_NO;
 }
 
+/* The first content coding other than identity in any Content-Encoding line (a list: "identity, gzip", or
+ * two lines), into cls (64 bytes, cleaned for the message); an empty value is no coding. */
+static enum MHD_Result find_coding(void *cls, enum MHD_ValueKind kind, const char *key, const char *value)
+{
+    (void)kind;
+    if (strcasecmp(key, MHD_HTTP_HEADER_CONTENT_ENCODING) || !value)
+        return MHD_YES;
+    for (const char *p = value; *p;) {
+        p += strspn(p, " \t,");
+        const size_t n = strcspn(p, " \t,");
+        if (n && !(n == 8 && !strncasecmp(p, "identity", 8))) {
+            api_text_clean(cls, 64, p, n);
+            return MHD_NO;
+        }
+        p += n;
+    }
+    return MHD_YES;
+}
+
 /* Content-Length as digits only, within uint64; -1 if absent, -2 if malformed. */
 static long long content_length(struct MHD_Connection *c)
 {
@@ -316,13 +335,13 @@ static int admit(srv_req *r, const char *method)
         srv_problem(r, qs.bad ? 400 : 422, NULL, "%s", qs.msg);
         return 0;
     }
-    const char *ce = MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_ENCODING);
-    if (ce && strcasecmp(ce, "identity") && (srv_routes[r->route].flags & SRV_RT_BODY)) {
-        char shown[64];
-        api_text_clean(shown, sizeof shown, ce, strlen(ce));
+    char coding[64] = "";
+    if (srv_routes[r->route].flags & SRV_RT_BODY)
+        MHD_get_connection_values(r->conn, MHD_HEADER_KIND, find_coding, coding);
+    if (*coding) {
         r->decided = 1;   /* RFC 9110 15.5.16: 415 for a content coding not taken (a gzip body read as JSON: 0x1F) */
         srv_problem(r, 415, NULL, "the body's Content-Encoding is %s; pdesolidd takes bodies uncompressed "
-                    "(identity): send it without the header", shown);
+                    "(identity): send it without the header", coding);
         return 0;
     }
     if (!srv_origin_allowed(r)) {
@@ -736,8 +755,10 @@ srv_server *srv_start(const srv_config *c, char *err, size_t errlen)
     s->pool = srv_pool_create(c->threads, c->queue, c->max_conns);
     s->log = c->quiet ? NULL : srv_log_create(2, c->log_format);
     s->web = srv_static_load(c->web, err, errlen);
-    /* a head (request line and headers) has --request-timeout, as the whole request; checked 4 times as often */
-    s->watch = srv_watch_start(c->request_timeout, fmin(fmax(c->request_timeout / 4, 0.05), 1.0));
+    /* a head (request line and headers) has --request-timeout, as the whole request, and a keep-alive connection's
+     * next head the longer of that and --timeout (libmicrohttpd's idle timeout); checked 4 times as often */
+    s->watch = srv_watch_start(c->request_timeout, fmax(c->request_timeout, (double)c->timeout),
+                               fmin(fmax(c->request_timeout / 4, 0.05), 1.0));
     srv_store_config sc = { .spec = c->store, .max_mb = c->store_mb, .prefix = c->store_prefix, .ttl_s = c->store_ttl };
     if (s->web && !(s->store = srv_store_open(&sc, err, errlen)) && *err) {   /* "" for --store none */
         free_server(s);

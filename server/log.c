@@ -64,14 +64,15 @@ static char *put_hex(char *o, const char *pre, unsigned c)
 }
 
 /* A C1 control (U+0080 to U+009F) or a bidirectional control (U+061C, U+200E, U+200F, U+202A to U+202E,
- * U+2066 to U+2069: a viewer shows the rest of a line after U+202E reversed), the valid UTF-8 sequence
+ * U+2066 to U+2069: a viewer shows the rest of a line after U+202E reversed) or a line or paragraph
+ * separator (U+2028, U+2029: some viewers break the line there), the valid UTF-8 sequence
  * at p of n bytes: escaped, as C0 controls are. */
 static int unseen(const unsigned char *p, size_t n)
 {
     if (n == 2)
         return (p[0] == 0xc2 && p[1] < 0xa0) || (p[0] == 0xd8 && p[1] == 0x9c);
     return n == 3 && p[0] == 0xe2 &&
-           ((p[1] == 0x80 && (p[2] == 0x8e || p[2] == 0x8f || (p[2] >= 0xaa && p[2] <= 0xae))) ||
+           ((p[1] == 0x80 && (p[2] == 0x8e || p[2] == 0x8f || (p[2] >= 0xa8 && p[2] <= 0xae))) ||
             (p[1] == 0x81 && p[2] >= 0xa6 && p[2] <= 0xa9));
 }
 

@@ -18,7 +18,7 @@ struct srv_watch {
     pthread_cond_t wake;
     pthread_t thread;
     srv_watched head;   /* a ring: head.next is the oldest opened */
-    double limit, period;
+    double limit, idle, period;
     int stop;
 };
 
@@ -43,7 +43,7 @@ static void *watcher(void *arg)
             ;
         const double t = now();
         for (srv_watched *c = w->head.next; c != &w->head; c = c->next)
-            if (!c->busy && c->fd >= 0 && t - c->since > w->limit) {
+            if (!c->busy && c->fd >= 0 && t - c->since > (c->answered ? w->idle : w->limit)) {
                 shutdown(c->fd, SHUT_RDWR);
                 c->fd = -1;   /* once */
             }
@@ -52,7 +52,7 @@ static void *watcher(void *arg)
     return NULL;
 }
 
-srv_watch *srv_watch_start(double limit, double period)
+srv_watch *srv_watch_start(double limit, double idle, double period)
 {
     srv_watch *w = calloc(1, sizeof *w);
     pthread_condattr_t ca;
@@ -64,7 +64,7 @@ srv_watch *srv_watch_start(double limit, double period)
     int bad = pthread_mutex_init(&w->lock, NULL) || pthread_cond_init(&w->wake, &ca);
     pthread_condattr_destroy(&ca);
     w->head.next = w->head.prev = &w->head;
-    w->limit = limit, w->period = period;
+    w->limit = limit, w->idle = idle, w->period = period;
     if (bad || pthread_create(&w->thread, NULL, watcher, w)) {
         free(w);
         return NULL;
@@ -89,7 +89,7 @@ void srv_watch_stop(srv_watch *w)
 void srv_watch_open(srv_watch *w, srv_watched *c, int fd)
 {
     pthread_mutex_lock(&w->lock);
-    c->fd = fd, c->busy = 0, c->since = now();
+    c->fd = fd, c->busy = c->answered = 0, c->since = now();
     c->prev = w->head.prev, c->next = &w->head;
     w->head.prev->next = c, w->head.prev = c;
     pthread_mutex_unlock(&w->lock);
@@ -110,6 +110,6 @@ void srv_watch_busy(srv_watch *w, srv_watched *c, int busy)
 {
     pthread_mutex_lock(&w->lock);
     if (c->prev)
-        c->busy = busy, c->since = now();
+        c->busy = busy, c->answered |= !busy, c->since = now();
     pthread_mutex_unlock(&w->lock);
 }

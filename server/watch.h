@@ -15,11 +15,13 @@ typedef struct srv_watched {
     struct srv_watched *prev, *next;
     int fd;
     int busy;       /* between its head and its answer: the request's own deadlines hold */
+    int answered;   /* a request was answered on it: what comes now is keep-alive idleness first */
     double since;   /* opened, or answered last */
 } srv_watched;
 
-/* Checks every `period` seconds for heads older than `limit`; NULL when out of memory or threads. */
-srv_watch *srv_watch_start(double limit, double period);
+/* Checks every `period` seconds for heads older than `limit`, or than `idle` on a connection answered
+before (an idle keep-alive connection: --timeout may be longer); NULL when out of memory or threads. */
+srv_watch *srv_watch_start(double limit, double idle, double period);
 void srv_watch_stop(srv_watch *w);
 
 /* Connection opened on fd (its head's clock starts), closed (before libmicrohttpd closes fd), its head

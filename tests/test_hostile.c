@@ -1066,6 +1066,42 @@ static void a_content_encoded_body_should_be_415_naming_the_coding(void **state)
     r = ask(&d, "GET", "/livez", "Content-Encoding: br\r\n", NULL, 0, 5000);
     assert_int_equal(r.status, 200);
     raw_reply_free(&r);
+    /* a list, or two lines, is one list (RFC 9110 5.3): the second line was not read (review) */
+    r = ask(&d, "POST", "/solve", "Content-Encoding: identity\r\nContent-Encoding: gzip\r\n", gz, sizeof gz - 1, 8000);
+    expect_problem(&r, 415, NULL, "Content-Encoding is gzip");
+    raw_reply_free(&r);
+    r = ask(&d, "POST", "/solve", "Content-Encoding: identity, br\r\n", gz, sizeof gz - 1, 8000);
+    expect_problem(&r, 415, NULL, "Content-Encoding is br");
+    raw_reply_free(&r);
+    r = ask(&d, "POST", "/solve", "Content-Encoding:\r\n", body, strlen(body), 8000);
+    assert_int_equal(r.status, 200);
+    raw_reply_free(&r);
+    stop(&d);
+}
+
+/* A keep-alive connection idle for longer than --request-timeout but within --timeout is served: the head's
+ * deadline on a connection answered before is the longer of the two (the watcher closed it at
+ * --request-timeout, so --timeout above it did nothing: review). */
+static void a_keep_alive_connection_should_stay_open_for_its_timeout(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "--request-timeout 1 --timeout 6");
+    int fd = raw_dial(d.port);
+    assert_true(fd >= 0);
+    static const char one[] = "GET /livez HTTP/1.1\r\nHost: localhost\r\n\r\n",
+                      two[] = "GET /livez HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n";
+    raw_send_all(fd, one, sizeof one - 1);
+    char buf[4096];
+    struct pollfd pf = { fd, POLLIN, 0 };
+    assert_true(poll(&pf, 1, 5000) == 1);
+    assert_true(recv(fd, buf, sizeof buf, 0) > 0);
+    usleep(2500000);   /* idle: past --request-timeout, within --timeout */
+    raw_send_all(fd, two, sizeof two - 1);
+    long n = raw_read_to_close(fd, buf, sizeof buf - 1, 5);
+    close(fd);
+    if (n < 12 || strncmp(buf, "HTTP/1.1 200", 12))
+        fail_msg("the second request on an idle keep-alive connection got %ld bytes: %s", n, n > 0 ? shown(buf, 0) : "");
     stop(&d);
 }
 
@@ -1584,6 +1620,7 @@ int main(void)
         T(the_response_cache_should_key_on_the_whole_query),
         T(nul_in_a_path_query_or_body_should_be_400),
         T(a_content_encoded_body_should_be_415_naming_the_coding),
+        T(a_keep_alive_connection_should_stay_open_for_its_timeout),
         T(invalid_utf8_anywhere_should_give_a_problem_in_valid_json_and_utf8),
         T(an_unknown_query_parameter_should_be_400_naming_it_and_the_known_ones),
         T(bad_framing_should_get_one_error_response_or_a_close_within_2_s),

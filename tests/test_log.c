@@ -132,8 +132,8 @@ static const hostile cases[] = {
     { "a C1 control (CSI)", "/\xc2\x9b" "31m", NULL, "/\xc2\x9b" "31m", NULL },
     { "a tab and a space", "/a\tb c", "k=v w", "/a\tb c", "k=v w" },
     { "bidirectional controls (QA: U+202E showed the rest of the line reversed)",
-      "/x\xe2\x80\xae\" 200 3 rid=abc\xe2\x80\x8f", "q=\xe2\x81\xa6" "a\xd8\x9c\xe2\x80\xaa",
-      "/x\xe2\x80\xae\" 200 3 rid=abc\xe2\x80\x8f", "q=\xe2\x81\xa6" "a\xd8\x9c\xe2\x80\xaa" },
+      "/x\xe2\x80\xae\" 200 3 rid=abc\xe2\x80\x8f", "q=\xe2\x81\xa6" "a\xd8\x9c\xe2\x80\xaa\xe2\x80\xa8",
+      "/x\xe2\x80\xae\" 200 3 rid=abc\xe2\x80\x8f", "q=\xe2\x81\xa6" "a\xd8\x9c\xe2\x80\xaa\xe2\x80\xa8" },
 };
 
 /* A 4 KiB path of every hostile byte in turn, and what JSON makes of it. */
@@ -170,7 +170,7 @@ static void check_plain_line(const char *b, size_t n)
             fail_msg("a raw C1 control in %.200s", b);
     static const char *const bidi[] = { "\xd8\x9c", "\xe2\x80\x8e", "\xe2\x80\x8f", "\xe2\x80\xaa", "\xe2\x80\xab",
                                         "\xe2\x80\xac", "\xe2\x80\xad", "\xe2\x80\xae", "\xe2\x81\xa6", "\xe2\x81\xa7",
-                                        "\xe2\x81\xa8", "\xe2\x81\xa9" };
+                                        "\xe2\x81\xa8", "\xe2\x81\xa9", "\xe2\x80\xa8", "\xe2\x80\xa9" };
     for (size_t k = 0; k < sizeof bidi / sizeof *bidi; k++)
         for (size_t i = 0, m = strlen(bidi[k]); i + m <= n; i++)
             if (!memcmp(b + i, bidi[k], m))
