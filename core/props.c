@@ -286,6 +286,14 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
  * measured against their size. The derivatives of each factor and each h are tabulated once per
  * sample line: a point then costs three multiply-adds per mode.
  */
+/* A factor's value and fourth derivative at t: lambda f for every kind but t^n (factor_lambda is
+ * factor_deriv's w^4, to the bit), one sin, cos or exp rather than two. */
+static void factor_04(pde_factor f, double t, double *v, double *v4)
+{
+    *v = factor_deriv(f, t, 0);
+    *v4 = f.kind == PDE_POW ? factor_deriv(f, t, 4) : factor_lambda(f) * *v;
+}
+
 #define RESIDUAL_TWINS 64   /* modes at most among which pde_residual looks for the same h(w) */
 
 static pde_status pde_residual(const pde_solution *s, int res, poller *pl, double *out)
@@ -361,9 +369,9 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
         for (size_t m = 0; m < nm; m++) {
             const pde_mode *md = &cs->modes[m];
             for (size_t i = i0; i < i0 + ni; i++)
-                fu[m * n + i] = factor_deriv(md->u, ts[i], 0), fu4[m * n + i] = factor_deriv(md->u, ts[i], 4);
+                factor_04(md->u, ts[i], &fu[m * n + i], &fu4[m * n + i]);
             for (size_t j = j0; j < j0 + nj; j++)
-                fv[m * n + j] = factor_deriv(md->v, ts[j], 0), fv4[m * n + j] = factor_deriv(md->v, ts[j], 4);
+                factor_04(md->v, ts[j], &fv[m * n + j], &fv4[m * n + j]);
         }
         double err = 0.0, scale = 0.0;
         for (size_t i = i0; i < i0 + ni; i++)
