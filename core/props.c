@@ -286,6 +286,14 @@ static pde_status bc_residual(const pde_solution *s, int res, const double own_s
  * measured against their size. The derivatives of each factor and each h are tabulated once per
  * sample line: a point then costs three multiply-adds per mode.
  */
+/* A factor's value and fourth derivative at t: lambda f for every kind but t^n (factor_lambda is
+ * factor_deriv's w^4, to the bit), one sin, cos or exp rather than two. */
+static void factor_04(pde_factor f, double t, double *v, double *v4)
+{
+    *v = factor_deriv(f, t, 0);
+    *v4 = f.kind == PDE_POW ? factor_deriv(f, t, 4) : factor_lambda(f) * *v;
+}
+
 #define RESIDUAL_TWINS 64   /* modes at most among which pde_residual looks for the same h(w) */
 
 static pde_status pde_residual(const pde_solution *s, int res, poller *pl, double *out)
@@ -361,9 +369,9 @@ static pde_status pde_residual(const pde_solution *s, int res, poller *pl, doubl
         for (size_t m = 0; m < nm; m++) {
             const pde_mode *md = &cs->modes[m];
             for (size_t i = i0; i < i0 + ni; i++)
-                fu[m * n + i] = factor_deriv(md->u, ts[i], 0), fu4[m * n + i] = factor_deriv(md->u, ts[i], 4);
+                factor_04(md->u, ts[i], &fu[m * n + i], &fu4[m * n + i]);
             for (size_t j = j0; j < j0 + nj; j++)
-                fv[m * n + j] = factor_deriv(md->v, ts[j], 0), fv4[m * n + j] = factor_deriv(md->v, ts[j], 4);
+                factor_04(md->v, ts[j], &fv[m * n + j], &fv4[m * n + j]);
         }
         double err = 0.0, scale = 0.0;
         for (size_t i = i0; i < i0 + ni; i++)
@@ -774,15 +782,23 @@ static void harmonic_models(const harmonic *hc, double w0, double w1, double c, 
     harmonic_models_of(hc, w0, w1, c, NULL, NULL, NULL, m);
 }
 
-/* alpha and beta at w. */
-static void harmonic_ab(const harmonic *hc, double w, double ab[2])
+/* alpha and beta at w, from the modes' h there (hv; NULL: mode_h's). */
+static void harmonic_ab_of(const harmonic *hc, const double *hv, double w, double ab[2])
 {
     ab[0] = ab[1] = 0.0;
     for (size_t m = 0; m < hc->nmodes; m++) {
         double h, dh;
-        mode_h(&hc->modes[m], w, &h, &dh);
+        if (hv)
+            h = hv[m];
+        else
+            mode_h(&hc->modes[m], w, &h, &dh);
         ab[harmonic_is_cos(hc, m)] += h;
     }
+}
+
+static void harmonic_ab(const harmonic *hc, double w, double ab[2])
+{
+    harmonic_ab_of(hc, NULL, w, ab);
 }
 
 /* R^2 = alpha^2 + beta^2, for line_minimise. */
@@ -963,6 +979,7 @@ static pde_status w_only_extremes(const pde_solution *s, int c, const double *st
  * sigma the sign the rows' and columns' order gives: g's extremes are a problem in w alone.
  */
 #define DL_MODES 8   /* modes of each harmonic at most whose h a twin of the other's shares */
+#define DL_VALUE_MODES 32   /* modes at most whose h detj_line_value takes at once */
 #define DL_MEMO 128  /* g's models remembered across pde_properties' searches of det J */
 
 /* g's models by their interval and point (w0, w1, c): det J's searches for its least value, its
@@ -1049,15 +1066,24 @@ static void detj_line_model(const void *ctx, double w0, double w1, double c, tm1
     }
 }
 
+/* g at w: every mode's h at once where they are few (solution_factors' exps and sincos shared: fig.
+ * 4's y repeats x's terms), the same values to the bit as mode_h's one by one. */
 static double detj_line_value(const void *ctx, double w)
 {
     const detj_line *d = ctx;
-    double ab[2], gd[2], zp = 0.0;
-    harmonic_ab(&d->h[0], w, ab);
-    harmonic_ab(&d->h[1], w, gd);
+    const pde_solution *s = d->sol;
+    const size_t off[3] = { 0, s->comp[0].nmodes, s->comp[0].nmodes + s->comp[1].nmodes },
+                 mt = off[2] + s->comp[2].nmodes, z = (size_t)(d->zc - s->comp);
+    double hv[DL_VALUE_MODES], dv[DL_VALUE_MODES], ab[2], gd[2], zp = 0.0;
+    const int all = mt <= DL_VALUE_MODES;
+    if (all)
+        solution_factors(s, 2, w, hv, dv);
+    harmonic_ab_of(&d->h[0], all ? hv + off[d->c[0]] : NULL, w, ab);
+    harmonic_ab_of(&d->h[1], all ? hv + off[d->c[1]] : NULL, w, gd);
     for (size_t k = 0; k < d->zc->nmodes; k++) {
-        double h, dh;
-        mode_h(&d->zc->modes[k], w, &h, &dh);
+        double h, dh = all ? dv[off[z] + k] : 0.0;
+        if (!all)
+            mode_h(&d->zc->modes[k], w, &h, &dh);
         zp += dh;
     }
     return d->scale * zp * (ab[1] * gd[0] - ab[0] * gd[1]);
