@@ -1706,6 +1706,13 @@ static void rp_wline(double v, double *out, void *ctx)
         double l = i > 0 ? f[i - 1] : NAN, r = i < N ? f[i + 1] : NAN, s = f[i] < 0 ? -1 : 1;
         int left = i == 0 || (s * l > 0 && fabs(f[i]) <= fabs(l));
         int right = i == N || (s * r > 0 && fabs(f[i]) <= fabs(r));
+        /* The least of a run of one sign at its end, next to a sign change: a lobe of the other sign may
+         * hide between it and the sample before (after) it, on the run's side (a pair of roots 0.01 apart
+         * between samples 0.027 apart, then a third root: review's s1_043). */
+        if (i > 0 && i < N && s * l > 0 && s * r < 0 && fabs(f[i]) <= fabs(l))
+            nr += rp_dip(e, t - h, l, t, f[i], s, 0, roots + nr);
+        if (i > 0 && i < N && s * r > 0 && s * l < 0 && fabs(f[i]) <= fabs(r))
+            nr += rp_dip(e, t, f[i], t + h, r, s, 0, roots + nr);
         if (!left || !right)
             continue;
         /* Every such least is searched: a parabola through the samples can miss a narrow lobe; the
@@ -2107,6 +2114,23 @@ int ref_props(const pde_solution *s, ref_props_out *out)
                         score[2]++;
                 }
     }
+    /* Lobes narrower than that grid's step show no sign change on it (fig. 4-like models fold in w over
+     * 0.005: the lines went along u, and the outer rule over w missed the lobes: review's s1_055): each
+     * axis's lines through a 9 x 9 grid of the other two, 401 samples each, count too. */
+    for (int a = 0; a < 3; a++)
+        for (int i = 0; i < 9; i++)
+            for (int j = 0; j < 9; j++) {
+                double p[3], x[3], J[3][3], prev = 0;
+                p[a] = 0, p[a == 0 ? 1 : 0] = (i + 0.5) / 9, p[a == 2 ? 1 : 2] = (j + 0.5) / 9;
+                rp_line(&e, a, p);
+                for (int k = 0; k <= 400; k++) {
+                    rp_at(&e, k / 400.0, x, J);
+                    const double d = rp_det(J);
+                    if (k && (d < 0) != (prev < 0))
+                        score[a]++;
+                    prev = d;
+                }
+            }
     int in = score[1] > score[2] ? (score[0] > score[1] ? 0 : 1) : (score[0] > score[2] ? 0 : 2);
     int o1 = in == 0 ? 1 : 0, o2 = in == 2 ? 1 : 2;
     vc.order[0] = score[o1] >= score[o2] ? o1 : o2;
