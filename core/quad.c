@@ -1095,6 +1095,12 @@ static void free_panel(qctx *q, const pbox *b, int depth, double acc[Q_N])
     panel_lines(q, b, k, definite, acc);
 }
 
+/* A mode of w alone: its factors along u and v are 1. */
+static int mode_of_w(const pde_mode *m)
+{
+    return m->u.kind == PDE_POW && m->u.p == 0.0 && m->v.kind == PDE_POW && m->v.p == 0.0;
+}
+
 int quad_same_h(const pde_mode *a, const pde_mode *b)
 {
     if (a->nterms != b->nterms || a->nslabs != b->nslabs)
@@ -1390,8 +1396,15 @@ static void free_span(free_ctx *f, double a, double b, const double coarse[Q_N],
 
 /* The face t = 1 where G = g(w) (quad_sep's free): 1-D along w, as above. Returns 0 (nothing done)
  * where it has too many modes for the moments of pairs, or out of memory. */
-static int free_solid(qctx *q, const qplan *p, int flat, int sa)
+/* A lifted component's mode of w alone (quad_sep's lift): 1, else 0. */
+static int lifted_mode(const qctx *q, const quad_sep *sp, int c, size_t o)
 {
+    return sp->lift[c] && mode_of_w(&q->s->comp[c].modes[o - q->off[c]]);
+}
+
+static int free_solid(qctx *q, const qplan *p, const quad_sep *sp)
+{
+    const int flat = sp->axis, sa = sp->free;
     const size_t mt = q->mt;
     if (mt == 0 || mt > FREE_MODES)
         return 0;
@@ -1467,17 +1480,23 @@ static int free_solid(qctx *q, const qplan *p, int flat, int sa)
     for (size_t o = 0; o < mt * mt + mt; o++)
         if (fabs(buf[o]) <= 1e-14 * abs2[o])
             buf[o] = 0.0;
-    /* free_point's sums, each pair (c <= d) once (o's component first), in the order of (o, p) */
+    /* free_point's sums, each pair (c <= d) once (o's component first), in the order of (o, p). A
+     * lifted component's modes of w alone lack the factor t^n that separable_moments' integral over t
+     * counts for their component: k factors t^n integrate to 1 / (n (ns + k)), so such a term's
+     * moment is scaled by (ns + k) / (ns + k - its modes of w alone). */
+    const double ns = sp->ns;
     for (size_t o = 0; o < mt; o++) {
-        const int c = comp[o];
+        const int c = comp[o], lo = lifted_mode(q, sp, c, o);
         if (f.mom1[o] != 0.0)
-            terms[f.nterms++] = (free_term){ (unsigned)o, 0, (unsigned)(Q_M1 + c), f.mom1[o] };
+            terms[f.nterms++] = (free_term){ (unsigned)o, 0, (unsigned)(Q_M1 + c),
+                                             f.mom1[o] * (ns + sp->in[c]) / (ns + sp->in[c] - lo) };
         for (size_t r = 0; r < mt; r++) {
-            const int cd = comp[r];
+            const int cd = comp[r], k = sp->in[c] + sp->in[cd];
             if (cd >= c && f.mom2[o * mt + r] != 0.0)
                 terms[f.nterms++] = (free_term){ (unsigned)o, (unsigned)r,
                                                  (unsigned)(Q_M2 + (cd == c ? c : c == 0 ? (cd == 1 ? 3 : 4) : 5)),
-                                                 f.mom2[o * mt + r] };
+                                                 f.mom2[o * mt + r] * (ns + k) /
+                                                     (ns + k - lo - lifted_mode(q, sp, cd, r)) };
         }
     }
     for (int l = 0; l < p->np[2] && !poll(q); l++) {
@@ -1747,7 +1766,8 @@ static int wronskian_constant(pde_factor a, pde_factor b)
            (a.kind == PDE_SINH && b.kind == PDE_COSH) || (a.kind == PDE_COSH && b.kind == PDE_SINH);
 }
 
-/* quad_sep's free: the face's other parameter along which G is constant, or -1. */
+/* quad_sep's free: the face's other parameter along which G is constant, or -1 (a lifted component's
+ * modes of w alone add nothing to G: not in the Wronskians). */
 static int separate_free(const pde_solution *s, const quad_sep *sp)
 {
     if (sp->ns != 2)
@@ -1772,13 +1792,15 @@ static int separate_free(const pde_solution *s, const quad_sep *sp)
     const comp_solution *a = &s->comp[c1], *b = &s->comp[c2];
     for (size_t i = 0; i < a->nmodes; i++)
         for (size_t j = 0; j < b->nmodes; j++)
-            if (!wronskian_constant(f == 0 ? a->modes[i].u : a->modes[i].v,
-                                    f == 0 ? b->modes[j].u : b->modes[j].v))
+            if (!mode_of_w(&a->modes[i]) && !mode_of_w(&b->modes[j]) &&
+                !wronskian_constant(f == 0 ? a->modes[i].u : a->modes[i].v, f == 0 ? b->modes[j].u : b->modes[j].v))
                 return -1;
     return f;
 }
 
-void quad_separate(const pde_solution *s, quad_sep *sep)
+/* quad_separate, and where lift, components whose modes of w alone (mode_of_w) sit beside modes of
+ * t^n: quad_sep's lift, kept only where G = g(w) (free). */
+static void separate_lifted(const pde_solution *s, int lift, quad_sep *sep)
 {
     sep->axis = -1;
     sep->free = -1;
@@ -1786,24 +1808,36 @@ void quad_separate(const pde_solution *s, quad_sep *sep)
         int n = 0, ok = 1;
         for (int c = 0; c < 3 && ok; c++) {
             const comp_solution *cs = &s->comp[c];
-            int kind = -1;   /* -1: no modes yet; 0: every factor 1; else n */
+            int kind = -1, of_w = 0;   /* kind -1: no modes yet; 0: every factor 1; else n */
             for (size_t m = 0; m < cs->nmodes && ok; m++) {
                 const pde_factor f = a == 0 ? cs->modes[m].u : cs->modes[m].v;
                 const int p = f.kind == PDE_POW && f.p == floor(f.p) ? (int)f.p : -1;
+                if (lift && mode_of_w(&cs->modes[m])) {
+                    of_w = 1;
+                    continue;
+                }
                 if (p < 0 || (kind >= 0 && p != kind) || (p > 0 && n > 0 && p != n))
                     ok = 0;
                 kind = p;
             }
             sep->in[c] = kind > 0;
+            sep->lift[c] = kind > 0 && of_w;
             if (kind > 0)
                 n = kind;
         }
         if (ok && n > 0) {
             sep->axis = a, sep->n = n, sep->ns = sep->in[0] + sep->in[1] + sep->in[2];
             sep->free = separate_free(s, sep);
+            if ((sep->lift[0] || sep->lift[1] || sep->lift[2]) && sep->free < 0)
+                sep->axis = -1;
             return;
         }
     }
+}
+
+void quad_separate(const pde_solution *s, quad_sep *sep)
+{
+    separate_lifted(s, 0, sep);
 }
 
 /* The moments about the origin in acc, about x0 instead. */
@@ -2205,8 +2239,9 @@ static pde_status solid_run(const pde_solution *s, const double x0[3], double js
         return PDE_ERR_NOMEM;
     q->wsign = ws;
     quad_sep sp = { .axis = -1, .free = -1 };
-    if (separate)
-        quad_separate(s, &sp);
+    if (separate)   /* lifted components on the free path alone (free_solid's modes) */
+        separate_lifted(s, separate == 1 && q->mt <= FREE_MODES, &sp);
+    const int lifted = sp.axis >= 0 && (sp.lift[0] || sp.lift[1] || sp.lift[2]);
     q->free = separate == 1 ? sp.free : -1;
     q->jtol = 1e-13 * jscale;
     q->vscale = vscale;
@@ -2263,7 +2298,11 @@ static pde_status solid_run(const pde_solution *s, const double x0[3], double js
      * or half-turn (param_symmetry) where the period is a whole number of panels; else, where the face
      * is integrated by rows (face_rows), a rotation (param_rotation), with the period's own panels. */
     /* G = g(w): 1-D along w over the whole face, no period needed */
-    const int one_d = q->free >= 0 && free_solid(q, &p, sp.axis, q->free);
+    const int one_d = q->free >= 0 && free_solid(q, &p, &sp);
+    if (lifted && !one_d) {   /* its memory: no other path takes a lifted component */
+        qctx_free(q);
+        return PDE_ERR_NOMEM;
+    }
     qsym sy = { .k = 0 };
     const int folds = sp.axis >= 0 && q->free < 0 && !jsign;   /* on the face, G depending on both */
     for (int t = 0; t < 2 && sp.axis >= 0 && separate != 3 && !sy.k && !one_d; t++) {
