@@ -897,6 +897,15 @@ static void props_should_match_the_reference_on_narrow_lobes_of_a_fold(void **st
         "\"dw1\": -2.551}, {\"w0\": -0.833, \"w1\": -0.435}], \"z\": [{\"u\": {\"pow\": 1}, \"v\": {\"cos\": 6}, \"w0\": 0.96, "
         "\"dw0\": -1.978, \"w1\": 0.989, \"dw1\": 2.617}], \"x\": [{\"w0\": 0.452, \"dw0\": -0.949, \"w1\": 2.421, "
         "\"dw1\": -3.566}]}}",
+        /* z' = 0 at w = 1.5e-4: a rounded fold of the faces u = 0 and 1 inside their lines' first
+         * interval; area 12.85086719994838 by an adaptive long double quadrature cut at the element's
+         * leasts (each u face also by a 1-D formula: 2.2082202067725634); the reference was 1.55e-8 short */
+        "{\"pde\": {\"a\": [1.009, 1.009, 1.009], \"b\": [0.82, 0.82, 0.82], \"c\": [-10, -10, -10.5]}, \"boundary\": "
+        "{\"x\": [{\"u\": {\"sin\": 1}, \"v\": {\"pow\": 3}, \"w0\": 0.716, \"dw0\": 1.045, \"w1\": 0.547, \"dw1\": -0.402}], "
+        "\"y\": [{\"u\": {\"cos\": 1}, \"v\": {\"pow\": 3}, \"w0\": 0.716, \"dw0\": -1.835, \"w1\": 0.547, \"dw1\": -2.373}], "
+        "\"z\": [{\"w0\": -0.408, \"dw0\": -0.001, \"w1\": 2.651, \"dw1\": 5.946}]}, \"force\": {\"x\": [{\"u\": {\"cos\": 1}, "
+        "\"v\": {\"pow\": 3}, \"coef\": 622.0, \"w\": {\"sin\": 3}}], \"y\": [{\"u\": {\"sin\": 1}, \"v\": {\"pow\": 3}, "
+        "\"coef\": 127.0, \"w\": {\"sin\": 3}}]}}",
     };
     for (size_t i = 0; i < sizeof models / sizeof *models; i++) {
         api_error err;
@@ -907,7 +916,8 @@ static void props_should_match_the_reference_on_narrow_lobes_of_a_fold(void **st
         ref_props_out r;
         assert_int_equal(ref_props(sol, &r), 0);
         assert_true(r.converged);
-        assert_true(r.volume - fabs(r.signed_volume) > 1e-6 * r.volume);   /* it folds */
+        if (i < 3)
+            assert_true(r.volume - fabs(r.signed_volume) > 1e-6 * r.volume);   /* it folds (3: its skin) */
         pde_props p;
         assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
         char name[32];
@@ -917,6 +927,10 @@ static void props_should_match_the_reference_on_narrow_lobes_of_a_fold(void **st
             assert_rel(r.volume, 23.81136496787779, 1e-12, 0);
         if (i == 2)
             assert_rel(r.volume, 26.2280414826238, 1e-12, 0);
+        if (i == 3) {
+            assert_rel(r.surface_area, 12.85086719994838, 1e-11, 0);
+            assert_rel(p.surface_area, 12.85086719994838, 1e-9, 0);
+        }
         pde_solution_free(sol);
         api_model_free(m);
     }
