@@ -654,18 +654,8 @@ static void every_skin_should_be_closed_with_normals_and_det_j_from_the_closed_f
     const size_t nfig = paper_figure_count(), n = nfig + sizeof lofts / sizeof *lofts;
     for (size_t f = 0; f < n; f++) {
         const char *name = f < nfig ? paper_figure_name(f) : lofts[f - nfig];
-        pde_solution *sol;
+        pde_solution *sol = solve_preset(name, NULL);
         api_error err;
-        if (f < nfig)
-            sol = solve_preset(name, NULL);
-        else {
-            char doc[64];
-            snprintf(doc, sizeof doc, "{\"preset\": \"%s\"}", name);
-            api_model *m = api_model_parse(doc, strlen(doc), &err);
-            assert_non_null(m);
-            assert_int_equal(api_solve(m, &sol, &err), 0);
-            api_model_free(m);
-        }
         const unsigned res[3] = { 24, 160, 24 };   /* fig. 3's sin 30 pi v: 10 samples a period */
         size_t len, nt;
         unsigned char *b = render(sol, NULL, API_FMT_STL, res, &len);
@@ -1162,11 +1152,8 @@ static void points_beyond_float32_should_be_refused_only_where_they_are_float32(
     const char *doc = "{\"pde\": {\"a\": [1, 1, 1], \"b\": [1, 1, 1], \"c\": [1, 1, 1]}, \"boundary\": {"
                       "\"x\": [{\"w0\": 1e39, \"w1\": 1e39}, {\"u\": {\"pow\": 1}, \"w0\": 1, \"w1\": 1}],"
                       " \"y\": [{\"v\": {\"pow\": 1}, \"w0\": 1, \"w1\": 1}], \"z\": [{\"w1\": 1, \"dw0\": 1, \"dw1\": 1}]}}";
+    pde_solution *sol = solve_text(doc);
     api_error err;
-    api_model *m = api_model_parse(doc, strlen(doc), &err);
-    assert_non_null(m);
-    pde_solution *sol = NULL;
-    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
     for (int f = 0; f < API_FMT_COUNT; f++) {
         const api_format_info *fi = api_format_info_of((api_format)f);
         const int doubles = f == API_FMT_JSON || f == API_FMT_MSH || f == API_FMT_VTU;
@@ -1178,7 +1165,6 @@ static void points_beyond_float32_should_be_refused_only_where_they_are_float32(
             fail_msg("%s: \"%s\"", fi->name, err.message);
     }
     pde_solution_free(sol);
-    api_model_free(m);
 }
 
 /* A solid whose integrals overflow a double (fig. 4a with p0 = 1e100) is a document the client can mend,
@@ -1187,11 +1173,8 @@ static void properties_beyond_a_double_should_be_a_document_error(void **state)
 {
     (void)state;
     const char *doc = "{\"preset\":\"fig4a\",\"params\":{\"p0\":1e100}}";
+    pde_solution *sol = solve_text(doc);
     api_error err;
-    api_model *m = api_model_parse(doc, strlen(doc), &err);
-    assert_non_null(m);
-    pde_solution *sol = NULL;
-    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
     for (int f = 0; f < API_FMT_COUNT; f++) {
         const api_format_info *fi = api_format_info_of((api_format)f);
         if (!fi->props)
@@ -1205,7 +1188,6 @@ static void properties_beyond_a_double_should_be_a_document_error(void **state)
             fail_msg("%s: status %d, \"%s\"", fi->name, (int)err.status, err.message);
     }
     pde_solution_free(sol);
-    api_model_free(m);
 }
 
 /* The skin's faces u = 0, 1 come from a grid of nu = 2, which fills its planes column-wise (core/eval.c);
