@@ -1190,6 +1190,27 @@ static void properties_beyond_a_double_should_be_a_document_error(void **state)
     pde_solution_free(sol);
 }
 
+/* A grid the core refuses (no samples along u, or more than it takes) is the caller's res, a document error
+ * that names it, not "out of memory" (api_rows_open dropped pde_grid_create's status: review). */
+static void a_grid_the_core_refuses_should_be_a_document_error_naming_res(void **state)
+{
+    (void)state;
+    pde_solution *sol = preset_solution("fig2a");
+    static const api_format sampled[] = { API_FMT_GRID, API_FMT_F32, API_FMT_VTS };
+    static const unsigned res[][3] = { { 0, 4, 4 }, { 4, 0, 4 }, { (1u << 24) + 1, 1, 1 } };
+    for (size_t f = 0; f < sizeof sampled / sizeof *sampled; f++)
+        for (size_t i = 0; i < sizeof res / sizeof *res; i++) {
+            api_error err;
+            memset(&err, 0, sizeof err);
+            api_output *o = api_output_open(sol, NULL, NULL, sampled[f], res[i], NULL, &err);
+            if (o || err.status != API_ERR_DOCUMENT || strncmp(err.message, "res: ", 5))
+                fail_msg("%s at res %u,%u,%u: %s, status %d, \"%s\"", api_format_info_of(sampled[f])->name, res[i][0],
+                         res[i][1], res[i][2], o ? "opened" : "refused", (int)err.status, err.message);
+            api_output_free(o);
+        }
+    pde_solution_free(sol);
+}
+
 /* The skin's faces u = 0, 1 come from a grid of nu = 2, which fills its planes column-wise (core/eval.c);
  * every bit of it, and of nu = 1, must be what a wide grid gives at the same u. */
 static void narrow_grids_should_sample_the_same_bits_as_wide_ones(void **state)
@@ -1232,6 +1253,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(properties_beyond_a_double_should_be_a_document_error),
+        cmocka_unit_test(a_grid_the_core_refuses_should_be_a_document_error_naming_res),
         cmocka_unit_test(points_beyond_float32_should_be_refused_only_where_they_are_float32),
         cmocka_unit_test(presets_should_carry_the_papers_values),
         cmocka_unit_test(presets_should_be_the_tests_own_transcription),
