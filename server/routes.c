@@ -492,7 +492,10 @@ static srv_entry *find_solid(srv_req *r)
 {
     api_error err = { .status = API_ERR_NOT_FOUND };
     int valid = api_id_valid(r->arg), missing = 1;
+    double t0 = srv_now();
     srv_entry *e = valid ? srv_cache_find(r->s->cache, r->arg, &err) : NULL;
+    r->tm.solve = srv_now() - t0;   /* as solve_cached's: the solve is the cache's, a wait at most */
+    r->tm.cached = e != NULL;
     if (!e && valid && r->s->store && (err.status == API_ERR_NOT_FOUND || err.status == API_ERR_CANCELLED))
         e = restore(r, &missing);
     if (e || !missing)
@@ -609,6 +612,7 @@ static void eval_points(srv_req *r)
                    derivs ? dv + 3 * i : NULL, derivs ? dw + 3 * i : NULL);
     }
     r->tm.solve = srv_now() - t0;
+    r->tm.cached = 0;   /* the slot is the evaluation's now (docs/API.md), which no cache answered */
     snprintf(r->id, sizeof r->id, "%s", srv_entry_id(e));
     srv_cache_release(s->cache, e);
     free(pts);
