@@ -644,6 +644,33 @@ static void server_timing_should_say_cached_wherever_the_cache_gave_the_solution
     stop(&d);
 }
 
+/* A gltf or glb at res 3 along v, around which a loft closes into a loop, is refused before its properties
+ * (8 ms for the vase, optimised), by the skin's own test of the loop (api_mesh_check_loops): they were computed
+ * first, to be thrown away (QA). 4 along v is a skin, its properties computed then. */
+static void a_skin_around_a_loop_at_res_3_should_be_refused_before_the_properties(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    static const char *const refused[] = { "/solve?format=glb&res=3", "/solve?format=gltf&res=16,3,16" };
+    char timing[512];
+    for (size_t i = 0; i < sizeof refused / sizeof *refused; i++) {
+        reply r = post(&d, refused[i], "{\"preset\":\"vase\"}");
+        expect_problem(&r, 422, NULL, "take at least 4 along v");
+        assert_true(header_value(&r, "Server-Timing", timing, sizeof timing));
+        if (!strstr(timing, "props;dur=0.000"))
+            fail_msg("%s: the properties were computed before the refusal: %s", refused[i], timing);
+        free(r.body);
+    }
+    reply r = post(&d, "/solve?format=glb&res=3,4,3", "{\"preset\":\"vase\"}");
+    assert_int_equal(r.status, 200);
+    assert_true(header_value(&r, "Server-Timing", timing, sizeof timing));
+    if (strstr(timing, "props;dur=0.000"))
+        fail_msg("the glb's properties took no time: %s", timing);
+    free(r.body);
+    stop(&d);
+}
+
 static void etag_with_if_none_match_should_give_304(void **state)
 {
     (void)state;
@@ -1591,6 +1618,7 @@ int main(void)
         cmocka_unit_test(a_get_waiting_on_a_cancelled_solve_should_get_the_solve_that_takes_it_over),
         cmocka_unit_test(a_get_waiting_on_a_cancelled_solve_no_one_takes_over_should_learn_it_was_cancelled),
         cmocka_unit_test(server_timing_should_say_cached_wherever_the_cache_gave_the_solution),
+        cmocka_unit_test(a_skin_around_a_loop_at_res_3_should_be_refused_before_the_properties),
         cmocka_unit_test(etag_with_if_none_match_should_give_304),
         cmocka_unit_test(sixty_four_concurrent_clients_should_all_get_correct_answers),
         cmocka_unit_test(a_full_queue_should_give_503_with_retry_after),
