@@ -99,20 +99,23 @@ static double axis(size_t i, size_t n)
     return n > 1 ? (double)i / (double)(n - 1) : 0.5;
 }
 
-int api_rows_open(api_rows *r, const api_output *o, int derivs)
+int api_rows_open(api_rows *r, const api_output *o, int derivs, api_error *err)
 {
     size_t nu = o->res[0], nv = o->res[1];
     double *us = malloc((nu + nv) * sizeof *us);
     if (!us)
-        return -1;
+        return api_fail_nomem(err);
     for (size_t i = 0; i < nu; i++)
         us[i] = axis(i, nu);
     for (size_t j = 0; j < nv; j++)
         us[nu + j] = axis(j, nv);
     pde_status st = pde_grid_create(o->sol, us, nu, us + nu, nv, &r->grid);
     free(us);
-    if (st != PDE_OK)
-        return -1;
+    if (st == PDE_ERR_NOMEM)
+        return api_fail_nomem(err);
+    if (st != PDE_OK)   /* the core's own refusal of the grid (a count it does not take), not memory */
+        return api_fail(err, api_status_of(st), "", "res: %u,%u,%u: the solution cannot be sampled on %zu by %zu "
+                        "points in u and v (%s)", o->res[0], o->res[1], o->res[2], nu, nv, pde_strerror(st));
     /* A row costs about (3 + nu) multiply-adds per mode and component (nu per distinct u-factor). */
     double row = 0.0;
     for (int c = 0; c < 3; c++) {
@@ -132,9 +135,9 @@ int api_rows_open(api_rows *r, const api_output *o, int derivs)
         r->xv = malloc(n * sizeof(float));
         r->xw = malloc(n * sizeof(float));
         if (!r->xu || !r->xv || !r->xw)
-            return -1;
+            return api_fail_nomem(err);
     }
-    return r->xyz ? 0 : -1;
+    return r->xyz ? 0 : api_fail_nomem(err);
 }
 
 size_t api_rows_next(api_rows *r, const api_output *o, int derivs)
@@ -165,11 +168,11 @@ void api_rows_free(api_rows *r)
     memset(r, 0, sizeof *r);
 }
 
-int api_sampled_open(api_output *o, int derivs)
+int api_sampled_open(api_output *o, int derivs, api_error *err)
 {
     api_sampled *g = calloc(1, sizeof *g);
     o->st = g;
-    return g ? api_rows_open(&g->rows, o, derivs) : -1;
+    return g ? api_rows_open(&g->rows, o, derivs, err) : api_fail_nomem(err);
 }
 
 void api_sampled_close(void *st)

@@ -86,12 +86,13 @@ typedef struct {
     int phase, first, c;
 } api_sampled;
 
-/* o->st as a new api_sampled, its rows set up; 0 or -1 (out of memory). */
-int api_sampled_open(api_output *o, int derivs);
+/* o->st as a new api_sampled, its rows set up; 0, or -1 with err (api_rows_open's). */
+int api_sampled_open(api_output *o, int derivs, api_error *err);
 void api_sampled_close(void *st);
 
-/* Sets up o->res's sampling tables, with derivatives or not; 0 or -1 (out of memory). */
-int api_rows_open(api_rows *r, const api_output *o, int derivs);
+/* Sets up o->res's sampling tables, with derivatives or not; 0, or -1 with err: out of memory, or the core's
+ * refusal of the grid (pde_grid_create's status, as api_status_of maps it; a document error naming res). */
+int api_rows_open(api_rows *r, const api_output *o, int derivs, api_error *err);
 /* The next chunk of rows; returns the number of points (0 when every plane is done). */
 size_t api_rows_next(api_rows *r, const api_output *o, int derivs);
 void api_rows_free(api_rows *r);

@@ -10,9 +10,8 @@
 static int f32_open(api_output *o, const pde_cancel *cancel, api_error *err)
 {
     (void)cancel;
-    (void)err;
     o->size = 12 * api_out_points(o);
-    return api_sampled_open(o, 0);
+    return api_sampled_open(o, 0, err);
 }
 
 static int f32_fill(api_output *o)

@@ -13,8 +13,7 @@
 static int grid_open(api_output *o, const pde_cancel *cancel, api_error *err)
 {
     (void)cancel;
-    (void)err;
-    return api_sampled_open(o, 0);
+    return api_sampled_open(o, 0, err);
 }
 
 static int grid_fill(api_output *o)

@@ -43,7 +43,7 @@ static const char vts_footer[] = "\n  </AppendedData>\n</VTKFile>\n";
 
 static int vts_open(api_output *o, const pde_cancel *cancel, api_error *err)
 {
-    if (!api_out_props(o, cancel, err) || api_sampled_open(o, 1) || vts_header(o))
+    if (!api_out_props(o, cancel, err) || api_sampled_open(o, 1, err) || vts_header(o))
         return -1;
     long long n = api_out_points(o);   /* the header measured once, for the size */
     o->size = (long long)o->len + 8 + 12 * n + 8 + 4 * n + (long long)strlen(vts_footer);

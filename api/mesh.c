@@ -754,8 +754,10 @@ void api_mesh_loop_message(int axis, char *buf, size_t n)
              "points around it, and the mesh folds flat onto itself; take at least 4 along %c", t, t, t, t);
 }
 
-int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_mesh *out,
-                   api_error *err)
+/* api_mesh_build, or with loops_only its steps 1 and 2 alone, to the test of 3 samples around a loop: then 0
+ * (out given back) or -1 with err as the build's. */
+static int build(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_mesh *out,
+                 api_error *err, int loops_only)
 {
     memset(out, 0, sizeof *out);
     if (res[0] < 2 || res[1] < 2 || res[2] < 2) {
@@ -828,7 +830,7 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
     /* 2. Join: the cube's edges by the lattice; collapsed rows and seams where the map joins them. */
     for (uint32_t i = 0; i < (uint32_t)nraw; i++)
         up[i] = i;
-    for (int fi = 0; fi < 6; fi++) {
+    for (int fi = 0; fi < 6 && !loops_only; fi++) {   /* the loops' test counts near samples, joined or not */
         const face *f = &faces[fi];
         const size_t na = f->na, nb = f->nb;
         int o[2];
@@ -874,6 +876,11 @@ int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_can
             why = loop, why_status = API_ERR_DOCUMENT;
             goto done;
         }
+    if (loops_only) {
+        api_mesh_free(out);
+        rc = 0;
+        goto done;
+    }
     /* Roots; a joined sample takes its root's position, so that every copy of a point is the same
      * bits (the root, the least sample, is settled before any other of its set). Almost every sample
      * is its own root and needs no store: 4 a step in SSE2 find the others. */
@@ -1202,4 +1209,18 @@ done:
     if (have_sp)
         sampler_free(&sp);
     return rc;
+}
+
+int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_mesh *out,
+                   api_error *err)
+{
+    return build(sol, res, cancel, out, err, 0);
+}
+
+int api_mesh_check_loops(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_error *err)
+{
+    if ((res[0] != 3 && res[1] != 3 && res[2] != 3) || pde_solution_is_flat(sol))
+        return 0;   /* no axis for the test; a flat solid's output refuses it first, for having no volume */
+    api_mesh m;
+    return build(sol, res, cancel, &m, err, 1);
 }

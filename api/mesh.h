@@ -48,6 +48,15 @@ typedef struct {
  */
 int api_mesh_build(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_mesh *out,
                    api_error *err);
+/*
+ * api_mesh_build's refusal of res 3 along an axis that closes into a loop (api_mesh_loop_message), by the
+ * build's own steps (the faces sampled and joined; no triangle, normal or det J): 0, or -1 with err as
+ * api_mesh_build's. Only where some res[a] is 3, else 0 at once, as for a flat solid (pde_solution_is_flat:
+ * its outputs refuse it first, for having no volume). For a caller with dearer work to do before the build,
+ * as the properties of gltf and glb; the build itself then samples the faces again.
+ */
+int api_mesh_check_loops(const pde_solution *sol, const unsigned res[3], const pde_cancel *cancel, api_error *err);
+
 /* Gives the mesh's block back for the next build; NULL or a zeroed mesh does nothing. */
 void api_mesh_free(api_mesh *m);
 

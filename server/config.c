@@ -26,7 +26,7 @@ typedef enum {
     K_COUNT,     /* size_t, a whole number in [lo, hi] */
     K_MB,        /* size_t bytes, given in MiB in [lo, hi] */
     K_BYTES,     /* size_t bytes, given as SIZE (parse_size), at least lo */
-    K_REAL,      /* double in (lo, hi]: 2.5, 2e9, 2000000000 */
+    K_REAL,      /* double over 0, in [lo, hi]: 2.5, 2e9, 2000000000 */
     K_LOGFMT,    /* srv_log_format: text or json */
     K_SWITCH,    /* int set to 1; takes no value */
     K_HELP,
@@ -100,9 +100,10 @@ static const flag flags[] = {
       "heavy requests that may wait before 503" },
     { "--job-timeout", "S", K_REAL, AT(job_timeout), 0, 86400, "2", NULL,
       "wall-clock seconds of solver time one request's\njobs may take in all; past it they are cancelled" },
-    { "--request-timeout", "S", K_REAL, AT(request_timeout), 0, 86400, "30", NULL,
+    { "--request-timeout", "S", K_REAL, AT(request_timeout), 1, 86400, "30", NULL,
       "seconds for a request's head (from the opening\nof its connection or its previous answer) and\n"
-      "again for its body (from the end of its head);\npast either the connection is closed" },
+      "again for its body (from the end of its head);\npast either the connection is closed.\n"
+      "At least 1, and never off: it bounds how long\na slow client holds a connection" },
     { "--timeout", "S", K_UNSIGNED, AT(timeout), 1, 86400, "30", NULL,
       "seconds before an idle connection is closed" },
     { "--max-conns-per-ip", "N", K_UNSIGNED, AT(per_ip), 1, 65535, "128", NULL,
@@ -214,14 +215,15 @@ static int parse_whole(const char *s, double lo, double hi, unsigned long long *
     return 0;
 }
 
-/* A plain decimal number (digits, '.', an exponent): no hex, inf, nan or spaces, which strtod would take. */
+/* A plain decimal number (digits, '.', an exponent) over 0 in [lo, hi]: no hex, inf, nan or spaces, which strtod
+ * would take. */
 static int parse_real(const char *s, double lo, double hi, double *out)
 {
     if (!((*s >= '0' && *s <= '9') || *s == '.') || strspn(s, "0123456789.eE+-") != strlen(s))
         return -1;
     char *end;
     double v = strtod(s, &end);
-    if (*end || !isfinite(v) || !(v > lo) || v > hi)
+    if (*end || !isfinite(v) || !(v > 0) || v < lo || v > hi)
         return -1;
     *out = v;
     return 0;
@@ -308,7 +310,10 @@ static void describe(const flag *r, char *out, size_t n)
         snprintf(out, n, "a size such as 1MiB, 512KiB or 65536, at least %.0f bytes", r->lo);
         break;
     case K_REAL:
-        snprintf(out, n, "a number over %g and at most %g, such as %s", r->lo, r->hi, r->def ? r->def : "1");
+        if (r->lo > 0)
+            snprintf(out, n, "a number from %g to %g, such as %s", r->lo, r->hi, r->def ? r->def : "1");
+        else
+            snprintf(out, n, "a number over 0 and at most %g, such as %s", r->hi, r->def ? r->def : "1");
         break;
     case K_LOGFMT:
         snprintf(out, n, "text or json");

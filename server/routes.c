@@ -24,6 +24,7 @@
 #include "catalog.h"
 #include "cost.h"
 #include "internal.h"
+#include "mesh.h"
 #include "model.h"
 #include "sbuf.h"
 #include "strict.h"
@@ -302,9 +303,12 @@ static void answer_heavy(srv_req *r, srv_entry *e)
     const pde_props *props = NULL;
     api_error err;
     /* The output's own refusals first (float32's range: a glb of a solid beyond it), which cost nothing,
-     * where the properties of the same solid would take their whole budget. */
+     * where the properties of the same solid would take their whole budget; and a skin's of res 3 around a
+     * loop (mesh.h), which costs a sampling of its faces, only at res 3 and only before properties to come. */
     double t0 = srv_now();
-    if (api_output_check(sol, f, &opts, &err)) {
+    if (api_output_check(sol, f, &opts, &err) ||
+        (with_props && api_format_info_of(f)->mesh && !srv_entry_has_props(e) &&
+         api_mesh_check_loops(sol, res, &r->cancel, &err))) {
         r->tm.output = srv_now() - t0;
         srv_cache_release(s->cache, e);
         failed(r, &err);
@@ -492,7 +496,10 @@ static srv_entry *find_solid(srv_req *r)
 {
     api_error err = { .status = API_ERR_NOT_FOUND };
     int valid = api_id_valid(r->arg), missing = 1;
+    double t0 = srv_now();
     srv_entry *e = valid ? srv_cache_find(r->s->cache, r->arg, &err) : NULL;
+    r->tm.solve = srv_now() - t0;   /* as solve_cached's: the solve is the cache's, a wait at most */
+    r->tm.cached = e != NULL;
     if (!e && valid && r->s->store && (err.status == API_ERR_NOT_FOUND || err.status == API_ERR_CANCELLED))
         e = restore(r, &missing);
     if (e || !missing)
@@ -609,6 +616,7 @@ static void eval_points(srv_req *r)
                    derivs ? dv + 3 * i : NULL, derivs ? dw + 3 * i : NULL);
     }
     r->tm.solve = srv_now() - t0;
+    r->tm.cached = 0;   /* the slot is the evaluation's now (docs/API.md), which no cache answered */
     snprintf(r->id, sizeof r->id, "%s", srv_entry_id(e));
     srv_cache_release(s->cache, e);
     free(pts);

@@ -1239,6 +1239,17 @@ pde_solution *preset_solution(const char *name)
     return sol;
 }
 
+pde_solution *solve_text(const char *text)
+{
+    api_error err;
+    api_model *m = api_model_parse(text, strlen(text), &err);
+    pde_solution *sol = NULL;
+    if (!m || api_solve(m, &sol, &err) != 0)
+        fail_msg("%s: %s: %s", m ? "solve" : "parse", err.pointer, err.message);
+    api_model_free(m);
+    return sol;
+}
+
 /* ---- HTTP through libcurl ---- */
 
 static size_t on_body(char *p, size_t size, size_t n, void *cls)

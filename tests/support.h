@@ -101,6 +101,11 @@ void sixteen_mode_model(pde_bterm b[3][16], pde_model *m);
  * pde_solution_free(). */
 struct pde_solution *preset_solution(const char *name);
 
+/* The solution of a client's document (a model, a preset or a loft, as POST /solve takes it), parsed and
+ * solved through api_solve (a test failure naming the pointer if either fails); free with
+ * pde_solution_free(). */
+struct pde_solution *solve_text(const char *text);
+
 /* Reads a whole file into a NUL-terminated buffer; NULL on failure. */
 char *read_file(const char *path, size_t *len);
 

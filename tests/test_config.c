@@ -288,6 +288,33 @@ static void each_error_should_exit_2_naming_its_argument(void **state)
     }
 }
 
+/* --request-timeout bounds a head's time on its connection; under a second (0.05 s is the watcher's first sweep)
+ * every connection of a client not on loopback was closed before its head could arrive, and there is no 0 for
+ * off (slow heads would hold connections, and an address's --max-conns-per-ip, forever): 1 is the least. */
+static void request_timeout_should_be_a_second_or_more(void **state)
+{
+    (void)state;
+    static const char *const refused[] = { "0", "0.0", "0.5", "0.999", "1e-9" };
+    for (size_t i = 0; i < sizeof refused / sizeof *refused; i++) {
+        srv_config c;
+        result r = parse(&c, ARGS("--request-timeout", refused[i]));
+        char want[96];
+        snprintf(want, sizeof want, "--request-timeout %s: not a valid value; give a number from 1 to 86400", refused[i]);
+        if (r.rc != 2 || !strstr(r.err, want))
+            fail_msg("%s: rc %d, err \"%s\"", refused[i], r.rc, r.err);
+    }
+    srv_config c;
+    result r = parse(&c, ARGS("--request-timeout=1"));
+    assert_int_equal(r.rc, 0);
+    assert_true(c.request_timeout == 1.0);
+    /* the other seconds keep their bound: over 0 */
+    r = parse(&c, ARGS("--job-timeout=0.001"));
+    assert_int_equal(r.rc, 0);
+    r = parse(&c, ARGS("--job-timeout=0"));
+    assert_int_equal(r.rc, 2);
+    assert_non_null(strstr(r.err, "give a number over 0 and at most 86400"));
+}
+
 /* The forms --bind and --store take beyond every_flag's, kept as given. */
 static void store_and_bind_should_take_each_of_their_forms(void **state)
 {
@@ -410,6 +437,7 @@ int main(void)
         cmocka_unit_test(every_flag_should_take_its_value_in_both_forms),
         cmocka_unit_test(every_flag_in_the_usage_should_be_tested),
         cmocka_unit_test(each_error_should_exit_2_naming_its_argument),
+        cmocka_unit_test(request_timeout_should_be_a_second_or_more),
         cmocka_unit_test(store_and_bind_should_take_each_of_their_forms),
         cmocka_unit_test(web_given_without_an_index_should_refuse_to_start),
         cmocka_unit_test(help_and_version_should_print_and_return_1),

@@ -600,6 +600,77 @@ static void concurrent_identical_requests_should_solve_once(void **state)
     stop(&d);
 }
 
+/* Server-Timing's solve says "cached" whenever the cache gave the solution: a POST /solve of a solid solved
+ * before and a GET /solids/{id} alike (the GET never said so: review); not a new solve, nor an eval, whose
+ * solve is the evaluation. Each request is a new one for the response cache, so a job answers it. */
+static void server_timing_should_say_cached_wherever_the_cache_gave_the_solution(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    static const char body[] = "{\"preset\":\"fig2a\"}";
+    char id[API_ID_LEN + 1], path[128], timing[512];
+    reply r = post(&d, "/solve", body);
+    assert_int_equal(r.status, 200);
+    assert_true(header_value(&r, "X-Solid-Id", id, sizeof id));
+    free(r.body);
+    const struct {
+        const char *method, *path, *body;   /* %s: the id */
+        int cached;
+    } cases[] = {
+        { "POST", "/solve?format=grid&res=3", body, 1 },
+        { "GET", "/solids/%s", NULL, 1 },
+        { "GET", "/solids/%s?format=glb&res=5", NULL, 1 },
+        { "POST", "/solids/%s/eval", "{\"points\":[[0.5,0.5,0.5]]}", 0 },
+        { "POST", "/solve", "{\"preset\":\"fig2b\"}", 0 },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        snprintf(path, sizeof path, cases[i].path, id);
+        const char *b = cases[i].body;
+        r = http(&d, cases[i].method, path, b, b ? strlen(b) : 0, NULL);
+        if (r.status != 200)
+            fail_msg("%s %s: %ld %s", cases[i].method, path, r.status, r.body);
+        if (!header_value(&r, "Server-Timing", timing, sizeof timing))
+            fail_msg("%s %s: no Server-Timing", cases[i].method, path);
+        const char *solve = strstr(timing, "solve;dur="), *next = solve ? strchr(solve, ',') : NULL;
+        assert_non_null(next);
+        const char *desc = strstr(solve, ";desc=\"cached\"");
+        const int said = desc && desc < next;
+        if (said != cases[i].cached)
+            fail_msg("%s %s: Server-Timing %s, want the solve %s", cases[i].method, path, timing,
+                     cases[i].cached ? "cached" : "not cached");
+        free(r.body);
+    }
+    stop(&d);
+}
+
+/* A gltf or glb at res 3 along v, around which a loft closes into a loop, is refused before its properties
+ * (8 ms for the vase, optimised), by the skin's own test of the loop (api_mesh_check_loops): they were computed
+ * first, to be thrown away (QA). 4 along v is a skin, its properties computed then. */
+static void a_skin_around_a_loop_at_res_3_should_be_refused_before_the_properties(void **state)
+{
+    (void)state;
+    daemon_t d;
+    start(&d, "");
+    static const char *const refused[] = { "/solve?format=glb&res=3", "/solve?format=gltf&res=16,3,16" };
+    char timing[512];
+    for (size_t i = 0; i < sizeof refused / sizeof *refused; i++) {
+        reply r = post(&d, refused[i], "{\"preset\":\"vase\"}");
+        expect_problem(&r, 422, NULL, "take at least 4 along v");
+        assert_true(header_value(&r, "Server-Timing", timing, sizeof timing));
+        if (!strstr(timing, "props;dur=0.000"))
+            fail_msg("%s: the properties were computed before the refusal: %s", refused[i], timing);
+        free(r.body);
+    }
+    reply r = post(&d, "/solve?format=glb&res=3,4,3", "{\"preset\":\"vase\"}");
+    assert_int_equal(r.status, 200);
+    assert_true(header_value(&r, "Server-Timing", timing, sizeof timing));
+    if (strstr(timing, "props;dur=0.000"))
+        fail_msg("the glb's properties took no time: %s", timing);
+    free(r.body);
+    stop(&d);
+}
+
 static void etag_with_if_none_match_should_give_304(void **state)
 {
     (void)state;
@@ -1546,6 +1617,8 @@ int main(void)
         cmocka_unit_test(a_request_waiting_on_a_cancelled_solve_should_solve_for_itself),
         cmocka_unit_test(a_get_waiting_on_a_cancelled_solve_should_get_the_solve_that_takes_it_over),
         cmocka_unit_test(a_get_waiting_on_a_cancelled_solve_no_one_takes_over_should_learn_it_was_cancelled),
+        cmocka_unit_test(server_timing_should_say_cached_wherever_the_cache_gave_the_solution),
+        cmocka_unit_test(a_skin_around_a_loop_at_res_3_should_be_refused_before_the_properties),
         cmocka_unit_test(etag_with_if_none_match_should_give_304),
         cmocka_unit_test(sixty_four_concurrent_clients_should_all_get_correct_answers),
         cmocka_unit_test(a_full_queue_should_give_503_with_retry_after),
