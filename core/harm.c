@@ -24,7 +24,6 @@
 #include <string.h>
 
 #include "harm.h"
-#include "quad.h"
 
 #define NT 256          /* points of theta per 2 pi on the trapezoidal rule's finest level */
 #define N0 16           /* ... on its first */
@@ -111,12 +110,10 @@ typedef struct {
     const harm_opts *o;
     const pde_solution *s;
     size_t nm;
-    double *wt, *h, *dh;       /* per mode: its factor of the face's fixed parameter at the side; per mode
-                                * of hs: h, h' */
-    const pde_solution *hs;    /* the modes whose h(w) are evaluated: s's, or each distinct one once (distinct) */
-    pde_solution distinct;     /* its modes dmodes (quad_same_h; fig. 2 and 4: 3 of 5) */
-    pde_mode *dmodes;
-    unsigned *map;             /* per mode of s: its h's place in h, dh */
+    double *wt, *h, *dh;       /* per mode: its factor of the face's fixed parameter at the side; per
+                                * distinct h(w) of tab: h, h' */
+    wtable *tab;               /* s's distinct h(w) (fig. 2 and 4: 3 of 5), each evaluated once a point */
+    const unsigned *map;       /* per mode of s: its h's place in h, dh */
     unsigned char *slot;       /* per mode: 3 part + c, part 0 sin (A), 1 cos (B), 2 the factor 1 (D) */
     double kpi, tol[2];
     double dip, dip_at;        /* the least element over its largest at the points of w since reset, and where */
@@ -687,7 +684,7 @@ static void square(trig4 *q)
 static double section(harm_ctx *H, double w, trig4 *q)
 {
     double x[9] = { 0 }, d[9] = { 0 };   /* A, B, D and their w-derivatives, component c of part p at 3 p + c */
-    solution_factors(H->hs, 2, w, H->h, H->dh);
+    wtable_eval(H->tab, w, H->h, H->dh);
     for (size_t m = 0; m < H->nm; m++)
         x[H->slot[m]] += H->wt[m] * H->h[H->map[m]], d[H->slot[m]] += H->wt[m] * H->dh[H->map[m]];
     H->nodes++;
@@ -1274,7 +1271,7 @@ static void many_at_w(void *arg, double w, double *val)
     harm_ctx *H = arg;
     double *cf = H->cf;
     memset(cf, 0, 6 * (2 * (size_t)H->nh + 1) * sizeof *cf);
-    solution_factors(H->hs, 2, w, H->h, H->dh);
+    wtable_eval(H->tab, w, H->h, H->dh);
     for (size_t m = 0; m < H->nm; m++) {
         const int sl = H->mslot[m], at = 6 * (sl / 3) + sl % 3;
         cf[at] += H->wt[m] * H->h[H->map[m]], cf[at + 3] += H->wt[m] * H->dh[H->map[m]];
@@ -1398,9 +1395,8 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
     H.kpi = k * M_PI;
     H.wt = malloc(3 * H.nm * sizeof *H.wt);
     H.slot = malloc(H.nm);
-    H.dmodes = malloc(H.nm * sizeof *H.dmodes);
-    H.map = malloc(H.nm * sizeof *H.map);
-    int ok = H.wt && H.slot && H.dmodes && H.map && (!H.many || (!over && many_form(s, axis == 1, seen, &H)));
+    H.tab = wtable_new(s);
+    int ok = H.wt && H.slot && H.tab && (!H.many || (!over && many_form(s, axis == 1, seen, &H)));
     if (H.many)   /* no cuts of w at dips: least_at's one harmonic */
         H.splits = 0, H.poll_every = MANY_POLL, H.max_nodes = MANY_NODES;
     if (ok) {
@@ -1416,20 +1412,7 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
                     H.wt[m] = -H.wt[m];
                 H.slot[m] = (unsigned char)(3 * part + c);
             }
-        size_t nd = 0;
-        for (int c = 0, m = 0; c < 3; c++)
-            for (size_t i = 0; i < s->comp[c].nmodes; i++, m++) {
-                unsigned j = 0;
-                while (j < nd && !quad_same_h(&H.dmodes[j], &s->comp[c].modes[i]))
-                    j++;
-                if (j == nd)
-                    H.dmodes[nd++] = s->comp[c].modes[i];
-                H.map[m] = j;
-            }
-        H.distinct = *s;
-        H.distinct.comp[0].modes = H.dmodes, H.distinct.comp[0].nmodes = nd;
-        H.distinct.comp[1].nmodes = H.distinct.comp[2].nmodes = 0;
-        H.hs = &H.distinct;
+        H.map = H.tab->map;
         pthread_once(&trig_once, trig_init);
         H.tol[0] = o->tol, H.tol[1] = o->tol * o->size;
     }
@@ -1454,8 +1437,7 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
         ok = -1;
     free(H.wt);
     free(H.slot);
-    free(H.dmodes);
-    free(H.map);
+    wtable_free(H.tab);
     free(H.hj);
     free(H.mslot);
     free(H.cf);
