@@ -114,9 +114,13 @@ void factor_eval(pde_factor f, double t, double *val, double *der)
     *val = *der = 0.0;
 }
 
-/* P(w) and P'(w) by Horner. */
-static void horner2(const double *c, int deg, double w, double *p, double *dp)
+/* P(w) and P'(w) by Horner (a constant, fig. 2 and 4's every term of x and y, without the loop). */
+static inline void horner2(const double *c, int deg, double w, double *p, double *dp)
 {
+    if (deg == 0) {
+        *p = c[0], *dp = 0.0;
+        return;
+    }
     double v = c[deg], d = 0.0;
     for (int k = deg - 1; k >= 0; k--) {
         d = d * w + v;

@@ -76,6 +76,10 @@
 
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
+/* cos 2 theta_i, sin 2 theta_i, cos 4 theta_i, sin 4 theta_i, i < NT / 2, each a column in the order samples()
+ * takes them without odd harmonics (the first level's i, then each next level's new ones, ascending): a
+ * level's points two at a time lie side by side */
+static double etrig[4][NT / 2];
 /* cos alpha(beta_i), the trapezoidal rule's weight alpha'(beta_i) (half at the ends), 1 - cos alpha and
  * 1 + cos alpha (without cancellation), at beta_i = pi i / EV_N: [0] alpha = beta, [1] alpha = beta - sin(2 beta) / 2;
  * each a column, in the order even_mean takes the points (its first level's EV_N0 + 1, then each next level's
@@ -88,6 +92,9 @@ static void trig_init(void)
     for (int i = 0; i < NT; i++)
         for (int j = 1; j <= 4; j++)
             trig[i][j - 1] = cos(2.0 * M_PI * i * j / NT), trig[i][j + 3] = sin(2.0 * M_PI * i * j / NT);
+    for (int st = NT / N0, p = 0, first = 1; st >= 1; st /= 2, first = 0)
+        for (int i = first ? 0 : st; i < NT / 2; i += first ? st : 2 * st, p++)
+            etrig[0][p] = trig[i][1], etrig[1][p] = trig[i][5], etrig[2][p] = trig[i][3], etrig[3][p] = trig[i][7];
     for (int st = EV_N / EV_N0, p = 0, first = 1; st >= 1; st /= 2, first = 0)
         for (int i = first ? 0 : st; i <= EV_N; i += first ? st : 2 * st, p++) {
             const double b = M_PI * i / EV_N;
@@ -493,7 +500,7 @@ static inline void ev_pair(const ev_cut *c, const double (*tab)[EV_N + 2], int p
     v2d c0, wt, om, op;
     memcpy(&c0, &tab[0][p], sizeof c0), memcpy(&wt, &tab[1][p], sizeof wt);
     memcpy(&om, &tab[2][p], sizeof om), memcpy(&op, &tab[3][p], sizeof op);
-    const v2d sgn = (v2d)(v2i){ (long long)1 << 63, (long long)1 << 63 }, half = { 0.5, 0.5 };
+    const v2d sgn = { -0.0, -0.0 }, half = { 0.5, 0.5 };   /* sgn: the sign bits */
     const v2d zr = c->Mr + c->Hr * c0, zi = c->Mi + c->Hi * c0;
     const v2d f1r = c->e1 + c->g1r * om, f1i = c->g1i * om, f2r = c->e2 + c->g2r * op, f2i = c->g2i * op;
     const v2d x = f1r * f2r - f1i * f2i, y = f1r * f2i + f1i * f2r, rw = v2_sqrt(x * x + y * y);
@@ -627,27 +634,47 @@ static int even_mean(const trig4 *q, const double *e, ev_hint *hint, double *mea
     return 0;
 }
 
+/* The element at theta_i, i = from, from + step, ... below per, into e[i], added to *sum in that order;
+ * *lo, *big the least and largest so far. Without odd harmonics two at a time (a lane each, q_at's
+ * operations: the same roundings). */
+static void samples(const trig4 *q, double *e, int from, int step, int per, double *sum, double *lo, double *big)
+{
+    int i = from;
+    double sm = *sum, l = *lo, bg = *big;   /* kept apart from e[] */
+    if (!q->odd) {
+        const v2d a0 = { q->a[0], q->a[0] }, a2 = { q->a[2], q->a[2] }, b2 = { q->b[2], q->b[2] },
+                  a4 = { q->a[4], q->a[4] }, b4 = { q->b[4], q->b[4] }, zero = { 0.0, 0.0 };
+        for (int at = from ? per / step : 0; i + step < per; i += 2 * step, at += 2) {   /* etrig's place of i */
+            v2d c2, s2, c4, s4;
+            memcpy(&c2, &etrig[0][at], sizeof c2), memcpy(&s2, &etrig[1][at], sizeof s2);
+            memcpy(&c4, &etrig[2][at], sizeof c4), memcpy(&s4, &etrig[3][at], sizeof s4);
+            const v2d p = a0 + (a2 * c2 + b2 * s2) + (a4 * c4 + b4 * s4), r = v2_select(p > zero, v2_sqrt(p), zero);
+            e[i] = r[0], e[i + step] = r[1];
+            for (int k = 0; k < 2; k++)
+                sm += r[k], l = r[k] < l ? r[k] : l, bg = r[k] > bg ? r[k] : bg;
+        }
+    }
+    for (; i < per; i += step) {
+        const double p = q_at(q, trig[i]);
+        sm += e[i] = p > 0.0 ? sqrt(p) : 0.0;
+        l = e[i] < l ? e[i] : l, bg = e[i] > bg ? e[i] : bg;
+    }
+    *sum = sm, *lo = l, *big = bg;
+}
+
 static double elem_mean(const harm_opts *o, const trig4 *q, ev_hint *hint, double *dip)
 {
     double ev = 0.0;
     const int per = q->odd ? NT : NT / 2;
     double e[NT], sum = 0.0, mean, lo = INFINITY, big = 0.0;
     int stride = NT / N0;
-    for (int i = 0; i < per; i += stride) {
-        const double p = q_at(q, trig[i]);
-        sum += e[i] = p > 0.0 ? sqrt(p) : 0.0;
-        lo = e[i] < lo ? e[i] : lo, big = e[i] > big ? e[i] : big;
-    }
+    samples(q, e, 0, stride, per, &sum, &lo, &big);
     mean = sum * stride / per;
     *dip = big > 0.0 ? lo / big : 1.0;
     int tried = 0;   /* even_mean failed on these samples (it would again: it reads only them) */
     while (stride > 1 && !(stride <= NT / 64 && *dip < DEEP && narrow(e, per, stride))) {
         const int half = stride / 2;
-        for (int i = half; i < per; i += stride) {
-            const double p = q_at(q, trig[i]);
-            sum += e[i] = p > 0.0 ? sqrt(p) : 0.0;
-            lo = e[i] < lo ? e[i] : lo, big = e[i] > big ? e[i] : big;
-        }
+        samples(q, e, half, stride, per, &sum, &lo, &big);
         stride = half;
         const double next = sum * stride / per;
         *dip = big > 0.0 ? lo / big : 1.0;
