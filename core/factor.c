@@ -8,6 +8,7 @@
 #include <stdlib.h>
 
 #include "internal.h"
+#include "quad.h"   /* quad_same_h */
 
 /* n (n-1) ... (n-k+1) */
 static double falling(double n, int k)
@@ -211,24 +212,6 @@ static inline void mode_h_memo(const pde_mode *m, double w, wmemo *mc, double *h
     *dh = hd;
 }
 
-int mode_same_h(const pde_mode *a, const pde_mode *b)
-{
-    if (a->nterms != b->nterms || a->nslabs != b->nslabs)
-        return 0;
-    for (size_t k = 0; a->nslabs > 1 && k <= a->nslabs; k++)
-        if (a->breaks[k] != b->breaks[k] || a->first[k] != b->first[k])
-            return 0;
-    for (size_t k = 0; k < a->nterms; k++) {
-        const pde_wterm *x = &a->terms[k], *y = &b->terms[k];
-        if (x->alpha != y->alpha || x->beta != y->beta || x->shift != y->shift || x->deg != y->deg)
-            return 0;
-        for (int i = 0; i <= x->deg; i++)
-            if (x->A[i] != y->A[i] || x->B[i] != y->B[i])
-                return 0;
-    }
-    return 1;
-}
-
 size_t distinct_h(const pde_solution *s, const pde_mode **dm, unsigned *map)
 {
     size_t nd = 0, o = 0;
@@ -236,7 +219,7 @@ size_t distinct_h(const pde_solution *s, const pde_mode **dm, unsigned *map)
         for (size_t m = 0; m < s->comp[c].nmodes; m++, o++) {
             const pde_mode *md = &s->comp[c].modes[m];
             size_t i = 0;
-            while (i < nd && !mode_same_h(dm[i], md))
+            while (i < nd && !quad_same_h(dm[i], md))
                 i++;
             if (i == nd)
                 dm[nd++] = md;

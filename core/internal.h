@@ -164,10 +164,7 @@ void mode_h(const pde_mode *m, double w, double *h, double *dh);
  * w-term's exp and sincos computed once where modes share them. */
 void solution_factors(const pde_solution *s, int axis, double t, double *val, double *der);
 
-/* Non-zero where modes a and b have the same h(w): the same breaks and terms. */
-int mode_same_h(const pde_mode *a, const pde_mode *b);
-
-/* The distinct h(w) among s's modes (mode_same_h; fig. 2 and 4: 3 of 5): the first mode of each into
+/* The distinct h(w) among s's modes (quad.c's quad_same_h; fig. 2 and 4: 3 of 5): the first mode of each into
  * dm[], and each mode's (x's, y's, then z's) place among them into map[]; returns how many. dm and map
  * hold as many as s has modes. Cannot fail. */
 size_t distinct_h(const pde_solution *s, const pde_mode **dm, unsigned *map);
