@@ -5,8 +5,10 @@
  */
 #include <complex.h>
 #include <math.h>
+#include <stdlib.h>
 
 #include "internal.h"
+#include "quad.h"   /* quad_same_h */
 
 /* n (n-1) ... (n-k+1) */
 static double falling(double n, int k)
@@ -113,9 +115,13 @@ void factor_eval(pde_factor f, double t, double *val, double *der)
     *val = *der = 0.0;
 }
 
-/* P(w) and P'(w) by Horner. */
-static void horner2(const double *c, int deg, double w, double *p, double *dp)
+/* P(w) and P'(w) by Horner (a constant, fig. 2 and 4's every term of x and y, without the loop). */
+static inline void horner2(const double *c, int deg, double w, double *p, double *dp)
 {
+    if (deg == 0) {
+        *p = c[0], *dp = 0.0;
+        return;
+    }
     double v = c[deg], d = 0.0;
     for (int k = deg - 1; k >= 0; k--) {
         d = d * w + v;
@@ -169,6 +175,24 @@ static inline void memo_sincos(wmemo *mc, double beta, double w, double *c, doub
     mc->tb[i] = beta, mc->tc[i] = *c, mc->ts[i] = *s;
 }
 
+/* A term's value and w-derivative added to *hv, *hd, given E = exp(alpha (w - shift)) (1 where alpha
+ * = 0) and, where beta is not 0, c = cos(beta w), s = sin(beta w). */
+static inline void wterm_add(const pde_wterm *t, double w, double E, double c, double s, double *hv, double *hd)
+{
+    double a, da;
+    horner2(t->A, t->deg, w, &a, &da);
+    if (t->beta == 0.0) {
+        *hv += E * a;
+        *hd += E * (t->alpha * a + da);
+        return;
+    }
+    double b, db;
+    horner2(t->B, t->deg, w, &b, &db);
+    double v = a * c + b * s;
+    *hv += E * v;
+    *hd += E * (t->alpha * v + da * c + db * s + t->beta * (b * c - a * s));
+}
+
 /* mode_h, with the exps and sincos of mc (NULL: none kept). The library calls come first in a term,
  * so that fewer values live across them (and are spilled to memory). */
 static inline void mode_h_memo(const pde_mode *m, double w, wmemo *mc, double *h, double *dh)
@@ -179,23 +203,116 @@ static inline void mode_h_memo(const pde_mode *m, double w, wmemo *mc, double *h
     for (size_t k = k0; k < k1; k++) {
         const pde_wterm *t = &m->terms[k];
         const double E = memo_exp(mc, t, w);
-        double a, da;
-        if (t->beta == 0.0) {
-            horner2(t->A, t->deg, w, &a, &da);
-            hv += E * a;
-            hd += E * (t->alpha * a + da);
-        } else {
-            double b, db, c, s;
+        double c = 0.0, s = 0.0;
+        if (t->beta != 0.0)
             memo_sincos(mc, t->beta, w, &c, &s);
-            horner2(t->A, t->deg, w, &a, &da);
-            horner2(t->B, t->deg, w, &b, &db);
-            double v = a * c + b * s;
-            hv += E * v;
-            hd += E * (t->alpha * v + da * c + db * s + t->beta * (b * c - a * s));
-        }
+        wterm_add(t, w, E, c, s, &hv, &hd);
     }
     *h = hv;
     *dh = hd;
+}
+
+size_t distinct_h(const pde_solution *s, const pde_mode **dm, unsigned *map)
+{
+    size_t nd = 0, o = 0;
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes; m++, o++) {
+            const pde_mode *md = &s->comp[c].modes[m];
+            size_t i = 0;
+            while (i < nd && !quad_same_h(dm[i], md))
+                i++;
+            if (i == nd)
+                dm[nd++] = md;
+            map[o] = (unsigned)i;
+        }
+    return nd;
+}
+
+/* The index of v among vals[lo .. *n - 1] (pairs where two is set: vals[2 i], vals[2 i + 1]), added at
+ * *n where it is not there. */
+static unsigned wtab_slot(double *vals, int two, size_t lo, size_t *n, double v0, double v1)
+{
+    size_t i = lo;
+    while (i < *n && !(vals[two ? 2 * i : i] == v0 && (!two || vals[2 * i + 1] == v1)))
+        i++;
+    if (i == *n) {
+        if (two)
+            vals[2 * i] = v0, vals[2 * i + 1] = v1;
+        else
+            vals[i] = v0;
+        ++*n;
+    }
+    return (unsigned)i;
+}
+
+wtable *wtable_new(const pde_solution *s)
+{
+    size_t nm = 0, nt = 0;
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; m < s->comp[c].nmodes; m++, nm++)
+            nt += s->comp[c].modes[m].nterms;
+    size_t nslabs;
+    const double *breaks = solution_breaks(s, &nslabs);
+    /* one block: the struct, its doubles (ea: nt + 1 pairs, ev: nt + 1, bb: nt, cs: nt + 1 pairs), its
+     * pointers (dm), its unsigneds (toff, eoff, boff, ie, ib, map) */
+    const size_t ndbl = 2 * (nt + 1) + (nt + 1) + nt + 2 * (nt + 1), nuns = (nm + 1) + 2 * (nslabs + 1) + 2 * nt + nm;
+    wtable *t = calloc(1, sizeof *t + ndbl * sizeof(double) + nm * sizeof *t->dm + nuns * sizeof(unsigned));
+    if (!t)
+        return NULL;
+    double *p = (double *)(t + 1);
+    t->ea = p, p += 2 * (nt + 1);
+    t->ev = p, p += nt + 1;
+    t->bb = p, p += nt;
+    t->cs = p, p += 2 * (nt + 1);
+    t->dm = (const pde_mode **)p;
+    t->toff = (unsigned *)(t->dm + nm);
+    t->eoff = t->toff + nm + 1, t->boff = t->eoff + nslabs + 1;
+    t->ie = t->boff + nslabs + 1, t->ib = t->ie + nt, t->map = t->ib + nt;
+    t->nslabs = nslabs, t->breaks = breaks;
+    t->nd = distinct_h(s, t->dm, t->map);
+    for (size_t d = 0; d < t->nd; d++)
+        t->toff[d + 1] = t->toff[d] + (unsigned)t->dm[d]->nterms;
+    size_t ne = 1, nb = 0;   /* the exps' slot 0: alpha = 0, E = 1 */
+    t->ev[0] = 1.0;
+    for (size_t k = 0; k < nslabs; k++) {
+        t->eoff[k] = (unsigned)ne, t->boff[k] = (unsigned)nb;
+        for (size_t d = 0; d < t->nd; d++) {
+            const pde_mode *m = t->dm[d];
+            const size_t k0 = m->nslabs <= 1 ? 0 : m->first[k], k1 = m->nslabs <= 1 ? m->nterms : m->first[k + 1];
+            for (size_t i = k0; i < k1; i++) {
+                const pde_wterm *w = &m->terms[i];
+                t->ie[t->toff[d] + i] = w->alpha == 0.0 ? 0 : wtab_slot(t->ea, 1, t->eoff[k], &ne, w->alpha, w->shift);
+                t->ib[t->toff[d] + i] = w->beta == 0.0 ? 0 : wtab_slot(t->bb, 0, t->boff[k], &nb, w->beta, 0.0);
+            }
+        }
+    }
+    t->eoff[nslabs] = (unsigned)ne, t->boff[nslabs] = (unsigned)nb;
+    return t;
+}
+
+void wtable_free(wtable *t)
+{
+    free(t);
+}
+
+void wtable_eval(wtable *t, double w, double *h, double *dh)
+{
+    const size_t k = slab_index(t->breaks, t->nslabs, w);
+    for (size_t i = t->eoff[k]; i < t->eoff[k + 1]; i++)
+        t->ev[i] = exp(t->ea[2 * i] * (w - t->ea[2 * i + 1]));
+    for (size_t i = t->boff[k]; i < t->boff[k + 1]; i++) {
+        const double x = t->bb[i] * w;   /* loaded once: one sincos */
+        t->cs[2 * i] = cos(x), t->cs[2 * i + 1] = sin(x);
+    }
+    for (size_t d = 0; d < t->nd; d++) {
+        const pde_mode *m = t->dm[d];
+        const size_t k0 = m->nslabs <= 1 ? 0 : m->first[k], k1 = m->nslabs <= 1 ? m->nterms : m->first[k + 1];
+        const unsigned *ie = t->ie + t->toff[d], *ib = t->ib + t->toff[d];
+        double hv = 0.0, hd = 0.0;
+        for (size_t i = k0; i < k1; i++)
+            wterm_add(&m->terms[i], w, t->ev[ie[i]], t->cs[2 * ib[i]], t->cs[2 * ib[i] + 1], &hv, &hd);
+        h[d] = hv, dh[d] = hd;
+    }
 }
 
 void mode_h(const pde_mode *m, double w, double *h, double *dh)

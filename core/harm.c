@@ -22,9 +22,11 @@
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include "harm.h"
-#include "quad.h"
 
 #define NT 256          /* points of theta per 2 pi on the trapezoidal rule's finest level */
 #define N0 16           /* ... on its first */
@@ -74,9 +76,15 @@
 
 /* cos j theta_i, then sin j theta_i, j = 1..4, at theta_i = 2 pi i / NT */
 static double trig[NT][8];
+/* cos 2 theta_i, sin 2 theta_i, cos 4 theta_i, sin 4 theta_i, i < NT / 2, each a column in the order samples()
+ * takes them without odd harmonics (the first level's i, then each next level's new ones, ascending): a
+ * level's points two at a time lie side by side */
+static double etrig[4][NT / 2];
 /* cos alpha(beta_i), the trapezoidal rule's weight alpha'(beta_i) (half at the ends), 1 - cos alpha and
- * 1 + cos alpha (without cancellation), at beta_i = pi i / EV_N: [0] alpha = beta, [1] alpha = beta - sin(2 beta) / 2 */
-static double evt[2][EV_N + 1][4];
+ * 1 + cos alpha (without cancellation), at beta_i = pi i / EV_N: [0] alpha = beta, [1] alpha = beta - sin(2 beta) / 2;
+ * each a column, in the order even_mean takes the points (its first level's EV_N0 + 1, then each next level's
+ * new ones, i ascending), so that a level's points two at a time lie side by side (one more, unused, at the end) */
+static double evt[2][4][EV_N + 2];
 static pthread_once_t trig_once = PTHREAD_ONCE_INIT;
 
 static void trig_init(void)
@@ -84,14 +92,18 @@ static void trig_init(void)
     for (int i = 0; i < NT; i++)
         for (int j = 1; j <= 4; j++)
             trig[i][j - 1] = cos(2.0 * M_PI * i * j / NT), trig[i][j + 3] = sin(2.0 * M_PI * i * j / NT);
-    for (int i = 0; i <= EV_N; i++) {
-        const double b = M_PI * i / EV_N;
-        for (int m = 0; m < 2; m++) {
-            const double a = m ? b - 0.5 * sin(2.0 * b) : b, sa = sin(0.5 * a), ca = cos(0.5 * a);
-            evt[m][i][0] = cos(a), evt[m][i][2] = 2.0 * sa * sa, evt[m][i][3] = 2.0 * ca * ca;
-            evt[m][i][1] = m ? 2.0 * sin(b) * sin(b) : i == 0 || i == EV_N ? 0.5 : 1.0;
+    for (int st = NT / N0, p = 0, first = 1; st >= 1; st /= 2, first = 0)
+        for (int i = first ? 0 : st; i < NT / 2; i += first ? st : 2 * st, p++)
+            etrig[0][p] = trig[i][1], etrig[1][p] = trig[i][5], etrig[2][p] = trig[i][3], etrig[3][p] = trig[i][7];
+    for (int st = EV_N / EV_N0, p = 0, first = 1; st >= 1; st /= 2, first = 0)
+        for (int i = first ? 0 : st; i <= EV_N; i += first ? st : 2 * st, p++) {
+            const double b = M_PI * i / EV_N;
+            for (int m = 0; m < 2; m++) {
+                const double a = m ? b - 0.5 * sin(2.0 * b) : b, sa = sin(0.5 * a), ca = cos(0.5 * a);
+                evt[m][0][p] = cos(a), evt[m][2][p] = 2.0 * sa * sa, evt[m][3][p] = 2.0 * ca * ca;
+                evt[m][1][p] = m ? 2.0 * sin(b) * sin(b) : i == 0 || i == EV_N ? 0.5 : 1.0;
+            }
         }
-    }
 }
 
 /* x_t x x_w = v[0] + v[1] cos theta + v[2] sin theta + v[3] cos 2 theta + v[4] sin 2 theta, and its
@@ -111,12 +123,10 @@ typedef struct {
     const harm_opts *o;
     const pde_solution *s;
     size_t nm;
-    double *wt, *h, *dh;       /* per mode: its factor of the face's fixed parameter at the side; per mode
-                                * of hs: h, h' */
-    const pde_solution *hs;    /* the modes whose h(w) are evaluated: s's, or each distinct one once (distinct) */
-    pde_solution distinct;     /* its modes dmodes (quad_same_h; fig. 2 and 4: 3 of 5) */
-    pde_mode *dmodes;
-    unsigned *map;             /* per mode of s: its h's place in h, dh */
+    double *wt, *h, *dh;       /* per mode: its factor of the face's fixed parameter at the side; per
+                                * distinct h(w) of tab: h, h' */
+    wtable *tab;               /* s's distinct h(w) (fig. 2 and 4: 3 of 5), each evaluated once a point */
+    const unsigned *map;       /* per mode of s: its h's place in h, dh */
     unsigned char *slot;       /* per mode: 3 part + c, part 0 sin (A), 1 cos (B), 2 the factor 1 (D) */
     double kpi, tol[2];
     double dip, dip_at;        /* the least element over its largest at the points of w since reset, and where */
@@ -405,27 +415,34 @@ static void quartic_roots(double complex b, double complex c, double complex d, 
 }
 
 /* A root z of z^4 + b z^3 + c z^2 + d z + e polished by Newton while that lowers |f| (a root of a pair
- * about to coincide comes out to their separation's share of the rounding, all the factors need). */
-static double complex polish(double complex b, double complex c, double complex d, double complex e, double complex z)
+ * about to coincide comes out to their separation's share of the rounding, all the factors need);
+ * *settled (where not NULL) set where it stopped there (f = 0, or a step that did not lower it), so
+ * that polishing the root again would change nothing, clear where it stopped after 4 steps. */
+static double complex polish(double complex b, double complex c, double complex d, double complex e, double complex z,
+                             int *settled)
 {
     double complex f = (((z + b) * z + c) * z + d) * z + e;
-    for (int it = 0; it < 4 && f != 0.0; it++) {
+    int it = 0;
+    for (; it < 4 && f != 0.0; it++) {
         const double complex fp = ((4.0 * z + 3.0 * b) * z + 2.0 * c) * z + d, nz = z - f / fp,
                              nf = (((nz + b) * nz + c) * nz + d) * nz + e;
         if (!(norm2(nf) < norm2(f)))
             break;
         z = nz, f = nf;
     }
+    if (settled)
+        *settled = it < 4 || f == 0.0;
     return z;
 }
 
 /*
  * Two roots of z^4 + b z^3 + c z^2 + d z + e, not a root's mirror 1 / conj(z), into r[0], r[1], from
  * start[1] (the last section's root nearest the circle) by Newton, the other pair by deflation:
- * returns 0 where Newton does not converge in a few steps (Ferrari's formulas then).
+ * returns 0 where Newton does not converge in a few steps (Ferrari's formulas then). r[0] is polished,
+ * *settled as polish's.
  */
 static int deflated(double complex b, double complex c, double complex d, double complex e, const double complex *start,
-                    double complex *r)
+                    double complex *r, int *settled)
 {
     double complex z = start[1];
     for (int it = 0;; it++) {
@@ -437,13 +454,62 @@ static int deflated(double complex b, double complex c, double complex d, double
         if (!(norm2(dz) > 1e-24 * norm2(z)))
             break;
     }
-    z = polish(b, c, d, e, z);
+    z = polish(b, c, d, e, z, settled);
     /* z^4 + ... = (z^2 - sum z + prod) (z^2 + B z + C), sum and prod of z and 1 / conj(z) */
     const double complex zm = 1.0 / conj(z), sum = z + zm, prod = z * zm, B = b + sum, C = c + sum * B - prod;
     double complex y[2];
     quad_roots(B, C, y);
     r[0] = z, r[1] = norm2(y[0]) < norm2(y[1]) ? y[0] : y[1];
     return 1;
+}
+
+/* Two doubles, one per lane of the cut's rule (even_mean): its points two at a time, each lane's
+ * operations those of one point alone (the same roundings) */
+typedef double v2d __attribute__((vector_size(16)));
+typedef long long v2i __attribute__((vector_size(16)));
+
+static inline v2d v2_sqrt(v2d x)
+{
+#ifdef __SSE2__
+    return _mm_sqrt_pd(x);
+#else
+    return (v2d){ sqrt(x[0]), sqrt(x[1]) };
+#endif
+}
+
+/* m ? a : b lane by lane, m a comparison's lanes (all bits set or none) */
+static inline v2d v2_select(v2i m, v2d a, v2d b)
+{
+    return (v2d)(((v2i)a & m) | ((v2i)b & ~m));
+}
+
+/* The cut from z1 to z2 (even_mean): z = M + H cos alpha, w = (e1 + g1 (1 - cos alpha)) (e2 + g2 (1 + cos
+ * alpha)), each number in both lanes */
+typedef struct {
+    v2d Mr, Mi, Hr, Hi, g1r, g1i, g2r, g2i, e1, e2;
+} ev_cut;
+
+/*
+ * At the points p and p + 1 of the rule's table tab (evt's, a lane each): the rule's weight over
+ * sqrt(w), its real and imaginary parts, into v[0], v[1], times z into v[2], v[3] and times z^2 into
+ * v[4], v[5]. 1 / sqrt(w) = conj(sqrt(w)) / |w|, sqrt(w) without cancellation: with s = sqrt((|w| +
+ * |x|) / 2), sqrt(w) = s + i y / 2s where x = Re w >= 0, else y / 2s' + i s', s' = s with y's sign.
+ */
+static inline void ev_pair(const ev_cut *c, const double (*tab)[EV_N + 2], int p, v2d v[6])
+{
+    v2d c0, wt, om, op;
+    memcpy(&c0, &tab[0][p], sizeof c0), memcpy(&wt, &tab[1][p], sizeof wt);
+    memcpy(&om, &tab[2][p], sizeof om), memcpy(&op, &tab[3][p], sizeof op);
+    const v2d sgn = { -0.0, -0.0 }, half = { 0.5, 0.5 };   /* sgn: the sign bits */
+    const v2d zr = c->Mr + c->Hr * c0, zi = c->Mi + c->Hi * c0;
+    const v2d f1r = c->e1 + c->g1r * om, f1i = c->g1i * om, f2r = c->e2 + c->g2r * op, f2i = c->g2i * op;
+    const v2d x = f1r * f2r - f1i * f2i, y = f1r * f2i + f1i * f2r, rw = v2_sqrt(x * x + y * y);
+    const v2d ax = (v2d)((v2i)x & ~(v2i)sgn), s = v2_sqrt(half * (rw + ax));
+    const v2i pos = x >= (v2d){ 0.0, 0.0 };
+    const v2d den = v2_select(pos, s, (v2d)(((v2i)s & ~(v2i)sgn) | ((v2i)y & (v2i)sgn))), q = half * y / den;
+    const v2d a = v2_select(pos, s, q), b = v2_select(pos, q, den);
+    const v2d g = wt / rw, ur = a * g, ui = -b * g, vr = ur * zr - ui * zi, vi = ur * zi + ui * zr;
+    v[0] = ur, v[1] = ui, v[2] = vr, v[3] = vi, v[4] = vr * zr - vi * zi, v[5] = vr * zi + vi * zr;
 }
 
 /*
@@ -490,8 +556,9 @@ static int even_mean(const trig4 *q, const double *e, ev_hint *hint, double *mea
      * pair by deflation), else by Ferrari's formulas: either way checked by P~ - P */
     for (int warm = hint && hint->ok;; warm = 0) {
         double complex r[4];
-        if (!(warm && deflated(qb, qc, qd, qe, hint->z, r))) {
-            warm = 0;
+        int settled[2] = { 0, 0 };   /* polished already, to no further change */
+        if (!(warm && deflated(qb, qc, qd, qe, hint->z, r, &settled[0]))) {
+            warm = 0, settled[0] = 0;
             quartic_roots(qb, qc, qd, qe, r);
             for (int i = 1; i < 4; i++)   /* the two inside first */
                 for (int j = i; j > 0 && norm2(r[j]) < norm2(r[j - 1]); j--) {
@@ -501,7 +568,7 @@ static int even_mean(const trig4 *q, const double *e, ev_hint *hint, double *mea
         }
         /* the two inside, polished (a root's mirror 1 / conj(z) is one too) */
         for (int k = 0; k < 2; k++)
-            if (norm2(r[k] = polish(qb, qc, qd, qe, r[k])) > 1.0)
+            if (norm2(r[k] = settled[k] ? r[k] : polish(qb, qc, qd, qe, r[k], NULL)) > 1.0)
                 r[k] = 1.0 / conj(r[k]);
         z1 = norm2(r[0]) <= norm2(r[1]) ? r[0] : r[1], z2 = norm2(r[0]) <= norm2(r[1]) ? r[1] : r[0];
         /* The roots' P~ = K |z - z1|^2 |z - z2|^2 (C0 = K): its coefficients, p0 + dp0 and so on; P~ - P
@@ -532,24 +599,21 @@ static int even_mean(const trig4 *q, const double *e, ev_hint *hint, double *mea
     /* w = (1 - z conj(z1)) (1 - z conj(z2)), each factor from its end, z = z1 - H (1 - cos alpha) =
      * z2 + H (1 + cos alpha): e_k + ..., no cancellation where it is small (a root near the circle) */
     const double complex g1 = conj(z1) * H, g2 = -conj(z2) * H;
-    const double (*tab)[4] = evt[1.0 - mag(z2) < EV_MAP];
+    const double (*tab)[EV_N + 2] = evt[1.0 - mag(z2) < EV_MAP];
     const double Mr = creal(M), Mi = cimag(M), Hr = creal(H), Hi = cimag(H), g1r = creal(g1), g1i = cimag(g1),
                  g2r = creal(g2), g2i = cimag(g2);
+    const ev_cut cut = { { Mr, Mr }, { Mi, Mi }, { Hr, Hr }, { Hi, Hi }, { g1r, g1r }, { g1i, g1i }, { g2r, g2r },
+                         { g2i, g2i }, { e1, e1 }, { e2_, e2_ } };
     double s0r = 0.0, s0i = 0.0, s1r = 0.0, s1i = 0.0, s2r = 0.0, s2i = 0.0, prev = NAN;
-    for (int st = EV_N / EV_N0, first = 1; st >= 1; st /= 2, first = 0) {
-        for (int i = first ? 0 : st; i <= EV_N; i += first ? st : 2 * st) {
-            const double zr = Mr + Hr * tab[i][0], zi = Mi + Hi * tab[i][0];
-            const double f1r = e1 + g1r * tab[i][2], f1i = g1i * tab[i][2], f2r = e2_ + g2r * tab[i][3], f2i = g2i * tab[i][3];
-            const double x = f1r * f2r - f1i * f2i, y = f1r * f2i + f1i * f2r, rw = sqrt(x * x + y * y);
-            /* 1 / sqrt(w) = conj(sqrt(w)) / |w|, sqrt(w) without cancellation */
-            double a, b;
-            if (x >= 0.0)
-                a = sqrt(0.5 * (rw + x)), b = 0.5 * y / a;
-            else
-                b = copysign(sqrt(0.5 * (rw - x)), y), a = 0.5 * y / b;
-            const double g = tab[i][1] / rw, ur = a * g, ui = -b * g, vr = ur * zr - ui * zi, vi = ur * zi + ui * zr;
-            s0r += ur, s0i += ui, s1r += vr, s1i += vi, s2r += vr * zr - vi * zi, s2i += vr * zi + vi * zr;
+    for (int st = EV_N / EV_N0, p = 0; st >= 1; st /= 2) {
+        const int end = EV_N / st + 1;   /* the points up to this level */
+        for (; p < end; p += 2) {   /* the level's two at a time (the first's last alone) */
+            v2d v[6];
+            ev_pair(&cut, tab, p, v);
+            for (int l = 0; l < 1 + (p + 1 < end); l++)   /* added in the points' order, as one at a time */
+                s0r += v[0][l], s0i += v[1][l], s1r += v[2][l], s1i += v[3][l], s2r += v[4][l], s2i += v[5][l];
         }
+        p = end;
         const double complex S[3] = { s0r + I * s0i, s1r + I * s1i, s2r + I * s2i };
         const double f = 1.0 / ((double)(EV_N / st) * sqrt(K)), sg = s0r > 0.0 ? f : -f;
         const double complex m0 = sg * S[0], m1 = sg * S[1], m2 = sg * S[2];
@@ -570,27 +634,47 @@ static int even_mean(const trig4 *q, const double *e, ev_hint *hint, double *mea
     return 0;
 }
 
+/* The element at theta_i, i = from, from + step, ... below per, into e[i], added to *sum in that order;
+ * *lo, *big the least and largest so far. Without odd harmonics two at a time (a lane each, q_at's
+ * operations: the same roundings). */
+static void samples(const trig4 *q, double *e, int from, int step, int per, double *sum, double *lo, double *big)
+{
+    int i = from;
+    double sm = *sum, l = *lo, bg = *big;   /* kept apart from e[] */
+    if (!q->odd) {
+        const v2d a0 = { q->a[0], q->a[0] }, a2 = { q->a[2], q->a[2] }, b2 = { q->b[2], q->b[2] },
+                  a4 = { q->a[4], q->a[4] }, b4 = { q->b[4], q->b[4] }, zero = { 0.0, 0.0 };
+        for (int at = from ? per / step : 0; i + step < per; i += 2 * step, at += 2) {   /* etrig's place of i */
+            v2d c2, s2, c4, s4;
+            memcpy(&c2, &etrig[0][at], sizeof c2), memcpy(&s2, &etrig[1][at], sizeof s2);
+            memcpy(&c4, &etrig[2][at], sizeof c4), memcpy(&s4, &etrig[3][at], sizeof s4);
+            const v2d p = a0 + (a2 * c2 + b2 * s2) + (a4 * c4 + b4 * s4), r = v2_select(p > zero, v2_sqrt(p), zero);
+            e[i] = r[0], e[i + step] = r[1];
+            for (int k = 0; k < 2; k++)
+                sm += r[k], l = r[k] < l ? r[k] : l, bg = r[k] > bg ? r[k] : bg;
+        }
+    }
+    for (; i < per; i += step) {
+        const double p = q_at(q, trig[i]);
+        sm += e[i] = p > 0.0 ? sqrt(p) : 0.0;
+        l = e[i] < l ? e[i] : l, bg = e[i] > bg ? e[i] : bg;
+    }
+    *sum = sm, *lo = l, *big = bg;
+}
+
 static double elem_mean(const harm_opts *o, const trig4 *q, ev_hint *hint, double *dip)
 {
-    double ev;
+    double ev = 0.0;
     const int per = q->odd ? NT : NT / 2;
     double e[NT], sum = 0.0, mean, lo = INFINITY, big = 0.0;
     int stride = NT / N0;
-    for (int i = 0; i < per; i += stride) {
-        const double p = q_at(q, trig[i]);
-        sum += e[i] = p > 0.0 ? sqrt(p) : 0.0;
-        lo = e[i] < lo ? e[i] : lo, big = e[i] > big ? e[i] : big;
-    }
+    samples(q, e, 0, stride, per, &sum, &lo, &big);
     mean = sum * stride / per;
     *dip = big > 0.0 ? lo / big : 1.0;
     int tried = 0;   /* even_mean failed on these samples (it would again: it reads only them) */
     while (stride > 1 && !(stride <= NT / 64 && *dip < DEEP && narrow(e, per, stride))) {
         const int half = stride / 2;
-        for (int i = half; i < per; i += stride) {
-            const double p = q_at(q, trig[i]);
-            sum += e[i] = p > 0.0 ? sqrt(p) : 0.0;
-            lo = e[i] < lo ? e[i] : lo, big = e[i] > big ? e[i] : big;
-        }
+        samples(q, e, half, stride, per, &sum, &lo, &big);
         stride = half;
         const double next = sum * stride / per;
         *dip = big > 0.0 ? lo / big : 1.0;
@@ -687,7 +771,7 @@ static void square(trig4 *q)
 static double section(harm_ctx *H, double w, trig4 *q)
 {
     double x[9] = { 0 }, d[9] = { 0 };   /* A, B, D and their w-derivatives, component c of part p at 3 p + c */
-    solution_factors(H->hs, 2, w, H->h, H->dh);
+    wtable_eval(H->tab, w, H->h, H->dh);
     for (size_t m = 0; m < H->nm; m++)
         x[H->slot[m]] += H->wt[m] * H->h[H->map[m]], d[H->slot[m]] += H->wt[m] * H->dh[H->map[m]];
     H->nodes++;
@@ -1274,7 +1358,7 @@ static void many_at_w(void *arg, double w, double *val)
     harm_ctx *H = arg;
     double *cf = H->cf;
     memset(cf, 0, 6 * (2 * (size_t)H->nh + 1) * sizeof *cf);
-    solution_factors(H->hs, 2, w, H->h, H->dh);
+    wtable_eval(H->tab, w, H->h, H->dh);
     for (size_t m = 0; m < H->nm; m++) {
         const int sl = H->mslot[m], at = 6 * (sl / 3) + sl % 3;
         cf[at] += H->wt[m] * H->h[H->map[m]], cf[at + 3] += H->wt[m] * H->dh[H->map[m]];
@@ -1398,9 +1482,8 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
     H.kpi = k * M_PI;
     H.wt = malloc(3 * H.nm * sizeof *H.wt);
     H.slot = malloc(H.nm);
-    H.dmodes = malloc(H.nm * sizeof *H.dmodes);
-    H.map = malloc(H.nm * sizeof *H.map);
-    int ok = H.wt && H.slot && H.dmodes && H.map && (!H.many || (!over && many_form(s, axis == 1, seen, &H)));
+    H.tab = wtable_new(s);
+    int ok = H.wt && H.slot && H.tab && (!H.many || (!over && many_form(s, axis == 1, seen, &H)));
     if (H.many)   /* no cuts of w at dips: least_at's one harmonic */
         H.splits = 0, H.poll_every = MANY_POLL, H.max_nodes = MANY_NODES;
     if (ok) {
@@ -1416,20 +1499,7 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
                     H.wt[m] = -H.wt[m];
                 H.slot[m] = (unsigned char)(3 * part + c);
             }
-        size_t nd = 0;
-        for (int c = 0, m = 0; c < 3; c++)
-            for (size_t i = 0; i < s->comp[c].nmodes; i++, m++) {
-                unsigned j = 0;
-                while (j < nd && !quad_same_h(&H.dmodes[j], &s->comp[c].modes[i]))
-                    j++;
-                if (j == nd)
-                    H.dmodes[nd++] = s->comp[c].modes[i];
-                H.map[m] = j;
-            }
-        H.distinct = *s;
-        H.distinct.comp[0].modes = H.dmodes, H.distinct.comp[0].nmodes = nd;
-        H.distinct.comp[1].nmodes = H.distinct.comp[2].nmodes = 0;
-        H.hs = &H.distinct;
+        H.map = H.tab->map;
         pthread_once(&trig_once, trig_init);
         H.tol[0] = o->tol, H.tol[1] = o->tol * o->size;
     }
@@ -1454,8 +1524,7 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
         ok = -1;
     free(H.wt);
     free(H.slot);
-    free(H.dmodes);
-    free(H.map);
+    wtable_free(H.tab);
     free(H.hj);
     free(H.mslot);
     free(H.cf);

@@ -54,8 +54,22 @@ struct pde_solution {
     size_t cond_mode;
 };
 
-/* The terms of the slab of m that holds w: terms[*k0] .. terms[*k1 - 1] (pde.h: below 0 the first
- * slab, above 1 the last, at an interior break the slab on its right). */
+/* The slab of breaks[0 .. nslabs] that holds w (pde.h: below 0 the first slab, above 1 the last, at an
+ * interior break the slab on its right). */
+static inline size_t slab_index(const double *breaks, size_t nslabs, double w)
+{
+    size_t lo = 0, hi = nslabs - 1;     /* the last slab whose start is <= w */
+    while (lo < hi) {
+        size_t mid = (lo + hi + 1) / 2;
+        if (breaks[mid] <= w)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return lo;
+}
+
+/* The terms of the slab of m that holds w: terms[*k0] .. terms[*k1 - 1]. */
 static inline void mode_slab(const pde_mode *m, double w, size_t *k0, size_t *k1)
 {
     if (m->nslabs <= 1) {
@@ -63,14 +77,7 @@ static inline void mode_slab(const pde_mode *m, double w, size_t *k0, size_t *k1
         *k1 = m->nterms;
         return;
     }
-    size_t lo = 0, hi = m->nslabs - 1;     /* the last slab whose start is <= w */
-    while (lo < hi) {
-        size_t mid = (lo + hi + 1) / 2;
-        if (m->breaks[mid] <= w)
-            lo = mid;
-        else
-            hi = mid - 1;
-    }
+    const size_t lo = slab_index(m->breaks, m->nslabs, w);
     *k0 = m->first[lo];
     *k1 = m->first[lo + 1];
 }
@@ -156,6 +163,37 @@ void mode_h(const pde_mode *m, double w, double *h, double *dh);
  * y, z in order, into val[] and der[]: the values of factor_eval and mode_h, each factor and each
  * w-term's exp and sincos computed once where modes share them. */
 void solution_factors(const pde_solution *s, int axis, double t, double *val, double *der);
+
+/* The distinct h(w) among s's modes (quad.c's quad_same_h; fig. 2 and 4: 3 of 5): the first mode of each into
+ * dm[], and each mode's (x's, y's, then z's) place among them into map[]; returns how many. dm and map
+ * hold as many as s has modes. Cannot fail. */
+size_t distinct_h(const pde_solution *s, const pde_mode **dm, unsigned *map);
+
+/*
+ * The distinct h(w) of a solution, made to be evaluated together (wtable_eval): the distinct exps
+ * exp(alpha (w - shift)) and sincos of beta w of their terms, slab by slab, each term's place among
+ * them, so that a point of w takes each once and each term without a search (the values of mode_h,
+ * to the bit). Built by wtable_new (NULL when out of memory), freed by wtable_free (NULL: nothing).
+ * wtable_eval writes the table's scratch: one table per thread.
+ */
+typedef struct {
+    size_t nd;                  /* distinct h(w) */
+    const pde_mode **dm;        /* nd: the first mode of each */
+    unsigned *map;              /* per mode of the solution (x's, y's, then z's): its h's place */
+    size_t nslabs;
+    const double *breaks;
+    unsigned *eoff, *boff;      /* nslabs + 1: slab k's exps are ea[eoff[k] ..], its sincos bb[boff[k] ..] */
+    double *ea, *ev;            /* pairs alpha, shift; their exps at the current w (slot 0: alpha = 0, 1) */
+    double *bb, *cs;            /* beta; cos and sin of beta w at the current w */
+    unsigned *toff;             /* nd + 1: mode d's terms' places in ie, ib from toff[d] */
+    unsigned *ie, *ib;          /* per term: its exp's slot, and its sincos's (beta != 0) */
+} wtable;
+
+wtable *wtable_new(const pde_solution *s);
+void wtable_free(wtable *t);
+
+/* h and h' of each distinct h(w) at w, into h[0 .. nd - 1] and dh[]. */
+void wtable_eval(wtable *t, double w, double *h, double *dh);
 
 /* A sampling grid (pde.h). Modes that share their u-factor share a row of the
  * u table, so a point costs one multiply-add per distinct u-factor, not per
