@@ -1149,11 +1149,9 @@ typedef struct {
     double *mom1, *mom2;         /* mt, mt x mt */
     double *da, *ds, *dw;        /* det J's partials' coefficients at s0: F'_t F_s, F_t F'_s, F_t F_s */
     double *h, *dh;              /* mt: the current point's h, h' */
-    /* Each distinct h(w) once (quad_same_h; fig. 2 and 4: 3 of 5 modes, each of x's h again in y):
-     * the modes of `distinct`, its exps and sincos shared as in every solution_factors; mode o's h is
-     * its hd[map[o]]. distinct NULL where every mode's h is its own. */
-    const pde_solution *distinct;
-    const unsigned *map;
+    /* Each distinct h(w) once (wtable: fig. 2 and 4: 3 of 5 modes, each of x's h again in y); mode
+     * o's h is hd[tab->map[o]]. */
+    wtable *tab;
     double *hd, *dhd;
     /* The moments that are not 0, in free_point's order of (o, p): fig. 2 and 4's products of sin
      * and cos 2 pi v (half of them 0) add nothing, and skipping them leaves every sum as it was. */
@@ -1188,12 +1186,9 @@ static double free_point(free_ctx *f, double w, double m[Q_N])
             memcpy(m, f->memo_m[at], sizeof f->memo_m[at]);
         return f->memo_j[at];
     }
-    if (f->distinct) {
-        solution_factors(f->distinct, 2, w, f->hd, f->dhd);
-        for (size_t o = 0; o < f->mt; o++)
-            f->h[o] = f->hd[f->map[o]], f->dh[o] = f->dhd[f->map[o]];
-    } else
-        solution_factors(q->s, 2, w, f->h, f->dh);
+    wtable_eval(f->tab, w, f->hd, f->dhd);
+    for (size_t o = 0; o < f->mt; o++)
+        f->h[o] = f->hd[f->tab->map[o]], f->dh[o] = f->dhd[f->tab->map[o]];
     q->r.evals++;
     double d[3][3] = { { 0 } };
     for (size_t o = 0; o < f->mt; o++) {
@@ -1412,35 +1407,17 @@ static int free_solid(qctx *q, const qplan *p, const quad_sep *sp)
     int *comp = malloc(mt * sizeof *comp);
     free_term *terms = malloc((mt * mt + mt) * sizeof *terms);
     unsigned char *had = malloc(FREE_MEMO);
-    unsigned *map = malloc(mt * sizeof *map);
-    pde_mode *dmodes = malloc(mt * sizeof *dmodes);
-    if (!buf || !comp || !terms || !had || !map || !dmodes) {
+    wtable *tab = wtable_new(q->s);
+    if (!buf || !comp || !terms || !had || !tab) {
         free(buf);
         free(comp);
         free(terms);
         free(had);
-        free(map);
-        free(dmodes);
+        wtable_free(tab);
         return 0;
     }
     free_ctx f = { .q = q, .flat = flat, .free = sa, .mt = mt, .comp = comp, .terms = terms, .memo_had_m = had,
-                   .map = map };
-    size_t nd = 0;
-    for (int c = 0; c < 3; c++)
-        for (size_t m = 0; m < q->s->comp[c].nmodes; m++) {
-            const pde_mode *md = &q->s->comp[c].modes[m];
-            size_t i = 0;
-            while (i < nd && !quad_same_h(&dmodes[i], md))
-                i++;
-            if (i == nd)
-                dmodes[nd++] = *md;
-            map[q->off[c] + m] = (unsigned)i;
-        }
-    pde_solution distinct = *q->s;
-    distinct.comp[0].modes = dmodes, distinct.comp[0].nmodes = nd;
-    distinct.comp[1].nmodes = distinct.comp[2].nmodes = 0;
-    if (nd < mt)
-        f.distinct = &distinct;
+                   .tab = tab };
     f.mom2 = buf, f.mom1 = buf + mt * mt, f.da = f.mom1 + mt, f.ds = f.da + mt, f.dw = f.ds + mt;
     f.h = f.dw + mt, f.dh = f.h + mt;
     double *ft = f.dh + mt, *dft = ft + mt, *fs = dft + mt, *dfs = fs + mt, *abs2 = dfs + mt, *abs1 = abs2 + mt * mt;
@@ -1523,8 +1500,7 @@ static int free_solid(qctx *q, const qplan *p, const quad_sep *sp)
     free(comp);
     free(terms);
     free(had);
-    free(map);
-    free(dmodes);
+    wtable_free(tab);
     return 1;
 }
 
