@@ -916,11 +916,7 @@ static void props_should_match_the_reference_on_narrow_lobes_of_a_fold(void **st
         "\"dw0\": -0.961, \"w1\": 3.271, \"dw1\": -4.073}]}}",
     };
     for (size_t i = 0; i < sizeof models / sizeof *models; i++) {
-        api_error err;
-        api_model *m = api_model_parse(models[i], strlen(models[i]), &err);
-        assert_non_null(m);
-        pde_solution *sol = NULL;
-        assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
+        pde_solution *sol = solve_text(models[i]);
         ref_props_out r;
         assert_int_equal(ref_props(sol, &r), 0);
         assert_true(r.converged);
@@ -944,7 +940,6 @@ static void props_should_match_the_reference_on_narrow_lobes_of_a_fold(void **st
             assert_rel(p.surface_area, 12.85086719994838, 1e-9, 0);
         }
         pde_solution_free(sol);
-        api_model_free(m);
     }
 }
 
@@ -966,11 +961,7 @@ static void integrals_error_should_cover_what_the_general_path_misses_on_narrow_
         "\"w1\": 0.174}]}, \"force\": {\"x\": [{\"u\": {\"pow\": 1}, \"v\": {\"cos\": 6}, \"coef\": -81.0, \"w\": {\"sin\": 3}}], "
         "\"y\": [{\"u\": {\"pow\": 1}, \"v\": {\"sin\": 6}, \"coef\": -675.0, \"w\": {\"sin\": 3}}]}}";
     const double V = 209123.24086882;
-    api_error err;
-    api_model *m = api_model_parse(model, strlen(model), &err);
-    assert_non_null(m);
-    pde_solution *sol = NULL;
-    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
+    pde_solution *sol = solve_text(model);
     pde_props p;
     assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
     const double miss = fabs(p.volume - V) / V;
@@ -979,7 +970,6 @@ static void integrals_error_should_cover_what_the_general_path_misses_on_narrow_
     assert_true(miss <= p.integral_error);
     assert_true(p.integral_error <= 1e-7);
     pde_solution_free(sol);
-    api_model_free(m);
 }
 
 /*
@@ -1567,13 +1557,7 @@ static pde_solution *fig4a_with_p0(const char *p0)
 {
     char doc[128];
     snprintf(doc, sizeof doc, "{\"preset\":\"fig4a\",\"params\":{\"p0\":%s}}", p0);
-    api_error err;
-    api_model *m = api_model_parse(doc, strlen(doc), &err);
-    assert_non_null(m);
-    pde_solution *sol = NULL;
-    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
-    api_model_free(m);
-    return sol;
+    return solve_text(doc);
 }
 
 /* fig. 4a with p0 = 1e300 has x ~ 1e296 and det J beyond a double (NaN from its partials' products): its
@@ -2149,12 +2133,7 @@ static void a_dip_in_a_piece_shorter_than_an_ulp_should_end(void **state)
 {
     (void)state;
     static const char doc[] = "{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[0.02,0.003,1]},\"boundary\":{\"x\":[{\"w0\":1,\"dw0\":-20,\"w1\":0.01,\"dw1\":30,\"u\":{\"pow\":1},\"v\":{\"sin\":2}},{\"w0\":0.01,\"dw0\":40,\"w1\":2,\"dw1\":0,\"u\":{\"pow\":1},\"v\":{\"cos\":2}}],\"y\":[{\"w0\":0.3,\"dw0\":10,\"w1\":1,\"dw1\":-50,\"u\":{\"pow\":1},\"v\":{\"cos\":2}},{\"w0\":-1,\"dw0\":0,\"w1\":0.2,\"dw1\":9,\"u\":{\"pow\":1},\"v\":{\"sin\":2}}],\"z\":[{\"w0\":0,\"dw0\":-5,\"w1\":1,\"dw1\":30}]},\"force\":{\"x\":[{\"coef\":-50000,\"u\":{\"pow\":1},\"v\":{\"cos\":2},\"w\":{\"cos\":9}}],\"y\":[{\"coef\":30000,\"u\":{\"pow\":1},\"v\":{\"sin\":2},\"w\":{\"sin\":3}}]}}";
-    api_error err;
-    api_model *m = api_model_parse(doc, sizeof doc - 1, &err);
-    assert_non_null(m);
-    pde_solution *sol = NULL;
-    assert_int_equal(pde_solve(api_model_get(m), &sol, NULL), PDE_OK);
-    api_model_free(m);
+    pde_solution *sol = solve_text(doc);
     pde_props p;
     assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
     ref_props_out r;
