@@ -1166,6 +1166,11 @@ typedef struct {
      * by its coarse rule: its halves' brackets that hold one take it rather than search again. */
     double root[FREE_KNOWN], dip_at[FREE_KNOWN], dip_f[FREE_KNOWN];
     int nroot, ndip;
+    /* Moments about x0 where a component has a mode of w alone (factors 1: its term of x_c is h): its
+     * h less x0_c, before any product (a loft 3000 from the origin lost 5.6e-9 of its inertia to
+     * moments_about's cancellation after the sums); shift_o[c] = that mode, or -1. */
+    long shift_o[3];
+    double shift_x[3];
 } free_ctx;
 
 static unsigned free_slot(double w)
@@ -1199,6 +1204,9 @@ static double free_point(free_ctx *f, double w, double m[Q_N])
     f->memo_w[at] = w, f->memo_j[at] = j, f->memo_had_m[at] = m != NULL;
     if (!m)
         return j;
+    for (int c = 0; c < 3; c++)
+        if (f->shift_o[c] >= 0)
+            f->h[f->shift_o[c]] -= f->shift_x[c];
     for (int e = 0; e < Q_N; e++)
         m[e] = 0.0;
     m[Q_VOL] = 1.0;
@@ -1397,7 +1405,7 @@ static int lifted_mode(const qctx *q, const quad_sep *sp, int c, size_t o)
     return sp->lift[c] && mode_of_w(&q->s->comp[c].modes[o - q->off[c]]);
 }
 
-static int free_solid(qctx *q, const qplan *p, const quad_sep *sp)
+static int free_solid(qctx *q, const qplan *p, const quad_sep *sp, const double x0[3], int shifted[3])
 {
     const int flat = sp->axis, sa = sp->free;
     const size_t mt = q->mt;
@@ -1418,6 +1426,13 @@ static int free_solid(qctx *q, const qplan *p, const quad_sep *sp)
     }
     free_ctx f = { .q = q, .flat = flat, .free = sa, .mt = mt, .comp = comp, .terms = terms, .memo_had_m = had,
                    .tab = tab };
+    for (int c = 0; c < 3; c++) {
+        f.shift_o[c] = -1, f.shift_x[c] = x0[c];
+        for (size_t m = 0; m < q->s->comp[c].nmodes && f.shift_o[c] < 0; m++)
+            if (mode_of_w(&q->s->comp[c].modes[m]))
+                f.shift_o[c] = (long)(q->off[c] + m);
+        shifted[c] = f.shift_o[c] >= 0;
+    }
     f.mom2 = buf, f.mom1 = buf + mt * mt, f.da = f.mom1 + mt, f.ds = f.da + mt, f.dw = f.ds + mt;
     f.h = f.dw + mt, f.dh = f.h + mt;
     double *ft = f.dh + mt, *dft = ft + mt, *fs = dft + mt, *dfs = fs + mt, *abs2 = dfs + mt, *abs1 = abs2 + mt * mt;
@@ -1780,6 +1795,7 @@ static void separate_lifted(const pde_solution *s, int lift, quad_sep *sep)
 {
     sep->axis = -1;
     sep->free = -1;
+    sep->lift[0] = sep->lift[1] = sep->lift[2] = 0;
     for (int a = 0; a < 2; a++) {
         int n = 0, ok = 1;
         for (int c = 0; c < 3 && ok; c++) {
@@ -1804,8 +1820,10 @@ static void separate_lifted(const pde_solution *s, int lift, quad_sep *sep)
         if (ok && n > 0) {
             sep->axis = a, sep->n = n, sep->ns = sep->in[0] + sep->in[1] + sep->in[2];
             sep->free = separate_free(s, sep);
-            if ((sep->lift[0] || sep->lift[1] || sep->lift[2]) && sep->free < 0)
-                sep->axis = -1;
+            if ((sep->lift[0] || sep->lift[1] || sep->lift[2]) && sep->free < 0) {
+                separate_lifted(s, 0, sep);   /* without: another axis may separate (review: x ~ v, y ~ u + C) */
+                return;
+            }
             return;
         }
     }
@@ -2256,7 +2274,7 @@ static int lobe_planar(lobe_col *c, double w, double jtol)
         for (int cv = 0; cv < LOBE_COLS; cv++) {
             o.u = lobe_at[cu], o.v = lobe_at[cv];
             const double near = fmax(fabs(lobe_detj(&o, fmax(w - 1e-3, 0.0))), fabs(lobe_detj(&o, fmin(w + 1e-3, 1.0))));
-            if (fabs(lobe_detj(&o, w)) > fmax(1e-9 * near, jtol))
+            if (!(fabs(lobe_detj(&o, w)) <= fmax(1e-9 * near, jtol)))   /* NaN: not planar */
                 return c->evals += o.evals - c->evals, 0;
         }
     c->evals = o.evals;
@@ -2332,18 +2350,19 @@ static void lobe_edges(qctx *q, qplan *p)
     free(t);
     if (!na)
         return;
-    /* merged with the edges; a root within 1e-9 of an edge is that edge */
+    /* among the edges, which stay (a slab's break among them); a root within 1e-9 of one, or not finite
+     * (det J NaN), is dropped */
     double *e = p->edge[2];
-    for (int i = 0; i < na; i++)
-        e[np + 1 + i] = add[i];
-    int m = np + 1 + na;
+    int m = np + 1;
+    for (int i = 0; i < na; i++) {
+        int near = !(add[i] > 0.0 && add[i] < 1.0);
+        for (int k = 0; k < m && !near; k++)
+            near = fabs(add[i] - e[k]) <= 1e-9;
+        if (!near)
+            e[m++] = add[i];
+    }
     qsort(e, (size_t)m, sizeof *e, lobe_cmp);
-    int k = 0;
-    for (int i = 0; i < m; i++)
-        if (k == 0 || e[i] - e[k - 1] > 1e-9)
-            e[k++] = e[i];
-    e[k - 1] = 1.0;
-    p->np[2] = k - 1;
+    p->np[2] = m - 1;
 }
 
 static pde_status solid_run(const pde_solution *s, const double x0[3], double jscale, double vscale, int separate,
@@ -2416,7 +2435,8 @@ static pde_status solid_run(const pde_solution *s, const double x0[3], double js
      * or half-turn (param_symmetry) where the period is a whole number of panels; else, where the face
      * is integrated by rows (face_rows), a rotation (param_rotation), with the period's own panels. */
     /* G = g(w): 1-D along w over the whole face, no period needed */
-    const int one_d = q->free >= 0 && free_solid(q, &p, &sp);
+    int shifted[3] = { 0, 0, 0 };   /* components whose moments free_solid took about x0 */
+    const int one_d = q->free >= 0 && free_solid(q, &p, &sp, x0, shifted);
     if (lifted && !one_d) {   /* its memory: no other path takes a lifted component */
         qctx_free(q);
         return PDE_ERR_NOMEM;
@@ -2492,7 +2512,8 @@ static pde_status solid_run(const pde_solution *s, const double x0[3], double js
             q->r.refine_left *= sy.k * sy.half, q->r.refine_change *= sy.k * sy.half;
         }
         if (sp.axis >= 0)
-            separable_moments(&sp, x0, q->r.acc);
+            separable_moments(&sp, (const double[3]){ shifted[0] ? 0.0 : x0[0], shifted[1] ? 0.0 : x0[1],
+                                                      shifted[2] ? 0.0 : x0[2] }, q->r.acc);
         if (q->mid >= 0)   /* and rounding, of sums over 1e5 points and more */
             q->r.err += q->mid_err / fmax(fabs(q->r.acc[Q_VOL]), DBL_MIN) + 16 * DBL_EPSILON;
         else if (one_d)   /* rounding (a lifted loft's signed volume: 5.8 eps off, its rules' estimate 2.9) */
