@@ -2290,7 +2290,8 @@ static int lobe_known(const double *add, int na, double a, double b)
     return 0;
 }
 
-static int lobe_cmp(const void *a, const void *b)
+/* qsort's order of doubles (lobe_edges' edges, fold_row's roots) */
+static int double_cmp(const void *a, const void *b)
 {
     const double x = *(const double *)a, y = *(const double *)b;
     return (x > y) - (x < y);
@@ -2361,7 +2362,7 @@ static void lobe_edges(qctx *q, qplan *p)
         if (!near)
             e[m++] = add[i];
     }
-    qsort(e, (size_t)m, sizeof *e, lobe_cmp);
+    qsort(e, (size_t)m, sizeof *e, double_cmp);
     p->np[2] = m - 1;
 }
 
@@ -2624,12 +2625,6 @@ static double fold_dq(void *arg, double s)
     return P[0] * D[1] - P[1] * D[0];
 }
 
-static int fold_cmp(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* The integrand's basis at s: 1, P_x, P_y, P_x^2, P_y^2, P_x P_y, times Q, added with weight wt. */
 static void fold_add(double g[6], const double P[2], double qv, double wt)
 {
@@ -2724,7 +2719,7 @@ static int fold_row(fold_ctx *f, double w, double out[Q_N])
     if (nr) {
         for (int i = 0; i < nr; i++)
             f->roots[i] -= floor(f->roots[i]);
-        qsort(f->roots, (size_t)nr, sizeof *f->roots, fold_cmp);
+        qsort(f->roots, (size_t)nr, sizeof *f->roots, double_cmp);
         f->roots[nr] = f->roots[0] + 1.0;
         for (int i = 0; i < nr; i++) {
             const double a = f->roots[i], len = f->roots[i + 1] - a;
