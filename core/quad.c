@@ -2899,6 +2899,29 @@ static void fold_span(fold_ctx *f, fold_span_t sp, double acc[Q_N])
 }
 
 /*
+ * A model of the loft's form (below) that is not a loft takes these rows only where no other exact path
+ * does: the free path (G = g(w): fig. 2, 4, and a centre C(w) beside them, quad_sep's lift) and a
+ * period's rows (face_rows, where the solid repeats itself along v: fig. 3a, 3b, as exact and 1.6 to 2.7
+ * times cheaper there). Else its face went by 2-D boxes, whose outer rule converges slowly across the
+ * curves where Q's roots leave the rows (x = u (X1(w) cos 2 pi v + X2(w) sin 4 pi v), y = u Y(w) sin
+ * 2 pi v, z = Z(w) that folds: 2.5e-9 to 1.6e-7 off an independent quadrature with 6.8e-8 to 1.9e-7
+ * reported), and with a centre C(w) the general path's 3-D boxes (to 2.3e-7 off, 3.1e-6 reported);
+ * these rows: within 6e-13 (tests/test_props.c, loft_form_...).
+ */
+static int fold_direct(const pde_solution *s)
+{
+    quad_sep sp;
+    qsym sy;
+    int d[3], m[3];
+    separate_lifted(s, 1, &sp);
+    if (sp.axis >= 0 && sp.free >= 0)
+        return 0;
+    if (sp.axis >= 0 && (param_symmetry(s, 1, d, m) > 1 || param_rotation(s, 1, &sy)))
+        return 0;
+    return 1;
+}
+
+/*
  * The loft's form above, or 0: every mode's factor along u is 1 or t^n (one n >= 1), along v 1 or a
  * whole harmonic of 2 pi v (at most FOLD_K); a mode with the factor 1 along u has 1 along v (the
  * centre C); z has no mode with t^n. Then the integrals into out, 1.
@@ -2908,7 +2931,7 @@ static int fold_solid(const pde_solution *s, const double x0[3], double vscale, 
 {
     double n = 0.0;
     int K = 0;
-    if (!s->nsections)   /* the paper's figures keep their paths (fig. 3a, 4a: as exact, and faster) */
+    if (!s->nsections && !fold_direct(s))
         return 0;
     for (int c = 0; c < 3; c++)
         for (size_t m = 0; m < s->comp[c].nmodes; m++) {

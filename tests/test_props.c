@@ -1030,6 +1030,55 @@ static void free_integrals_should_not_depend_on_where_the_solid_sits_nor_lift_hi
 }
 
 /*
+ * A model of a loft's form, x = C(w) + u P(v, w) with P's factors whole harmonics of 2 pi v (here cos 2 pi v
+ * and sin 4 pi v: no constant Wronskian, so G is not g(w)), z = Z(w), that folds along curves of (v, w) and
+ * does not repeat itself along v: its face u = 1 went by 2-D boxes (2.5e-9 off the reference with
+ * 1.9e-7 reported), and with a centre C(w) by the general path's 3-D boxes (1.6e-7 off, 2.7e-6
+ * reported). det J = u Z'(w) (P_x P_y,v - P_y P_x,v) does not depend on C: the volume, signed volume and
+ * the centroid's z must not either. core/quad.c's fold_direct: the loft's root-split rows.
+ */
+static void loft_form_models_should_take_root_split_rows(void **state)
+{
+    (void)state;
+    static const char *const model[2] = {
+        "{\"pde\": {\"a\": [1.3, 1.3, 1.3], \"b\": [1.1, 1.1, 1.1], \"c\": [-10, -10, -10.5]}, \"boundary\": {\"x\": "
+        "[{\"u\": {\"pow\": 1}, \"v\": {\"cos\": 2}, \"w0\": 0.9, \"dw0\": 0.7, \"w1\": 0.5, \"dw1\": -2.5}, {\"u\": "
+        "{\"pow\": 1}, \"v\": {\"sin\": 4}, \"w0\": 1.8, \"dw0\": -2.4, \"w1\": 1.2, \"dw1\": 9.0}], \"y\": [{\"u\": "
+        "{\"pow\": 1}, \"v\": {\"sin\": 2}, \"w0\": 0.9, \"dw0\": 2.7, \"w1\": 0.5, \"dw1\": 1.5}], \"z\": [{\"w0\": 0.1, "
+        "\"dw0\": 1.2, \"w1\": 3.0, \"dw1\": 5.0}]}, \"force\": {\"x\": [{\"u\": {\"pow\": 1}, \"v\": {\"cos\": 2}, "
+        "\"coef\": 400.0, \"w\": {\"sin\": 3}}], \"y\": [{\"u\": {\"pow\": 1}, \"v\": {\"sin\": 2}, \"coef\": -600.0, "
+        "\"w\": {\"sin\": 3}}]}}",
+        /* the same with a centre x = 1000 + C(w) */
+        "{\"pde\": {\"a\": [1.3, 1.3, 1.3], \"b\": [1.1, 1.1, 1.1], \"c\": [-10, -10, -10.5]}, \"boundary\": {\"x\": "
+        "[{\"u\": {\"pow\": 1}, \"v\": {\"cos\": 2}, \"w0\": 0.9, \"dw0\": 0.7, \"w1\": 0.5, \"dw1\": -2.5}, {\"u\": "
+        "{\"pow\": 1}, \"v\": {\"sin\": 4}, \"w0\": 1.8, \"dw0\": -2.4, \"w1\": 1.2, \"dw1\": 9.0}, {\"w0\": 1000.0, "
+        "\"w1\": 1000.0, \"dw1\": 1.0}], \"y\": [{\"u\": {\"pow\": 1}, \"v\": {\"sin\": 2}, \"w0\": 0.9, \"dw0\": 2.7, "
+        "\"w1\": 0.5, \"dw1\": 1.5}], \"z\": [{\"w0\": 0.1, \"dw0\": 1.2, \"w1\": 3.0, \"dw1\": 5.0}]}, \"force\": {\"x\": "
+        "[{\"u\": {\"pow\": 1}, \"v\": {\"cos\": 2}, \"coef\": 400.0, \"w\": {\"sin\": 3}}], \"y\": [{\"u\": {\"pow\": 1}, "
+        "\"v\": {\"sin\": 2}, \"coef\": -600.0, \"w\": {\"sin\": 3}}]}}",
+    };
+    pde_props p[2];
+    for (int i = 0; i < 2; i++) {
+        pde_solution *sol = solve_text(model[i]);
+        assert_int_equal(pde_properties(sol, NULL, &p[i]), PDE_OK);
+        if (i == 1) {
+            ref_props_out r;
+            assert_int_equal(ref_props(sol, &r), 0);
+            assert_true(r.converged);
+            assert_true(r.volume - fabs(r.signed_volume) > 1e-3 * r.volume);   /* it folds */
+            expect_props_match_reference("loft form with a centre", &p[i], &r);
+        }
+        pde_solution_free(sol);
+    }
+    print_message("volume %.16g and %.16g, integrals error %.3g and %.3g\n", p[0].volume, p[1].volume,
+                  p[0].integral_error, p[1].integral_error);
+    assert_rel(p[0].volume, p[1].volume, 1e-13, 0);
+    assert_rel(p[0].signed_volume, p[1].signed_volume, 1e-13, 0);
+    assert_rel(p[0].centroid[2], p[1].centroid[2], 1e-13, 0);
+    assert_true(p[0].integral_error <= 1e-12);
+}
+
+/*
  * The signed volume by the divergence theorem, (1/3) of the flux of x through the six faces, with a
  * composite 8-point Gauss-Legendre rule of `panels` panels per face axis: independent of core/quad.c.
  */
@@ -2430,6 +2479,7 @@ int main(void)
         cmocka_unit_test(props_should_match_the_reference_on_narrow_lobes_of_a_fold),
         cmocka_unit_test(integrals_error_should_cover_what_the_general_path_misses_on_narrow_lobes),
         cmocka_unit_test(free_integrals_should_not_depend_on_where_the_solid_sits_nor_lift_hide_an_axis),
+        cmocka_unit_test(loft_form_models_should_take_root_split_rows),
         cmocka_unit_test(props_beyond_the_work_bound_should_report_an_error_that_covers_what_they_are_off_by),
         cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_every_preset),
         cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_stress_models),
