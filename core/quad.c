@@ -106,8 +106,8 @@
  * was 1.7e-10 off an independent quadrature, 1.2e-11 now). */
 #define ALONG_MIN_DEPTH 3
 #define ALONG_NEAR 0.01       /* ... and refined where |det J| at a line's end comes near 0 (ends_clear) */
-/* ... converging at least by ALONG_RHO each halving (solid_run's estimate) */
-#define ALONG_RHO 0.125
+/* ... converging at least by ALONG_RHO each halving (solid_run's estimate: a kink |s| of the lines' integrals) */
+#define ALONG_RHO 0.25
 #define SEG_MEMO 128          /* segments of w remembered by free_panel */
 #define ROW_DEPTH 12          /* halvings of a row of the face along w (row_refine), at most */
 #define ROW_DEPTH_MAX 40      /* ... and of its spans between the points where a line's signature changes */
@@ -2297,6 +2297,53 @@ static int double_cmp(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/*
+ * The faces u, v = 0, 1. A line along t (u or v) is integrated exactly between its located roots, and
+ * across lines its integral is smooth but where a root of det J leaves the line through an end: at
+ * t = 0, where det J's lowest term in t vanishes, or at t = 1, where det J does: the line integrals go
+ * as s |s| there (a jump of their second derivative), which the boxes' halvings in the two other axes
+ * converge to slowly, and which a box whose lines all have one root takes for smooth. Where that zero
+ * set is a plane w = const (det J = x_v(v, w) (u P(w) - Q(w)): at Q = 0 and P = Q), it becomes an edge
+ * of w, and every box keeps it at a face. The review's x = v X(w) + v^2 X2(w), y = u A(w) + C(w), z = u
+ * B(w) (tests/test_props.c): 4.2e-9 off with 5.3e-11 reported, and halving deeper changed nothing; now
+ * 5e-15 off. Each face t = 0 is sampled at t = 2^-40 (det J's lowest term where det J is 0 at t = 0:
+ * its root within ~1e-12 of the plane), along w at the plan's nodes on LOBE_COLS columns of the face's
+ * other parameter; a root on one is kept where every column's |det J| there is below 1e-6 of its own at
+ * w +- 1e-3 (a plane to ~1e-9 in w). Returns na.
+ */
+#define END_T 0x1p-40
+
+static int end_planes(lobe_col *c, const double *t, double *f, int ns, double *add, int na, int max)
+{
+    for (int a = 0; a < 2; a++)
+        for (int e = 0; e < 2; e++)
+            for (int col = 0; col < LOBE_COLS && na < max; col++) {
+                double *at = a == 0 ? &c->u : &c->v, *other = a == 0 ? &c->v : &c->u;
+                *at = e ? 1.0 : END_T, *other = lobe_at[col];
+                double top = 0.0;
+                for (int k = 0; k < ns; k++)
+                    f[k] = lobe_detj(c, t[k]), top = fmax(top, fabs(f[k]));
+                const double zero = 1e-13 * top;
+                for (int k = 0; k + 1 < ns && na < max; k++) {
+                    if ((f[k] < 0) == (f[k + 1] < 0) || fabs(f[k]) <= zero || fabs(f[k + 1]) <= zero ||
+                        lobe_known(add, na, t[k], t[k + 1]))
+                        continue;
+                    const double r = illinois(lobe_detj, c, t[k], t[k + 1], f[k], f[k + 1]);
+                    int planar = 1;
+                    for (int o = 0; o < LOBE_COLS && planar; o++) {
+                        *other = lobe_at[o];
+                        const double near =
+                            fmax(fabs(lobe_detj(c, fmax(r - 1e-3, 0.0))), fabs(lobe_detj(c, fmin(r + 1e-3, 1.0))));
+                        planar = fabs(lobe_detj(c, r)) <= 1e-6 * near;   /* NaN: not planar */
+                    }
+                    *other = lobe_at[col];
+                    if (planar)
+                        add[na++] = r;
+                }
+            }
+    return na;
+}
+
 /* The lobes' roots into p's edges along w, MAX_EDGES at most. */
 static void lobe_edges(qctx *q, qplan *p)
 {
@@ -2347,6 +2394,7 @@ static void lobe_edges(qctx *q, qplan *p)
                 add[na++] = illinois(lobe_detj, &c, x, t[b], c.sign * fx, f[b]);
             }
         }
+    na = end_planes(&c, t, f, ns, add, na, MAX_EDGES - np);
     q->r.evals += c.evals;
     free(t);
     if (!na)
@@ -2496,7 +2544,10 @@ static pde_status solid_run(const pde_solution *s, const double x0[3], double js
      * rho) of what it changed, not all of it. The lines are exact, and what is left is the 2-D rule
      * across the curves where a root of det J leaves the lines, kinks like s |s| at worst (a jump of
      * the second derivative), where a box's error falls as h^4 and the boxes on a curve double: rho
-     * 1/8 at best, taken no smaller. Where rho is above 1/2, or the work's bound stopped the
+     * 1/8 at best; but where det J vanishes on whole lines along a curve (det J = x_v(v, w) (u P(w) -
+     * Q(w)) at x_v = 0), a kink |s|: rho 1/4, taken no smaller (s1_026zu in tests/test_props.c, its
+     * boxes cut at the plane of its lines' ends (end_planes): 1.5e-8 off with 1.17e-8 reported at
+     * 1/8, 2.0e-8 at 1/4; fig. 3c and 3d, rho above 1/4, unchanged). Where rho is above 1/2, or the work's bound stopped the
      * halvings, what they changed stands. Only boxes whose halving still changed count, not those
      * whose quarters were all smooth (a lower rho). Fig. 3c: 2.3e-9 reported where it was 4e-11 off
      * an independent quadrature; rho 0.29: now 9.1e-10, and 2e-12 off; fig. 3d: 3.3e-10 where
@@ -2906,13 +2957,22 @@ static void fold_span(fold_ctx *f, fold_span_t sp, double acc[Q_N])
  * curves where Q's roots leave the rows (x = u (X1(w) cos 2 pi v + X2(w) sin 4 pi v), y = u Y(w) sin
  * 2 pi v, z = Z(w) that folds: 2.5e-9 to 1.6e-7 off an independent quadrature with 6.8e-8 to 1.9e-7
  * reported), and with a centre C(w) the general path's 3-D boxes (to 2.3e-7 off, 3.1e-6 reported);
- * these rows: within 6e-13 (tests/test_props.c, loft_form_...).
+ * these rows: within 6e-13 (tests/test_props.c, loft_form_...). Only up to FOLD_DIRECT_K harmonics:
+ * past the work's bound the rows' error counts only the lobes of the spans left unresolved, which
+ * misses what boundary layers leave (tests/test_props_loft.c's tubes of harmonics 96 to 100, z = w,
+ * signed volume 6.4e-2 off with 1.3e-6 reported at c = 1e-8, 1e-6 off with 1e-9 at c = 1, where the
+ * general path reports honestly; lofts still take them so).
  */
+#define FOLD_DIRECT_K 8
 static int fold_direct(const pde_solution *s)
 {
     quad_sep sp;
     qsym sy;
     int d[3], m[3];
+    for (int c = 0; c < 3; c++)
+        for (size_t i = 0; i < s->comp[c].nmodes; i++)
+            if (harmonic(s->comp[c].modes[i].v) > 2 * FOLD_DIRECT_K)
+                return 0;
     separate_lifted(s, 1, &sp);
     if (sp.axis >= 0 && sp.free >= 0)
         return 0;
