@@ -946,17 +946,22 @@ static void mean_at(harm_ctx *H, const wmap *sq, double x, double *val)
         val[k] *= 2.0 * fabs(sq->d) * x;
 }
 
-/* The Gauss rule over [a, b] (of w, or of s where sq is not NULL) into p */
+/* The Gauss rule over [a, b] (of w, or of s where sq is not NULL) into p. The rules take their points in
+ * order along w, the Kronrod rule's back from where the Gauss rule's ended, and add them in their own
+ * order: even_mean starts from the last section's roots, now the nearest (fig. 4a 1.610 -> 1.586 M
+ * instructions, 4s 4.079 -> 4.007 M; areas within 2e-16). */
 static void rule_w(harm_ctx *H, const wmap *sq, double a, double b, wpanel *p)
 {
     const double c = 0.5 * (a + b), h = 0.5 * (b - a);
     p->sum[0] = p->sum[1] = 0.0;
+    for (int j = 0; j < 10; j++) {   /* ascending */
+        const int sd = j >= 5, i = sd ? 9 - j : j;
+        mean_at(H, sq, c + (sd ? h : -h) * xgk[2 * i + 1], p->f[i][sd]);
+    }
     for (int i = 0; i < 5; i++)
-        for (int sd = 0; sd < 2; sd++) {
-            mean_at(H, sq, c + (sd ? h : -h) * xgk[2 * i + 1], p->f[i][sd]);
+        for (int sd = 0; sd < 2; sd++)
             for (int k = 0; k < 2; k++)
                 p->sum[k] += wg[i] * p->f[i][sd][k];
-        }
     for (int k = 0; k < 2; k++)
         p->sum[k] *= h;
 }
@@ -966,16 +971,19 @@ static void rule_w(harm_ctx *H, const wmap *sq, double a, double b, wpanel *p)
 static void kronrod_w(harm_ctx *H, const wmap *sq, double a, double b, const wpanel *p, double kv[11][2], double *K)
 {
     const double c = 0.5 * (a + b), h = 0.5 * (b - a);
-    mean_at(H, sq, c, kv[10]);
+    for (int j = 10; j >= 0; j--) {   /* descending, from where the Gauss rule ended */
+        const int sd = j > 5, i = sd ? 10 - j : j;
+        if (j == 5)
+            mean_at(H, sq, c, kv[10]);
+        else
+            mean_at(H, sq, c + (sd ? h : -h) * xgk[2 * i], kv[2 * i + sd]);
+    }
     for (int k = 0; k < 2; k++)
         K[k] = wgk[10] * kv[10][k];
-    for (int i = 0; i < 5; i++) {
-        for (int sd = 0; sd < 2; sd++) {
-            mean_at(H, sq, c + (sd ? h : -h) * xgk[2 * i], kv[2 * i + sd]);
+    for (int i = 0; i < 5; i++)
+        for (int sd = 0; sd < 2; sd++)
             for (int k = 0; k < 2; k++)
                 K[k] += wgk[2 * i] * kv[2 * i + sd][k] + wgk[2 * i + 1] * p->f[i][sd][k];
-        }
-    }
     for (int k = 0; k < 2; k++)
         K[k] *= h;
 }
@@ -984,19 +992,21 @@ static void kronrod_w(harm_ctx *H, const wmap *sq, double a, double b, const wpa
 static void patterson_w(harm_ctx *H, const wmap *sq, double a, double b, const wpanel *p, double kv[11][2], double *P)
 {
     const double c = 0.5 * (a + b), h = 0.5 * (b - a);
-    double v[2];
     for (int k = 0; k < 2; k++)
         P[k] = wpk[10] * kv[10][k];
     for (int i = 0; i < 5; i++)   /* the Kronrod rule's points */
         for (int sd = 0; sd < 2; sd++)
             for (int k = 0; k < 2; k++)
                 P[k] += wpk[2 * i] * kv[2 * i + sd][k] + wpk[2 * i + 1] * p->f[i][sd][k];
-    for (int i = 0; i < 11; i++)   /* and its own */
-        for (int sd = 0; sd < 2; sd++) {
-            mean_at(H, sq, c + (sd ? h : -h) * xp[i], v);
+    double pv[11][2][2];
+    for (int j = 0; j < 22; j++) {   /* its own, ascending */
+        const int sd = j >= 11, i = sd ? 21 - j : j;
+        mean_at(H, sq, c + (sd ? h : -h) * xp[i], pv[i][sd]);
+    }
+    for (int i = 0; i < 11; i++)
+        for (int sd = 0; sd < 2; sd++)
             for (int k = 0; k < 2; k++)
-                P[k] += wpn[i] * v[k];
-        }
+                P[k] += wpn[i] * pv[i][sd][k];
     for (int k = 0; k < 2; k++)
         P[k] *= h;
 }
