@@ -831,7 +831,7 @@ static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int dep
 {
     const int saved_n[3] = { q->n[0], q->n[1], q->n[2] };
     pbox sub[8];
-    int definite[8], axis[8], nsub[8][3], smooth[8];
+    int definite[8], axis[8], nsub[8][3], smooth[8], used[8] = { 0 };
     double part[8][Q_N], fine[Q_N] = { 0 };
     for (int s = 0; s < 8; s++) {
         sub[s] = *b;
@@ -840,6 +840,7 @@ static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int dep
         const int keep = q->flat >= 0 ? q->flat : q->along;   /* an axis not split */
         if (keep >= 0 && (s >> keep & 1))
             continue;
+        used[s] = 1;
         for (int a = 0; a < 3; a++) {
             if (a == keep) {
                 nsub[s][a] = q->n[a] = saved_n[a];
@@ -871,10 +872,19 @@ static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int dep
         return;
     }
     memset(out, 0, Q_N * sizeof *out);
+    /* Along a polynomial axis, quarters whose lines all keep one signature are smooth, but not always
+     * resolved: where the box's halving still changed and every quarter looks smooth, nothing tells the
+     * kink between them from a near singularity of the lines' integrals (det J = x_v (u P(w) - Q(w))
+     * where P and Q both nearly vanish: a box that changed by 8.2e-8 left 1.5e-7 off, unreported), so
+     * they are halved too. Not where only some quarters look smooth: their neighbours hold what
+     * changed (halving those too moved fig. 3d 5.7e-9 off, its work's bound spent on them). */
+    int all_smooth = q->along >= 0 && fabs(fine[Q_VOL] - coarse[Q_VOL]) > 1e-12 * q->vscale;
+    for (int s = 0; s < 8 && all_smooth; s++)
+        all_smooth = !used[s] || smooth[s];
     const double left = q->r.refine_left;
     for (int s = 0; s < 8; s++) {
         double o[Q_N];
-        if (smooth[s])
+        if (!used[s] || (smooth[s] && !all_smooth))
             memcpy(o, part[s], sizeof o);
         else {
             memcpy(q->n, nsub[s], sizeof q->n);
@@ -2290,6 +2300,65 @@ static int lobe_known(const double *add, int na, double a, double b)
     return 0;
 }
 
+/*
+ * The sign change of c's det J on [*a, *b] (values *fa, *fb) narrowed past the roots found already
+ * inside it: 0 where one of them is c's own (|det J| there below 1e-6 of the ends'), else 1 with the
+ * bracket between two of them, or one and an end, where the sign changes. Two planes in one interval
+ * of the samples (f058 of the review's family: Q = 0 and P = Q 3.2e-4 apart in w, the root crossing
+ * every line along u between them) are two edges, where lobe_known kept the first alone (3.7e-7 off
+ * with 2.9e-9 reported).
+ */
+static int lobe_bracket(lobe_col *c, const double *add, int na, double *a, double *fa, double *b, double *fb)
+{
+    const double zero = 1e-6 * fmax(fabs(*fa), fabs(*fb));
+    double lo = *a, flo = *fa;
+    for (;;) {
+        double e = *b;   /* the nearest known root above lo */
+        for (int i = 0; i < na; i++)
+            if (add[i] > lo && add[i] < e)
+                e = add[i];
+        if (e == *b)
+            break;
+        const double fe = lobe_detj(c, e);
+        if (!(fabs(fe) > zero))   /* c's own (NaN: as known) */
+            return 0;
+        if ((fe < 0) != (flo < 0)) {
+            *b = e, *fb = fe;
+            break;
+        }
+        lo = e, flo = fe;
+    }
+    *a = lo, *fa = flo;
+    return 1;
+}
+
+/*
+ * A lobe at the sample k of c's column (values f at t, ns of them, largest |f| top): where |f[k]| is a
+ * least of its neighbours' below half of top and above zero, and they keep its sign, Brent's search
+ * between them for a crossing of c->stop; found, its two roots into r. Returns 1 if found.
+ */
+static int lobe_dip(lobe_col *c, const double *t, const double *f, int ns, int k, double top, double zero,
+                    const double *add, int na, double r[2])
+{
+    const int a = k > 0 ? k - 1 : 0, b = k + 1 < ns ? k + 1 : ns - 1;
+    if (!(fabs(f[k]) <= fabs(f[a]) && fabs(f[k]) <= fabs(f[b]) && fabs(f[k]) < 0.5 * top) ||
+        fabs(f[k]) <= zero || (f[a] < 0) != (f[k] < 0) || (f[b] < 0) != (f[k] < 0) ||
+        lobe_known(add, na, t[a], t[b]))
+        return 0;
+    c->sign = f[k] < 0 ? -1.0 : 1.0;
+    const int end = a == k || b == k;   /* a least at w = 0 or 1: from the middle of its interval */
+    const double x0 = end ? 0.5 * (t[a] + t[b]) : t[k];
+    const brent_fn fn = { lobe_signed, lobe_crossed, c };
+    double fx;
+    const double x = brent_min(&fn, t[a], t[b], x0, end ? lobe_signed(c, x0) : c->sign * f[k],
+                               0.25e-9 * (t[b] - t[a]), 60, &fx);
+    if (!(fx < c->stop))
+        return 0;
+    r[0] = illinois(lobe_detj, c, t[a], x, f[a], c->sign * fx);
+    r[1] = illinois(lobe_detj, c, x, t[b], c->sign * fx, f[b]);
+    return 1;
+}
+
 /* qsort's order of doubles (lobe_edges' edges, fold_row's roots) */
 static int double_cmp(const void *a, const void *b)
 {
@@ -2313,6 +2382,19 @@ static int double_cmp(const void *a, const void *b)
  */
 #define END_T 0x1p-40
 
+/* c's det J vanishes at w on every column of its face (other: the column's parameter, back to col's) */
+static int end_planar(lobe_col *c, double *other, int col, double w)
+{
+    int planar = 1;
+    for (int o = 0; o < LOBE_COLS && planar; o++) {
+        *other = lobe_at[o];
+        const double near = fmax(fabs(lobe_detj(c, fmax(w - 1e-3, 0.0))), fabs(lobe_detj(c, fmin(w + 1e-3, 1.0))));
+        planar = fabs(lobe_detj(c, w)) <= 1e-6 * near;   /* NaN: not planar */
+    }
+    *other = lobe_at[col];
+    return planar;
+}
+
 static int end_planes(lobe_col *c, const double *t, double *f, int ns, double *add, int na, int max)
 {
     for (int a = 0; a < 2; a++)
@@ -2324,21 +2406,18 @@ static int end_planes(lobe_col *c, const double *t, double *f, int ns, double *a
                 for (int k = 0; k < ns; k++)
                     f[k] = lobe_detj(c, t[k]), top = fmax(top, fabs(f[k]));
                 const double zero = 1e-13 * top;
-                for (int k = 0; k + 1 < ns && na < max; k++) {
-                    if ((f[k] < 0) == (f[k + 1] < 0) || fabs(f[k]) <= zero || fabs(f[k + 1]) <= zero ||
-                        lobe_known(add, na, t[k], t[k + 1]))
-                        continue;
-                    const double r = illinois(lobe_detj, c, t[k], t[k + 1], f[k], f[k + 1]);
-                    int planar = 1;
-                    for (int o = 0; o < LOBE_COLS && planar; o++) {
-                        *other = lobe_at[o];
-                        const double near =
-                            fmax(fabs(lobe_detj(c, fmax(r - 1e-3, 0.0))), fabs(lobe_detj(c, fmin(r + 1e-3, 1.0))));
-                        planar = fabs(lobe_detj(c, r)) <= 1e-6 * near;   /* NaN: not planar */
-                    }
-                    *other = lobe_at[col];
-                    if (planar)
-                        add[na++] = r;
+                for (int k = 0; k < ns && na + 2 <= max; k++) {
+                    double r[2], lo = t[k], flo = f[k], hi = t[k + (k + 1 < ns)], fhi = f[k + (k + 1 < ns)];
+                    int nr = 0;
+                    if ((flo < 0) != (fhi < 0) && fabs(flo) > zero && fabs(fhi) > zero &&
+                        lobe_bracket(c, add, na, &lo, &flo, &hi, &fhi))
+                        r[nr++] = illinois(lobe_detj, c, lo, hi, flo, fhi);
+                    c->stop = -zero;   /* a pair through the face between two samples (f059: P = Q twice, 0.02 apart) */
+                    if (!nr && lobe_dip(c, t, f, ns, k, top, zero, add, na, r))
+                        nr = 2;
+                    for (int i = 0; i < nr; i++)
+                        if (end_planar(c, other, col, r[i]))
+                            add[na++] = r[i];
                 }
             }
     return na;
@@ -2368,31 +2447,16 @@ static void lobe_edges(qctx *q, qplan *p)
             for (int k = 0; k < ns; k++)
                 f[k] = lobe_detj(&c, t[k]), top = fmax(top, fabs(f[k]));
             for (int k = 0; k + 1 < ns && na + 1 <= MAX_EDGES - np; k++) {   /* roots seen, where planar */
-                if ((f[k] < 0) == (f[k + 1] < 0) || fabs(f[k]) <= q->jtol || fabs(f[k + 1]) <= q->jtol ||
-                    lobe_known(add, na, t[k], t[k + 1]))
+                double a = t[k], fa = f[k], b = t[k + 1], fb = f[k + 1];
+                if ((fa < 0) == (fb < 0) || fabs(fa) <= q->jtol || fabs(fb) <= q->jtol ||
+                    !lobe_bracket(&c, add, na, &a, &fa, &b, &fb))
                     continue;
-                const double r = illinois(lobe_detj, &c, t[k], t[k + 1], f[k], f[k + 1]);
+                const double r = illinois(lobe_detj, &c, a, b, fa, fb);
                 if (lobe_planar(&c, r, q->jtol))
                     add[na++] = r;
             }
-            for (int k = 0; k < ns && na + 2 <= MAX_EDGES - np; k++) {
-                const int a = k > 0 ? k - 1 : 0, b = k + 1 < ns ? k + 1 : ns - 1;
-                if (!(fabs(f[k]) <= fabs(f[a]) && fabs(f[k]) <= fabs(f[b]) && fabs(f[k]) < 0.5 * top) ||
-                    fabs(f[k]) <= q->jtol || (f[a] < 0) != (f[k] < 0) || (f[b] < 0) != (f[k] < 0) ||
-                    lobe_known(add, na, t[a], t[b]))
-                    continue;
-                c.sign = f[k] < 0 ? -1.0 : 1.0;
-                const int end = a == k || b == k;   /* a least at w = 0 or 1: from the middle of its interval */
-                const double x0 = end ? 0.5 * (t[a] + t[b]) : t[k];
-                const brent_fn fn = { lobe_signed, lobe_crossed, &c };
-                double fx;
-                const double x = brent_min(&fn, t[a], t[b], x0, end ? lobe_signed(&c, x0) : c.sign * f[k],
-                                           0.25e-9 * (t[b] - t[a]), 60, &fx);
-                if (!(fx < c.stop))
-                    continue;
-                add[na++] = illinois(lobe_detj, &c, t[a], x, f[a], c.sign * fx);
-                add[na++] = illinois(lobe_detj, &c, x, t[b], c.sign * fx, f[b]);
-            }
+            for (int k = 0; k < ns && na + 2 <= MAX_EDGES - np; k++)
+                na += 2 * lobe_dip(&c, t, f, ns, k, top, q->jtol, add, na, add + na);
         }
     na = end_planes(&c, t, f, ns, add, na, MAX_EDGES - np);
     q->r.evals += c.evals;
