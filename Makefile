@@ -58,7 +58,9 @@ run: all
 	build/pdesolidd $(ARGS)
 
 # Complex division without C99's NaN and overflow recovery: the core's systems are scaled to O(1).
-build/obj/core/%.o build/san/core/%.o: CFLAGS += -fcx-fortran-rules
+# Where the compiler has no such flag (clang), the C99 way, more slowly.
+CX_RULES := $(shell $(CC) -fcx-fortran-rules -E -x c /dev/null >/dev/null 2>&1 && echo -fcx-fortran-rules)
+build/obj/core/%.o build/san/core/%.o: CFLAGS += $(CX_RULES)
 
 build/obj/%.o: %.c | deps
 	@mkdir -p $(dir $@)
