@@ -873,12 +873,17 @@ static void box_refine(qctx *q, const pbox *b, const double coarse[Q_N], int dep
     }
     memset(out, 0, Q_N * sizeof *out);
     /* Along a polynomial axis, quarters whose lines all keep one signature are smooth, but not always
-     * resolved: where the box's halving still changed and every quarter looks smooth, nothing tells the
-     * kink between them from a near singularity of the lines' integrals (det J = x_v (u P(w) - Q(w))
-     * where P and Q both nearly vanish: a box that changed by 8.2e-8 left 1.5e-7 off, unreported), so
-     * they are halved too. Not where only some quarters look smooth: their neighbours hold what
-     * changed (halving those too moved fig. 3d 5.7e-9 off, its work's bound spent on them). */
-    int all_smooth = q->along >= 0 && fabs(fine[Q_VOL] - coarse[Q_VOL]) > 1e-12 * q->vscale;
+     * resolved: where the box has not agreed and every quarter looks smooth, nothing tells the kink
+     * between them from a near singularity of the lines' integrals (det J = x_v (u P(w) - Q(w)) where P
+     * and Q both nearly vanish: a box that changed by 8.2e-8 left 1.5e-7 off, unreported; P = 0 just
+     * beyond a slab of w where the root sweeps the lines, whose rules are sized to the solid's
+     * frequencies, not to 1 / P: quarters that changed by 3e-12 each, below the tolerance but above
+     * depth, left 1.6e-11 off with 1e-12 reported), so they are halved too, down to ALONG_MIN_DEPTH
+     * or agreement, where the halving changed more than 1e-2 of the tolerance (below it, fig. 3c and
+     * 3d spent 10 % more instructions for the same volumes to the last bit). Not where only some
+     * quarters look smooth: their neighbours hold what changed (halving those too moved fig. 3d
+     * 5.7e-9 off, its work's bound spent on them). */
+    int all_smooth = q->along >= 0 && fabs(fine[Q_VOL] - coarse[Q_VOL]) > 1e-14 * q->vscale;
     for (int s = 0; s < 8 && all_smooth; s++)
         all_smooth = !used[s] || smooth[s];
     const double left = q->r.refine_left;
@@ -2406,14 +2411,14 @@ static int end_planes(lobe_col *c, const double *t, double *f, int ns, double *a
                 for (int k = 0; k < ns; k++)
                     f[k] = lobe_detj(c, t[k]), top = fmax(top, fabs(f[k]));
                 const double zero = 1e-13 * top;
-                for (int k = 0; k < ns && na + 2 <= max; k++) {
+                for (int k = 0; k < ns && na < max; k++) {
                     double r[2], lo = t[k], flo = f[k], hi = t[k + (k + 1 < ns)], fhi = f[k + (k + 1 < ns)];
                     int nr = 0;
                     if ((flo < 0) != (fhi < 0) && fabs(flo) > zero && fabs(fhi) > zero &&
                         lobe_bracket(c, add, na, &lo, &flo, &hi, &fhi))
                         r[nr++] = illinois(lobe_detj, c, lo, hi, flo, fhi);
                     c->stop = -zero;   /* a pair through the face between two samples (f059: P = Q twice, 0.02 apart) */
-                    if (!nr && lobe_dip(c, t, f, ns, k, top, zero, add, na, r))
+                    if (!nr && na + 2 <= max && lobe_dip(c, t, f, ns, k, top, zero, add, na, r))
                         nr = 2;
                     for (int i = 0; i < nr; i++)
                         if (end_planar(c, other, col, r[i]))
