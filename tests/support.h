@@ -243,7 +243,8 @@ typedef struct {
     double face_area[6];           /* u = 0, u = 1, v = 0, v = 1, w = 0, w = 1, seams included */
     int face_seam[6];              /* 1: the face coincides with its opposite, and is left out */
     double eval_error;             /* this evaluator against pde_eval_d, relative to the largest value */
-    int converged;                 /* every adaptive integration met its tolerance */
+    int converged;                 /* every adaptive integration met its tolerance, and the faces show
+                                    * no fold that the integrals missed */
     size_t lines;                  /* w-lines evaluated, a measure of the work */
 } ref_props_out;
 
