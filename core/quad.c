@@ -124,6 +124,10 @@
 #define HARM_RULE 10          /* harm_face's Gauss points per panel of w and piece of theta */
 #define HARM_TOL 1e-10        /* ... and its tolerance on a unit of w, of the solid's size squared */
 
+/* A point's x as line_point gives it: x[0..2], and where the face's integrals lift (qctx's lifted), x[c] is
+ * only the part of x_c with the factor t^n and x[3 + c] the rest, its modes of w alone less x0_c. */
+#define QX 6
+
 /* The panels: their edges along each axis, the points of each axis's rule, and its estimated error. */
 typedef struct {
     int np[3], n[3];
@@ -185,6 +189,12 @@ typedef struct {
     int count_only;              /* line_integrate only counts the roots (row_sig_at), adding nothing */
     int node_sig[GMAX + 2];      /* panel_lines: the lines' signatures through each index of w, summed over
                                   * panels: twice their roots, plus 1 where det J is above jtol at s = 0 */
+    /* Where det J separates with a lift (quad_sep's lift) off the free path: lifted[o] = 1 for a lifted
+     * component's modes of w alone (else NULL), x0 of the lifted components (their moments are taken
+     * about it, before any product), and the factors by which add_value scales the terms with those
+     * modes: each has one factor t^n fewer to integrate over t (solid_run). */
+    unsigned char *lifted;
+    double lift_x0[3], lift1[3], lift_xl[6], lift_ll[6];
     quad_result r;
     size_t modes, next_poll;
     size_t off_evals;            /* points off the tables: roots, dips and the rules of pieces */
@@ -350,44 +360,67 @@ static void line_set(qctx *q, int k, const int idx[3])
         q->P[o] = fi[o] * fj[o], q->Pi[o] = di[o] * fj[o], q->Pj[o] = fi[o] * dj[o];
 }
 
-/* x, the partials d[axis][component] and det J on the current line where its own factors are g, dg. */
-static double line_point(qctx *q, const double *g, const double *dg, double x[3], double d[3][3])
+/* x (QX), the partials d[axis][component] and det J on the current line where its own factors are g, dg. */
+static double line_point(qctx *q, const double *g, const double *dg, double x[QX], double d[3][3])
 {
     const int k = q->k, i = q->ax[0], j = q->ax[1];
     for (int c = 0; c < 3; c++) {
-        double sx = 0, sk = 0, si = 0, sj = 0;
-        for (size_t o = q->off[c], e = o + q->s->comp[c].nmodes; o < e; o++)
-            sx += q->P[o] * g[o], sk += q->P[o] * dg[o], si += q->Pi[o] * g[o], sj += q->Pj[o] * g[o];
+        double sx = 0, sk = 0, si = 0, sj = 0, sl = 0;
+        if (q->lifted)
+            for (size_t o = q->off[c], e = o + q->s->comp[c].nmodes; o < e; o++) {
+                const double v = q->P[o] * g[o];
+                *(q->lifted[o] ? &sl : &sx) += v;
+                sk += q->P[o] * dg[o], si += q->Pi[o] * g[o], sj += q->Pj[o] * g[o];
+            }
+        else
+            for (size_t o = q->off[c], e = o + q->s->comp[c].nmodes; o < e; o++)
+                sx += q->P[o] * g[o], sk += q->P[o] * dg[o], si += q->Pi[o] * g[o], sj += q->Pj[o] * g[o];
         x[c] = sx, d[k][c] = sk, d[i][c] = si, d[j][c] = sj;
+        if (q->lifted)
+            x[3 + c] = q->lift1[c] != 0.0 ? sl - q->lift_x0[c] : 0.0;
     }
     q->r.evals++;
     return det3(d[0], d[1], d[2]);
 }
 
 /* The same at the current line's table point it. */
-static double line_eval_at(qctx *q, int it, double x[3], double d[3][3])
+static double line_eval_at(qctx *q, int it, double x[QX], double d[3][3])
 {
     const axis_tab *tb = &q->tab[q->k];
     return line_point(q, tb->val + (size_t)it * q->mt, tb->der + (size_t)it * q->mt, x, d);
 }
 
 /* The same at t, anywhere on the line. */
-static double line_eval_d(qctx *q, double t, double x[3], double d[3][3])
+static double line_eval_d(qctx *q, double t, double x[QX], double d[3][3])
 {
     q->off_evals++;
     solution_factors(q->s, q->k, t, q->g, q->dg);
     return line_point(q, q->g, q->dg, x, d);
 }
 
-static double line_eval(qctx *q, double t, double x[3])
+static double line_eval(qctx *q, double t, double x[QX])
 {
     double d[3][3];
     return line_eval_d(q, t, x, d);
 }
 
-static void add_value(qctx *q, const double x[3], double j, double wt)
+static void add_value(qctx *q, const double x[QX], double j, double wt)
 {
     double a = wt * fabs(j);
+    if (q->lifted) {   /* x_c = X_c + L_c (line_point): each product's terms scaled by their factors t^n */
+        static const int pi[6] = { 0, 1, 2, 0, 0, 1 }, pj[6] = { 0, 1, 2, 1, 2, 2 };
+        const double *X = x, *L = x + 3;
+        double *acc = q->r.acc;
+        acc[Q_VOL] += a;
+        for (int c = 0; c < 3; c++)
+            acc[Q_M1 + c] += a * (X[c] + q->lift1[c] * L[c]);
+        for (int k = 0; k < 6; k++) {
+            const int i = pi[k], l = pj[k];
+            acc[Q_M2 + k] += a * (X[i] * X[l] + q->lift_xl[k] * (X[i] * L[l] + L[i] * X[l]) + q->lift_ll[k] * L[i] * L[l]);
+        }
+        acc[Q_SIGNED] += wt * j;
+        return;
+    }
     double r0 = x[0] - q->x0[0], r1 = x[1] - q->x0[1], r2 = x[2] - q->x0[2];
     double *acc = q->r.acc;
     acc[Q_VOL] += a;
@@ -399,7 +432,7 @@ static void add_value(qctx *q, const double x[3], double j, double wt)
 
 static double line_detj(void *arg, double t)
 {
-    double x[3];
+    double x[QX];
     return line_eval(arg, t, x);
 }
 
@@ -414,7 +447,7 @@ static void line_gauss_tab(qctx *q, double wt)
 {
     const int n = q->n[q->k];
     const double h = q->tab[q->k].t[n + 1] - q->tab[q->k].t[0], *gw = rule_w(q, q->k, n);
-    double x[3], d[3][3];
+    double x[QX], d[3][3];
     for (int i = 0; i < n; i++) {
         double j = line_eval_at(q, i + 1, x, d);
         add_value(q, x, j, wt * h * gw[i]);
@@ -442,7 +475,7 @@ static int axis_points(const qctx *q, int a, double h)
 static void line_gauss(qctx *q, double a, double b, double wt)
 {
     const int n = axis_points(q, q->k, b - a);
-    double x[3], h = b - a;
+    double x[QX], h = b - a;
     for (int i = 0; i < n; i++) {
         double j = line_eval(q, a + h * q->gx[n][i], x);
         add_value(q, x, j, wt * h * q->gw[n][i]);
@@ -462,7 +495,7 @@ static int sign_changes(double fa, double fb, double tol)
 static int line_dip(qctx *q, double t0, double t2, double sign, double *at, double *fat)
 {
     const double g = 0.5 * (3.0 - sqrt(5.0));
-    double a = t0, b = t2, x[3];
+    double a = t0, b = t2, x[QX];
     double c = a + g * (b - a), d = b - g * (b - a);
     double fc = sign * line_eval(q, c, x), fd = sign * line_eval(q, d, x);
     for (int it = 0; it < 40 && b - a > 1e-9 * (t2 - t0); it++) {
@@ -571,7 +604,7 @@ static int poly_roots(const double *c, int deg, double *root)
  * The line integral is exact to rounding. Returns 0, with nothing added, where this does not apply
  * (not a polynomial axis, or too few points for the degree).
  */
-static int poly_line(qctx *q, double a, double b, const double *f, double x[][3], double wt)
+static int poly_line(qctx *q, double a, double b, const double *f, double x[][QX], double wt)
 {
     const int d = q->poly[q->k], n = q->n[q->k], deg = 3 * d - 1;
     if (d < 1 || deg > POLY_LINE_DEG || deg + 1 > n + 2)
@@ -618,7 +651,7 @@ static int poly_line(qctx *q, double a, double b, const double *f, double x[][3]
         const double s0 = r ? root[r - 1] : 0.0, s1 = r < nr ? root[r] : 1.0;
         for (int i = 0; i < m; i++) {
             const double si = s0 + (s1 - s0) * q->gx[m][i];
-            double xi[3];
+            double xi[QX] = { 0 };
             for (int c = 0; c < 3; c++)
                 xi[c] = poly_at(&(qpoly){ cx[c], d }, si);
             add_value(q, xi, poly_at(&pj, si), wt * (b - a) * (s1 - s0) * q->gw[m][i]);
@@ -637,7 +670,7 @@ static void line_integrate(qctx *q, double a, double b, double wt)
 {
     const int n = q->n[q->k], m = n + 1;
     const double *t = q->tab[q->k].t;   /* a, the rule's nodes, b */
-    double f[GMAX + 2], x[GMAX + 2][3], d[3][3];
+    double f[GMAX + 2], x[GMAX + 2][QX], d[3][3];
     if (q->along == q->k && q->poly[q->k] == 1 && m > 1) {
         /* x linear along the line (fig. 3c, 3d: every factor along u is 1 or u): x and its partials at
          * the ends give them at the rule's nodes, so only the ends take the modes' sums (a line took
@@ -1749,8 +1782,10 @@ static qctx *qctx_new(const pde_solution *s, const pde_cancel *cancel)
 
 static void qctx_free(qctx *q)
 {
-    if (q)
+    if (q) {
         free(q->P);
+        free(q->lifted);
+    }
     free(q);
 }
 
@@ -1804,8 +1839,24 @@ static int separate_free(const pde_solution *s, const quad_sep *sp)
     return f;
 }
 
+/* A lift keeps det J = n t^(n ns - 1) G: with ns = 1 (the two other components have no factor t^n, so
+ * their (t, s) minor is 0), or with ns = 2 where the third component is a function of w alone (its row
+ * (0, 0, Z')). */
+static int lift_keeps_form(const pde_solution *s, const quad_sep *sp)
+{
+    if (sp->ns == 1)
+        return 1;
+    if (sp->ns != 2)
+        return 0;
+    for (int c = 0; c < 3; c++)
+        for (size_t m = 0; !sp->in[c] && m < s->comp[c].nmodes; m++)
+            if (!mode_of_w(&s->comp[c].modes[m]))
+                return 0;
+    return 1;
+}
+
 /* quad_separate, and where lift, components whose modes of w alone (mode_of_w) sit beside modes of
- * t^n: quad_sep's lift, kept only where G = g(w) (free). */
+ * t^n: quad_sep's lift, kept where it keeps det J's form (lift_keeps_form). */
 static void separate_lifted(const pde_solution *s, int lift, quad_sep *sep)
 {
     sep->axis = -1;
@@ -1835,7 +1886,7 @@ static void separate_lifted(const pde_solution *s, int lift, quad_sep *sep)
         if (ok && n > 0) {
             sep->axis = a, sep->n = n, sep->ns = sep->in[0] + sep->in[1] + sep->in[2];
             sep->free = separate_free(s, sep);
-            if ((sep->lift[0] || sep->lift[1] || sep->lift[2]) && sep->free < 0) {
+            if ((sep->lift[0] || sep->lift[1] || sep->lift[2]) && sep->free < 0 && !lift_keeps_form(s, sep)) {
                 separate_lifted(s, 0, sep);   /* without: another axis may separate (review: x ~ v, y ~ u + C) */
                 return;
             }
@@ -2492,10 +2543,39 @@ static pde_status solid_run(const pde_solution *s, const double x0[3], double js
         return PDE_ERR_NOMEM;
     q->wsign = ws;
     quad_sep sp = { .axis = -1, .free = -1 };
-    if (separate)   /* lifted components on the free path alone (free_solid's modes) */
-        separate_lifted(s, separate == 1 && q->mt <= FREE_MODES, &sp);
+    if (separate) {
+        /* A lift (quad_sep's) on the free path, and on the face's other paths where det J may change
+         * sign, where the cube's boxes did worse than the face's (a centre C(w) beside x = u (X1 cos 3 pi
+         * v + X2 sin 6 pi v): 5.4e-9 off with 3.8e-8 reported; now its twin's without C, 1.2e-12 off).
+         * Where det J's sign is certified, the cube's tensor rules are exact (fig. 1), or a loft's
+         * uniform rule along v (the periodic path below). */
+        separate_lifted(s, 1, &sp);
+        if ((sp.lift[0] || sp.lift[1] || sp.lift[2]) && jsign && !(separate == 1 && sp.free >= 0 && q->mt <= FREE_MODES))
+            separate_lifted(s, 0, &sp);
+    }
     const int lifted = sp.axis >= 0 && (sp.lift[0] || sp.lift[1] || sp.lift[2]);
     q->free = separate == 1 ? sp.free : -1;
+    if (lifted) {   /* the face's paths (free_solid has its own moments): add_value's lifted terms */
+        static const int pi[6] = { 0, 1, 2, 0, 0, 1 }, pj[6] = { 0, 1, 2, 1, 2, 2 };
+        if (!(q->lifted = calloc(q->mt, 1))) {
+            qctx_free(q);
+            return PDE_ERR_NOMEM;
+        }
+        const double ns = sp.ns;
+        for (int c = 0; c < 3; c++) {
+            for (size_t m = 0; sp.lift[c] && m < s->comp[c].nmodes; m++)
+                q->lifted[q->off[c] + m] = (unsigned char)mode_of_w(&s->comp[c].modes[m]);
+            /* a term with k factors t^n integrates to 1 / (n (ns + k)) (separable_moments), one with j of
+             * them lifted (a mode of w alone in place of t^n X_c) to 1 / (n (ns + k - j)) */
+            q->lift1[c] = sp.lift[c] ? (ns + 1) / ns : 0.0;
+            q->lift_x0[c] = sp.lift[c] ? x0[c] : 0.0;
+        }
+        for (int k = 0; k < 6; k++) {
+            const int in = sp.in[pi[k]] + sp.in[pj[k]];
+            q->lift_xl[k] = in >= 1 ? (ns + in) / (ns + in - 1) : 0.0;
+            q->lift_ll[k] = in >= 2 ? (ns + in) / (ns + in - 2) : 0.0;
+        }
+    }
     q->jtol = 1e-13 * jscale;
     q->vscale = vscale;
     q->jsign = jsign;
@@ -2553,12 +2633,10 @@ static pde_status solid_run(const pde_solution *s, const double x0[3], double js
      * or half-turn (param_symmetry) where the period is a whole number of panels; else, where the face
      * is integrated by rows (face_rows), a rotation (param_rotation), with the period's own panels. */
     /* G = g(w): 1-D along w over the whole face, no period needed */
-    int shifted[3] = { 0, 0, 0 };   /* components whose moments free_solid took about x0 */
+    int shifted[3] = { 0, 0, 0 };   /* components whose moments were taken about x0 */
     const int one_d = q->free >= 0 && free_solid(q, &p, &sp, x0, shifted);
-    if (lifted && !one_d) {   /* its memory: no other path takes a lifted component */
-        qctx_free(q);
-        return PDE_ERR_NOMEM;
-    }
+    for (int c = 0; c < 3 && !one_d; c++)   /* the face's paths: the lifted components (add_value) */
+        shifted[c] = sp.lift[c] && sp.axis >= 0;
     qsym sy = { .k = 0 };
     const int folds = sp.axis >= 0 && q->free < 0 && !jsign;   /* on the face, G depending on both */
     for (int t = 0; t < 2 && sp.axis >= 0 && separate != 3 && !sy.k && !one_d; t++) {
@@ -3018,6 +3096,34 @@ static void fold_span(fold_ctx *f, fold_span_t sp, double acc[Q_N])
     }
 }
 
+/* Z'(w), z = Z(w) a function of w alone (fold_solid's form) */
+static double fold_dz(void *arg, double w)
+{
+    double x[3], xu[3], xv[3], xw[3];
+    pde_eval_d(arg, 0.5, 0.5, w, x, xu, xv, xw);
+    return xw[2];
+}
+
+/*
+ * Where Z' changes sign in (a, b), |det J| = n t^(2n - 1) |Z'(w)| |Q| has a kink that no count of Q's
+ * roots shows: the roots there, located where FOLD_ZSAMPLES samples change sign (Illinois), into cut,
+ * ascending; returns how many (at most max). A z turning back along w (Z'(0) < 0 < Z'(1)) was 1.2e-8
+ * off with 8.4e-15 reported, its span's rules agreeing across the kink.
+ */
+#define FOLD_ZSAMPLES 64
+static int fold_zcuts(const pde_solution *s, double a, double b, double *cut, int max)
+{
+    int n = 0;
+    double t0 = a, f0 = fold_dz((void *)s, a);
+    for (int i = 1; i <= FOLD_ZSAMPLES && n < max; i++) {
+        const double t1 = i == FOLD_ZSAMPLES ? b : a + (b - a) * i / FOLD_ZSAMPLES, f1 = fold_dz((void *)s, t1);
+        if ((f0 < 0.0 && f1 > 0.0) || (f0 > 0.0 && f1 < 0.0))
+            cut[n++] = illinois(fold_dz, (void *)s, t0, t1, f0, f1);
+        t0 = t1, f0 = f1;
+    }
+    return n;
+}
+
 /*
  * A model of the loft's form (below) that is not a loft takes these rows only where no other exact path
  * does: the free path (G = g(w): fig. 2, 4, and a centre C(w) beside them, quad_sep's lift) and a
@@ -3112,9 +3218,13 @@ static int fold_solid(const pde_solution *s, const double x0[3], double vscale, 
             }
         const double len = br[sl + 1] - br[sl];
         const int np = (int)fmin(MAX_PANELS, ceil(rate * len / PANEL_PHASE));
-        for (int p = 0; p < np && !f.stopped; p++)
-            fold_span(&f, (fold_span_t){ br[sl] + len * p / np, p + 1 == np ? br[sl + 1] : br[sl] + len * (p + 1) / np,
-                                         0, 0 }, out->acc);
+        for (int p = 0; p < np && !f.stopped; p++) {
+            const double a = br[sl] + len * p / np, b = p + 1 == np ? br[sl + 1] : br[sl] + len * (p + 1) / np;
+            double cut[8];
+            const int nc = fold_zcuts(s, a, b, cut, 8);
+            for (int c = 0; c <= nc && !f.stopped; c++)   /* each side of Z''s sign changes on its own */
+                fold_span(&f, (fold_span_t){ c ? cut[c - 1] : a, c < nc ? cut[c] : b, 0, 0 }, out->acc);
+        }
     }
     free(mem);
     if (f.stopped)
@@ -3233,7 +3343,7 @@ static double face_elem_of(const face_line *f, double d[3][3], double *sdir)
 /* The element at t on the current line, and at its table point it. */
 static double face_elem(const face_line *f, double t, double *sdir)
 {
-    double x[3], d[3][3];
+    double x[QX], d[3][3];
     line_eval_d(f->q, t, x, d);
     return face_elem_of(f, d, sdir);
 }
@@ -3241,7 +3351,7 @@ static double face_elem(const face_line *f, double t, double *sdir)
 /* flux: x . (x_a x x_b), whose integrals over the faces give the signed volume (quad_area). */
 static double face_elem_at(const face_line *f, int it, double *sdir, double *flux)
 {
-    double x[3], d[3][3];
+    double x[QX], d[3][3];
     line_eval_at(f->q, it, x, d);
     const double *ta = d[f->o[0]], *tb = d[f->o[1]];
     *flux = x[0] * (ta[1] * tb[2] - ta[2] * tb[1]) + x[1] * (ta[2] * tb[0] - ta[0] * tb[2]) +

@@ -46,9 +46,10 @@ typedef struct {
      * twice, exp(+-alpha s), 1 and s). Then G = Z'(w) sum h_i(w) k_j(w) W_ij = g(w); else -1. */
     int free;
     /* Components with in[c] = 1 that have modes of w alone as well (factors 1 along u and v: a centre
-     * C_c(w) moving along w, x_c = t^n X_c + C_c). Only quad_solid's free path takes them (lift[c]
-     * = 1; quad_separate leaves them 0 and refuses such a solid): there the third component is a
-     * function of w alone, its row (0, 0, Z'), so C_c's row (0, 0, C_c') adds C_c' times a (t, s)
+     * C_c(w) moving along w, x_c = t^n X_c + C_c). Only quad_solid takes them (lift[c] = 1;
+     * quad_separate leaves them 0 and refuses such a solid): on the free path, and on the face's
+     * other paths where det J may change sign. There ns = 1, or ns = 2 and the third component is
+     * a function of w alone, its row (0, 0, Z'), so C_c's row (0, 0, C_c') adds C_c' times a (t, s)
      * minor that is 0 to det J, which keeps its form; only the integrals over t of C_c's terms
      * differ (one factor t^n fewer). */
     int lift[3];
