@@ -323,6 +323,7 @@ typedef struct {
     double condition_harmonic;   /* its mode's harmonic m in v (cos, sin 2 pi m v), 0 if none */
     double integral_error;   /* the estimated error of volume, signed_volume, centroid, inertia, relative: about
                               * 1e-14 unless PDE_PROPS_WORK bounded them (docs/MATH.md) */
+    double surface_area_error;   /* the estimated error of surface_area, relative (docs/MATH.md) */
 } pde_props;
 
 /* The integrals' work, at most: their rules' points times (modes + 1), beyond which the panels get

@@ -76,6 +76,7 @@
 #define FACE_DEEP 30.0        /* (fig. 4a: two panels at a cusp of the fold, 8.7e-7 apart at depth 4) */
 #define FACE_EST 1e4          /* a face panel whose estimate is below this times the tolerance is not split */
 #define FACE_EST_MIN 0.3      /* ... unless its element falls below this of its largest at the nodes */
+#define FACE_EST_OFF 1e-2     /* ... and its error counted as this of the estimate (face_refine's measure) */
 #define GRADE_RATIO 0.15      /* a rounded fold: pieces graded towards its least, each this of the distance left, */
 #define GRADE_POINTS 10       /* ... the first with this rule, each next with 2 points fewer, 4 at least */
 #define GRADE_LEVELS 12       /* ... this many pieces at most */
@@ -3534,6 +3535,7 @@ typedef struct {
     int max_refined;             /* FACE_REFINE; where det J separates, every panel (REFINE_WORK bounds it) */
     int flat;                    /* the face parameter (0, 1) fixed at 1 where the face separates, or -1 */
     int stopped;
+    double left;                 /* the face's estimated error: its panels' last halvings' changes (face_refine) */
 } face_ctx;
 
 /* One panel [lo, lo + h] of the face: lines along the parameter that crosses the sign changes of
@@ -3629,8 +3631,10 @@ static double face_refine(face_ctx *c, const double lo[2], const double h[2], do
 {
     if (!c->stopped && pde_stopped(c->cancel))
         c->stopped = 1;
-    if (!(est > FACE_EST * c->tol))   /* NaN too: values beyond a double refine to nothing better */
+    if (!(est > FACE_EST * c->tol)) {   /* NaN too: values beyond a double refine to nothing better */
+        c->left += FACE_EST_OFF * est;
         return coarse;
+    }
     double q[4] = { 0, 0, 0, 0 }, ql[4][2], qe[4] = { 0, 0, 0, 0 }, fine = 0.0;
     const double hh[2] = { c->flat == 0 ? h[0] : 0.5 * h[0], c->flat == 1 ? h[1] : 0.5 * h[1] };
     for (int k = 0; k < 4; k++) {
@@ -3642,8 +3646,10 @@ static double face_refine(face_ctx *c, const double lo[2], const double h[2], do
     }
     const double diff = fabs(fine - coarse);
     if (c->stopped || c->line.q->r.evals * c->line.q->modes >= REFINE_WORK || !(diff > c->tol) ||
-        depth + 1 >= FACE_DEPTH_MAX || (depth + 1 >= FACE_DEPTH && !(diff > FACE_DEEP * c->tol)))
+        depth + 1 >= FACE_DEPTH_MAX || (depth + 1 >= FACE_DEPTH && !(diff > FACE_DEEP * c->tol))) {
+        c->left += diff;   /* the error left is about this, or less where it converges */
         return fine;
+    }
     double sum = 0.0;
     for (int k = 0; k < 4; k++)
         if (c->flat < 0 || !(k >> c->flat & 1))
@@ -3978,7 +3984,7 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
     /* Where det J separates, the faces of another axis are lines: the budget of refined panels
      * goes to the rest (fig. 3b's area 1.1e-5 -> 1.6e-8 of the reference quadrature's). */
     c->max_refined = sp.axis >= 0 ? INT_MAX : FACE_REFINE;
-    double total = 0.0, flux = 0.0;
+    double total = 0.0, flux = 0.0, left = 0.0;   /* left: the area's estimated error */
     int panels = 0;   /* faces integrated on the plan's panels, whose a-priori error stands */
     face_rot rot = { .known = { 0, 0 } };
     for (int axis = 0; axis < 3 && !c->stopped; axis++) {
@@ -4012,6 +4018,7 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
                 if (h) {
                     flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fflux;
                     total += face;
+                    left += ho.tol;   /* its rules' tolerance over the unit of w */
                     continue;
                 }
             }
@@ -4026,6 +4033,9 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
             for (int k = 0; k < 2 && per == 1; k++)
                 if (o[k] <= 1 && k != c->flat)
                     per = face_period(s, o[k], period & QUAD_PERIOD, &rot, &np[k], &div[k], &half, &fdet, &rdet);
+            double change = 0.0;   /* what refinement changed, over the panels refined */
+            int nref = 0, nleft = 0;
+            c->left = 0.0;
             for (int pa = 0; pa < np[0] && !c->stopped; pa++)
                 for (int pb = 0; pb < np[1] && !c->stopped; pb++) {
                     const int i[2] = { pa, pb };
@@ -4041,9 +4051,16 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
                         c->stopped = 1;
                     double fl, est, a = face_panel(c, lo, h, &fl, &est);
                     fflux += fl;
-                    face += c->refined++ >= c->max_refined || q->r.evals * q->modes >= REFINE_WORK
-                                ? a : face_refine(c, lo, h, a, est, 0);
+                    if (c->refined++ >= c->max_refined || q->r.evals * q->modes >= REFINE_WORK) {
+                        face += a, nleft++;
+                    } else {
+                        const double fine = face_refine(c, lo, h, a, est, 0);
+                        face += fine, change += fabs(fine - a), nref++;
+                    }
                 }
+            /* panels the work's bound left unrefined: what refinement changed on the others, on average */
+            if (nleft)
+                c->left += nref ? nleft * change / nref : fabs(face);
             /* Outward: side 1 along +axis; (o0, o1, axis) is odd for axis 1. */
             double fsum = 0.0, sig = 1.0;   /* the periods' fluxes: det R^j times the first's, and its mirror's */
             for (int j = 0; j < per; j++, sig *= fdet)
@@ -4052,6 +4069,7 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
                 fsum *= 1.0 + rdet;
             flux += (side ? 1.0 : -1.0) * (axis == 1 ? -1.0 : 1.0) * fscale * fsum * fflux;
             total += ascale * per * half * face;
+            left += ascale * per * half * c->left;
         }
     }
     pde_status st = c->stopped ? PDE_ERR_CANCELLED : PDE_OK;
@@ -4063,6 +4081,7 @@ pde_status quad_area_period(const pde_solution *s, double size, int period, cons
          * error: the lofts' skin and caps, whose plan the work's bound made coarse (tower: 2). */
         q->r.err = panels ? p.err : fmin(p.err, 1e-14);
         q->r.acc[Q_SIGNED] = flux / 3.0;
+        q->r.area_left = left;
         *info = q->r;
     }
     qctx_free(q);

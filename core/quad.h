@@ -22,6 +22,7 @@ typedef struct {
     double refine_left;          /* the sum of |fine - coarse| of the volume over boxes whose refinement
                                   * stopped at its depth (or the work's bound) before it agreed */
     int roots_skipped;  /* the work's bound stopped lines locating det J's roots (or the area's) */
+    double area_left;   /* quad_area: the area's estimated error, absolute (quad.c's face_refine) */
 } quad_result;
 
 /*
