@@ -173,6 +173,6 @@ void api_describe_props(FILE *out, const pde_props *props)
     triple(out, "%.6g", p->detj_max_at);
     fprintf(out, "\n    certified: every value lies in [%.10g, %.10g]\n", p->detj_min, p->detj_max);
     fprintf(out, "  folds: %s\n", p->folds ? "yes: det J changes sign, the solid overlaps itself" : "no");
-    fprintf(out, "  accuracy: boundary residual %.3g, PDE residual %.3g, integrals %.3g (relative)\n",
-            p->bc_residual, p->pde_residual, p->integral_error);
+    fprintf(out, "  accuracy: boundary residual %.3g, PDE residual %.3g, integrals %.3g, area %.3g (relative)\n",
+            p->bc_residual, p->pde_residual, p->integral_error, p->surface_area_error);
 }

@@ -182,6 +182,7 @@ static const prop_row prop_rows[] = {
     PROP("residuals", "boundary", bc_residual, 1, 1),
     PROP("residuals", "pde", pde_residual, 1, 1),
     PROP("residuals", "integrals", integral_error, 1, 1),
+    PROP("residuals", "area", surface_area_error, 1, 1),
     PROP("residuals", "fit", fit_error, 1, 1),
     PROP("conditioning", "condition", condition, 1, 1),
     PROP("conditioning", "harmonic", condition_harmonic, 1, 1),

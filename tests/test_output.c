@@ -123,6 +123,7 @@ static size_t prop_paths(pde_props *p, prop_path out[32])
         { "residuals", "boundary", "residuals_boundary", &p->bc_residual, 1 },
         { "residuals", "pde", "residuals_pde", &p->pde_residual, 1 },
         { "residuals", "integrals", "residuals_integrals", &p->integral_error, 1 },
+        { "residuals", "area", "residuals_area", &p->surface_area_error, 1 },
         { "residuals", "fit", "residuals_fit", &p->fit_error, 1 },
         { "conditioning", "condition", "conditioning_condition", &p->condition, 1 },
         { "conditioning", "harmonic", "conditioning_harmonic", &p->condition_harmonic, 1 },

@@ -188,7 +188,7 @@ function showProps(p, times) {
     p.inertia && ['inertia', inertiaDetails(p)],
     ['det J', `${fmt(p.detJ.min_found)} to ${fmt(p.detJ.max_found)} (certified: ${fmt(p.detJ.min)} to ${fmt(p.detJ.max)})`],
     ['bounds', `[${p.bbox.min.map(fmt).join(', ')}] to [${p.bbox.max.map(fmt).join(', ')}], certified to ${fmt(p.bbox.gap)}`],
-    ['accuracy', `boundary ${p.residuals.boundary.toExponential(1)}, PDE ${p.residuals.pde.toExponential(1)}${p.residuals.integrals !== undefined ? `, integrals ${p.residuals.integrals.toExponential(1)}` : ''}`],
+    ['accuracy', `boundary ${p.residuals.boundary.toExponential(1)}, PDE ${p.residuals.pde.toExponential(1)}${p.residuals.integrals !== undefined ? `, integrals ${p.residuals.integrals.toExponential(1)}` : ''}${p.residuals.area !== undefined ? `, area ${p.residuals.area.toExponential(1)}` : ''}`],
     ['times', times],
   ].filter(Boolean);
   el('props').replaceChildren(...rows.flatMap(([k, v]) => {
