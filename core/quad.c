@@ -125,6 +125,9 @@
 #define HARM_RULE 10          /* harm_face's Gauss points per panel of w and piece of theta */
 #define HARM_TOL 1e-10        /* ... and its tolerance on a unit of w, of the solid's size squared */
 
+/* The components of each second moment Q_M2 + k (quad.h's order): r[m2_i[k]] r[m2_j[k]]. */
+static const int m2_i[6] = { 0, 1, 2, 0, 0, 1 }, m2_j[6] = { 0, 1, 2, 1, 2, 2 };
+
 /* A point's x as line_point gives it: x[0..2], and where the face's integrals lift (qctx's lifted), x[c] is
  * only the part of x_c with the factor t^n and x[3 + c] the rest, its modes of w alone less x0_c. */
 #define QX 6
@@ -422,14 +425,13 @@ static void add_value(qctx *q, const double x[QX], double j, double wt)
 {
     double a = wt * fabs(j);
     if (q->lifted) {   /* x_c = X_c + L_c (line_point): each product's terms scaled by their factors t^n */
-        static const int pi[6] = { 0, 1, 2, 0, 0, 1 }, pj[6] = { 0, 1, 2, 1, 2, 2 };
         const double *X = x, *L = x + 3;
         double *acc = q->r.acc;
         acc[Q_VOL] += a;
         for (int c = 0; c < 3; c++)
             acc[Q_M1 + c] += a * (X[c] + q->lift1[c] * L[c]);
         for (int k = 0; k < 6; k++) {
-            const int i = pi[k], l = pj[k];
+            const int i = m2_i[k], l = m2_j[k];
             acc[Q_M2 + k] += a * (X[i] * X[l] + q->lift_xl[k] * (X[i] * L[l] + L[i] * X[l]) + q->lift_ll[k] * L[i] * L[l]);
         }
         acc[Q_SIGNED] += wt * j;
@@ -624,7 +626,7 @@ static int poly_line(qctx *q, double a, double b, const double *f, double x[][QX
     if (d < 1 || deg > POLY_LINE_DEG || deg + 1 > n + 2)
         return 0;
     const double *t = q->tab[q->k].t;
-    double s[POLY_LINE_DEG + 1], y[POLY_LINE_DEG + 1], cj[POLY_LINE_DEG + 1], cx[3][POLY_LINE_DEG + 1];
+    double s[POLY_LINE_DEG + 1], y[POLY_LINE_DEG + 1], cj[POLY_LINE_DEG + 1], cx[QX][POLY_LINE_DEG + 1];
     for (int i = 0; i <= deg; i++) {   /* deg + 1 of the n + 2 points, spread from a to b */
         const int at = (i * (n + 1) + deg / 2) / deg;
         s[i] = (t[at] - a) / (b - a), y[i] = f[at];
@@ -652,7 +654,8 @@ static int poly_line(qctx *q, double a, double b, const double *f, double x[][QX
             add_value(q, x[i + 1], f[i + 1], wt * (b - a) * gw[i]);
         return 1;
     }
-    for (int c = 0; c < 3; c++) {
+    const int nx = q->lifted ? QX : 3;   /* a lift's parts of x apart (line_point_lifted): each a polynomial */
+    for (int c = 0; c < nx; c++) {
         for (int i = 0; i <= d; i++) {
             const int at = (i * (n + 1) + d / 2) / d;
             s[i] = (t[at] - a) / (b - a), y[i] = x[at][c];
@@ -665,8 +668,8 @@ static int poly_line(qctx *q, double a, double b, const double *f, double x[][QX
         const double s0 = r ? root[r - 1] : 0.0, s1 = r < nr ? root[r] : 1.0;
         for (int i = 0; i < m; i++) {
             const double si = s0 + (s1 - s0) * q->gx[m][i];
-            double xi[QX] = { 0 };
-            for (int c = 0; c < 3; c++)
+            double xi[QX];
+            for (int c = 0; c < nx; c++)
                 xi[c] = poly_at(&(qpoly){ cx[c], d }, si);
             add_value(q, xi, poly_at(&pj, si), wt * (b - a) * (s1 - s0) * q->gw[m][i]);
         }
@@ -1917,12 +1920,11 @@ void quad_separate(const pde_solution *s, quad_sep *sep)
 /* The moments about the origin in acc, about x0 instead. */
 static void moments_about(const double x0[3], double acc[Q_N])
 {
-    static const int pi[6] = { 0, 1, 2, 0, 0, 1 }, pj[6] = { 0, 1, 2, 1, 2, 2 };
     const double V = acc[Q_VOL], M1[3] = { acc[Q_M1], acc[Q_M1 + 1], acc[Q_M1 + 2] };
     for (int c = 0; c < 3; c++)
         acc[Q_M1 + c] = M1[c] - x0[c] * V;
     for (int k = 0; k < 6; k++)
-        acc[Q_M2 + k] += -x0[pi[k]] * M1[pj[k]] - x0[pj[k]] * M1[pi[k]] + x0[pi[k]] * x0[pj[k]] * V;
+        acc[Q_M2 + k] += -x0[m2_i[k]] * M1[m2_j[k]] - x0[m2_j[k]] * M1[m2_i[k]] + x0[m2_i[k]] * x0[m2_j[k]] * V;
 }
 
 /*
@@ -1932,13 +1934,12 @@ static void moments_about(const double x0[3], double acc[Q_N])
  */
 static void separable_moments(const quad_sep *sp, const double x0[3], double acc[Q_N])
 {
-    static const int pi[6] = { 0, 1, 2, 0, 0, 1 }, pj[6] = { 0, 1, 2, 1, 2, 2 };
     const double n = sp->n;
     acc[Q_VOL] /= n * sp->ns;
     for (int c = 0; c < 3; c++)
         acc[Q_M1 + c] /= n * (sp->ns + sp->in[c]);
     for (int k = 0; k < 6; k++)
-        acc[Q_M2 + k] /= n * (sp->ns + sp->in[pi[k]] + sp->in[pj[k]]);
+        acc[Q_M2 + k] /= n * (sp->ns + sp->in[m2_i[k]] + sp->in[m2_j[k]]);
     acc[Q_SIGNED] /= n * sp->ns;
     moments_about(x0, acc);
 }
@@ -1997,7 +1998,6 @@ typedef struct {
  * moments A M1, the second A M2 A^T, det J times sig. */
 static void sym_add(const double A[3][3], double sig, const double in[Q_N], double out[Q_N])
 {
-    static const int pi[6] = { 0, 1, 2, 0, 0, 1 }, pj[6] = { 0, 1, 2, 1, 2, 2 };
     static const int at[3][3] = { { 0, 3, 4 }, { 3, 1, 5 }, { 4, 5, 2 } };
     out[Q_VOL] += in[Q_VOL];
     out[Q_SIGNED] += sig * in[Q_SIGNED];
@@ -2007,7 +2007,7 @@ static void sym_add(const double A[3][3], double sig, const double in[Q_N], doub
     for (int q = 0; q < 6; q++)
         for (int e = 0; e < 3; e++)
             for (int f = 0; f < 3; f++)
-                out[Q_M2 + q] += A[pi[q]][e] * A[pj[q]][f] * in[Q_M2 + at[e][f]];
+                out[Q_M2 + q] += A[m2_i[q]][e] * A[m2_j[q]][f] * in[Q_M2 + at[e][f]];
 }
 
 static double det33(const double A[3][3])
@@ -2476,13 +2476,13 @@ static int end_planes(lobe_col *c, const double *t, double *f, int ns, double *a
                 for (int k = 0; k < ns; k++)
                     f[k] = lobe_detj(c, t[k]), top = fmax(top, fabs(f[k]));
                 const double zero = 1e-13 * top;
+                c->stop = -zero;   /* lobe_dip's: a pair through the face between two samples (f059: P = Q twice, 0.02 apart) */
                 for (int k = 0; k < ns && na < max; k++) {
                     double r[2], lo = t[k], flo = f[k], hi = t[k + (k + 1 < ns)], fhi = f[k + (k + 1 < ns)];
                     int nr = 0;
                     if ((flo < 0) != (fhi < 0) && fabs(flo) > zero && fabs(fhi) > zero &&
                         lobe_bracket(c, add, na, &lo, &flo, &hi, &fhi))
                         r[nr++] = illinois(lobe_detj, c, lo, hi, flo, fhi);
-                    c->stop = -zero;   /* a pair through the face between two samples (f059: P = Q twice, 0.02 apart) */
                     if (!nr && na + 2 <= max && lobe_dip(c, t, f, ns, k, top, zero, add, na, r))
                         nr = 2;
                     for (int i = 0; i < nr; i++)
@@ -2570,7 +2570,6 @@ static pde_status solid_run(const pde_solution *s, const double x0[3], double js
     const int lifted = sp.axis >= 0 && (sp.lift[0] || sp.lift[1] || sp.lift[2]);
     q->free = separate == 1 ? sp.free : -1;
     if (lifted) {   /* the face's paths (free_solid has its own moments): add_value's lifted terms */
-        static const int pi[6] = { 0, 1, 2, 0, 0, 1 }, pj[6] = { 0, 1, 2, 1, 2, 2 };
         if (!(q->lifted = calloc(q->mt, 1))) {
             qctx_free(q);
             return PDE_ERR_NOMEM;
@@ -2585,7 +2584,7 @@ static pde_status solid_run(const pde_solution *s, const double x0[3], double js
             q->lift_x0[c] = sp.lift[c] ? x0[c] : 0.0;
         }
         for (int k = 0; k < 6; k++) {
-            const int in = sp.in[pi[k]] + sp.in[pj[k]];
+            const int in = sp.in[m2_i[k]] + sp.in[m2_j[k]];
             q->lift_xl[k] = in >= 1 ? (ns + in) / (ns + in - 1) : 0.0;
             q->lift_ll[k] = in >= 2 ? (ns + in) / (ns + in - 2) : 0.0;
         }
