@@ -222,31 +222,66 @@ static double dq(const trig4 *q, double th, double *d2)
     return d1;
 }
 
+/* q's derivatives 1 to TAYLOR at theta into d[1..TAYLOR]: with C_j = a_j cos j theta + b_j sin j theta and
+ * S_j = b_j cos j theta - a_j sin j theta, the kth is sum_j j^k of S_j, -C_j, -S_j, C_j for k = 1, 2, 3, 4 mod 4 */
+#define TAYLOR 8
+static void dq_all(const trig4 *q, double th, double d[TAYLOR + 1])
+{
+    double cs[8], C[4], S[4];
+    harmonics(th, cs);
+    for (int j = 0; j < 4; j++)
+        C[j] = q->a[j + 1] * cs[j] + q->b[j + 1] * cs[j + 4], S[j] = q->b[j + 1] * cs[j] - q->a[j + 1] * cs[j + 4];
+    double jk[4] = { 1.0, 1.0, 1.0, 1.0 };   /* j^k */
+    for (int k = 1; k <= TAYLOR; k++) {
+        double s = 0.0;
+        for (int j = 0; j < 4; j++)
+            jk[j] *= j + 1, s += jk[j] * (k % 2 ? S[j] : C[j]);
+        d[k] = k % 4 == 1 || k % 4 == 0 ? s : -s;
+    }
+}
+
 /*
  * Every least value of |x_t x x_w|^2 in [lo, hi] (q' there d1lo, d1hi) into at[], *n of them, located
  * (least). q' is a trigonometric polynomial of degree 4, with at most 8 zeros a period, but two of
- * them (two narrow dips) may sit closer than any sampling's spacing: they are isolated by bounds
- * instead, L[0] of |q''| and L[1] of |q'''| (sums of j^2 and j^3 times the harmonics' amplitudes): no
- * zero where |q'(mid)| > L[0] h (h the half-width), at most one where |q''(mid)| > L[1] h (q'
- * monotone: a least value where it rises through 0), else halved (a degenerate one: to 2^-CRIT_DEPTH).
+ * them (two narrow dips) may sit closer than any sampling's spacing: they are isolated by Taylor's
+ * theorem instead. With d_k = q^(k)(mid), h the half-width and L[k] = sum_j j^k times the harmonics'
+ * amplitudes (a bound of |q^(k)|): no zero of q' where |d_1| > L[2] h, or > sum_{k = 2..TAYLOR}
+ * |d_k| h^(k-1) / (k-1)! + L[TAYLOR + 1] h^TAYLOR / TAYLOR!; at most one (q' monotone: a least value
+ * where it rises through 0) where the same holds for q'' (|d_2| > L[3] h, or > its sum); else halved,
+ * to 2^-CRIT_DEPTH. Where q' vanishes to high order (an element like |sin theta| (1 - cos theta), a
+ * section's cusp: q ~ theta^6), the first bounds alone left every interval near the zero undecided at
+ * every depth, 2^40 of them (make fuzz: one section ran for hours); the whole series leaves a few a
+ * level, as many as the zero's order. Each call's intervals are counted against *left (CRIT_WORK a
+ * section): 0 where it runs out, the cuts then unknown, else 1.
  */
 #define CRIT_DEPTH 40
 #define CRIT_MAX 8
-static void minima(const trig4 *q, double lo, double hi, double d1lo, double d1hi, const double L[2], int depth,
-                   double *at, int *n)
+#define CRIT_WORK 4096
+static int minima(const trig4 *q, double lo, double hi, double d1lo, double d1hi, const double L[TAYLOR + 2],
+                  int depth, double *at, int *n, int *left)
 {
     const double h = 0.5 * (hi - lo), mid = lo + h;
-    double d2;
-    const double d1 = dq(q, mid, &d2);
-    if (fabs(d1) > L[0] * h)
-        return;
-    if (fabs(d2) > L[1] * h || depth >= CRIT_DEPTH) {
+    double d[TAYLOR + 1], r[2];
+    if (--*left < 0)
+        return 0;
+    dq_all(q, mid, d);
+    for (int i = 0; i < 2; i++) {   /* the series of q' (i = 0) and q'' (i = 1) about mid, but its first term */
+        double hk = 1.0, s = 0.0;
+        for (int k = 2 + i; k <= TAYLOR; k++)
+            hk *= h / (k - 1 - i), s += fabs(d[k]) * hk;
+        r[i] = s + L[TAYLOR + 1] * hk * h / (TAYLOR - i);
+    }
+    const double a1 = fabs(d[1]), a2 = fabs(d[2]);
+    if (a1 > L[2] * h || a1 > r[0])
+        return 1;
+    if (a2 > L[3] * h || a2 > r[1] || depth >= CRIT_DEPTH) {
+        double d2;
         if (d1lo < 0.0 && d1hi >= 0.0 && *n < CRIT_MAX)
             at[(*n)++] = least(q, lo, hi, &d2);
-        return;
+        return 1;
     }
-    minima(q, lo, mid, d1lo, d1, L, depth + 1, at, n);
-    minima(q, mid, hi, d1, d1hi, L, depth + 1, at, n);
+    return minima(q, lo, mid, d1lo, d[1], L, depth + 1, at, n, left) &&
+           minima(q, mid, hi, d[1], d1hi, L, depth + 1, at, n, left);
 }
 
 /* The element at c + t, cos c = cb and sin c = sb, |t| <= PIECE_MAX: cos and sin of t by their series */
@@ -703,11 +738,12 @@ static double elem_mean(const harm_opts *o, const trig4 *q, ev_hint *hint, doubl
     const double period = per * (2.0 * M_PI / NT);
     /* the cuts: every least value of the element, isolated by bounds (minima), not at the least
      * samples, which took two narrow dips between two samples for one (2.5e-6 of the mean off) */
-    double cut[CRIT_MAX], scale[CRIT_MAX], L[2] = { 0.0, 0.0 }, d2;
-    int ncut = 0;
+    double cut[CRIT_MAX], scale[CRIT_MAX], L[TAYLOR + 2] = { 0.0 }, d2;
+    int ncut = 0, left = CRIT_WORK;
     for (int j = 1; j <= 4; j++) {
         const double amp = hypot(q->a[j], q->b[j]);
-        L[0] += j * j * amp, L[1] += j * j * j * amp;
+        for (int k = 0, jk = 1; k <= TAYLOR + 1; k++, jk *= j)
+            L[k] += jk * amp;
     }
     /* q' at 16 ends, its value at 0 also at the period's end: a least value at a shared end then goes to
      * exactly one side (q' < 0 on the left, >= 0 on the right) */
@@ -716,7 +752,8 @@ static double elem_mean(const harm_opts *o, const trig4 *q, ev_hint *hint, doubl
         d1[p] = dq(q, period * p / 16, &d2);
     d1[16] = d1[0];
     for (int p = 0; p < 16; p++)
-        minima(q, period * p / 16, period * (p + 1) / 16, d1[p], d1[p + 1], L, 0, cut, &ncut);
+        if (!minima(q, period * p / 16, period * (p + 1) / 16, d1[p], d1[p + 1], L, 0, cut, &ncut, &left))
+            return NAN;   /* harm_face then declines the face (at_w's NaN): the general path's panels */
     for (int j = 0; j < ncut; j++) {
         double m;
         dq(q, cut[j], &d2);

@@ -195,11 +195,40 @@ static void harm_mean_should_find_both_of_two_close_dips_on_odd_sections(void **
     print_message("harm_mean on %d odd sections: %.3g off at most\n", cases, worst);
 }
 
+/* A section whose element vanishes to third order (make fuzz's loft, whose section at some w is
+ * x_t x x_w = (s sin theta - s k / 2 sin 2 theta) e_x = s sin theta (1 - k cos theta) e_x: at k = 1,
+ * |x_t x x_w|^2 ~ theta^6 at 0): its mean over a period is s / pi times the integral of |1 - k c| over
+ * c in [-1, 1], 2 for k <= 1 and k + 1 / k beyond. The cuts' search (minima) halved every interval near
+ * theta = 0 at every depth, 2^40 of them: one section never ended. Also with the cusp turned out of
+ * the plane by t e_y in v4 (against the adaptive rule). */
+static void harm_mean_should_take_a_section_whose_element_vanishes_to_third_order(void **state)
+{
+    (void)state;
+    double x[10], wt[10];
+    ref_gauss_legendre(10, x, wt);
+    const double s = 9.5870525873394357;
+    static const double ks[] = { 1.0, 1.0 + 1e-12, 1.0 - 1e-12, 1.0 + 1e-8, 1.0 - 1e-8, 1.0 + 1e-4, 0.999, 1.5 };
+    for (size_t i = 0; i < sizeof ks / sizeof *ks; i++) {
+        const double v[5][3] = { { 0, 0, 0 }, { 0, 0, 0 }, { s, 0, 0 }, { 0, 0, 0 }, { -0.5 * s * ks[i], 0, 0 } };
+        const double ref = s / M_PI * (ks[i] <= 1.0 ? 2.0 : ks[i] + 1.0 / ks[i]), got = harm_mean(v, x, wt, 10);
+        if (!(fabs(got - ref) <= 1e-12 * ref))
+            fail_msg("k = 1 %+g: %.17g against the exact %.17g (%.3g)", ks[i] - 1.0, got, ref, (got - ref) / ref);
+    }
+    static const double ts[] = { 1e-9, 1e-6, 1e-3 };
+    for (size_t i = 0; i < sizeof ts / sizeof *ts; i++) {
+        const double v[5][3] = { { 0, 0, 0 }, { 0, 0, 0 }, { s, 0, 0 }, { 0, 0, 0 }, { -0.5 * s, ts[i] * s, 0 } };
+        const double ref = ref_mean(v, 0), got = harm_mean(v, x, wt, 10);
+        if (!(fabs(got - ref) <= 1e-12 * ref))
+            fail_msg("t = %g: %.17g against the adaptive rule's %.17g (%.3g)", ts[i], got, ref, (got - ref) / ref);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(harm_mean_should_match_a_dense_sum_on_even_sections_with_deep_dips),
         cmocka_unit_test(harm_mean_should_find_both_of_two_close_dips_on_odd_sections),
+        cmocka_unit_test(harm_mean_should_take_a_section_whose_element_vanishes_to_third_order),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
