@@ -1300,6 +1300,31 @@ static void area_of_sections_that_cusp_should_match_an_independent_value_or_repo
 }
 
 /*
+ * make fuzz's loft from a point-like section to a circle: the face u = 1 (harm.c, one harmonic) has a
+ * section whose element x_v x x_w is s sin theta (1 - cos theta) e_x, vanishing to third order at
+ * theta = 0, where the search for the element's least values (minima) halved every interval near the
+ * zero at every depth (2^40 of them): the properties never ended. The area against tests/support.c's
+ * ref_props.
+ */
+static void a_loft_whose_section_cusps_to_third_order_should_end_with_its_area(void **state)
+{
+    (void)state;
+    pde_solution *sol = solve_text("{\"loft\":{\"pde\":{\"a\":[1,1,1],\"b\":[1,1,1],\"c\":[2,2,2]},\"sections\":["
+                                   "{\"w\":0,\"profile\":[[0,0,8],[0,0,0],[0,0,0]]},{\"w\":1,\"profile\":[[0,2,0],"
+                                   "[0,0,0],[0,0,0]]}]}}");
+    pde_props p;
+    ref_props_out r;
+    assert_int_equal(pde_properties(sol, NULL, &p), PDE_OK);
+    assert_int_equal(ref_props(sol, &r), 0);
+    assert_true(r.converged);
+    const double miss = fabs(p.surface_area - r.surface_area) / r.surface_area;
+    print_message("surface_area %.15g, reference %.15g: %.3g off, %.3g reported\n", p.surface_area, r.surface_area,
+                  miss, p.surface_area_error);
+    assert_true(miss <= 1e-9 && miss <= p.surface_area_error);
+    pde_solution_free(sol);
+}
+
+/*
  * The loft's root-split rows (fold_direct) on x = u (X1(w) cos 4 pi v + X2(w) sin 8 pi v) + C(w), y = u
  * Y(w) sin 4 pi v, z = Z(w) with Z'(0) < 0 < Z'(1): |det J| = u |Z'(w)| |Q(v, w)| kinks where Z' changes
  * sign (w = 0.0966), which no count of Q's roots shows. Its span's two rules agreed across it: 3.4e-11 off
@@ -2741,6 +2766,7 @@ int main(void)
         cmocka_unit_test(a_centre_of_w_alone_should_keep_the_face_path_of_its_twin_without_it),
         cmocka_unit_test(root_split_rows_should_cut_w_where_z_turns_back),
         cmocka_unit_test(area_of_sections_that_cusp_should_match_an_independent_value_or_report_its_miss),
+        cmocka_unit_test(a_loft_whose_section_cusps_to_third_order_should_end_with_its_area),
         cmocka_unit_test(props_beyond_the_work_bound_should_report_an_error_that_covers_what_they_are_off_by),
         cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_every_preset),
         cmocka_unit_test(bounds_should_contain_a_dense_sampling_of_stress_models),
