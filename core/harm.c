@@ -182,19 +182,40 @@ static void elem_fn(void *arg, double th, double *val)
     *val = elem_cs(arg, cos(th), sin(th));
 }
 
+/* q's derivatives 1 to n (at most TAYLOR) at theta into d[1..n]: with C_j = a_j cos j theta + b_j sin j theta and
+ * S_j = b_j cos j theta - a_j sin j theta, the kth is sum_j j^k of S_j, -C_j, -S_j, C_j for k = 1, 2, 3, 4 mod 4 */
+#define TAYLOR 8
+static void dq_all(const trig4 *q, double th, int n, double d[TAYLOR + 1])
+{
+    double cs[8], C[4], S[4];
+    harmonics(th, cs);
+    for (int j = 0; j < 4; j++)
+        C[j] = q->a[j + 1] * cs[j] + q->b[j + 1] * cs[j + 4], S[j] = q->b[j + 1] * cs[j] - q->a[j + 1] * cs[j + 4];
+    double jk[4] = { 1.0, 1.0, 1.0, 1.0 };   /* j^k */
+    for (int k = 1; k <= n; k++) {
+        double s = 0.0;
+        for (int j = 0; j < 4; j++)
+            jk[j] *= j + 1, s += jk[j] * (k % 2 ? S[j] : C[j]);
+        d[k] = k % 4 == 1 || k % 4 == 0 ? s : -s;
+    }
+}
+
+/* q' (returned) and q'' (into *d2) at theta, for q = |x_t x x_w|^2 */
+static double dq(const trig4 *q, double th, double *d2)
+{
+    double d[TAYLOR + 1];
+    dq_all(q, th, 2, d);
+    *d2 = d[2];
+    return d[1];
+}
+
 /* |x_t x x_w|^2's least in [lo, hi] (around a least sample), by Newton on its derivative kept inside
  * the bracket, bisecting where a step leaves it; its second derivative there into *d2. */
 static double least(const trig4 *q, double lo, double hi, double *d2)
 {
     double x = 0.5 * (lo + hi);
     for (int it = 0; it < 60; it++) {
-        double cs[8], d1 = 0.0;
-        harmonics(x, cs);
-        *d2 = 0.0;
-        for (int j = 1; j <= 4; j++) {
-            d1 += j * (q->b[j] * cs[j - 1] - q->a[j] * cs[j + 3]);
-            *d2 -= j * j * (q->a[j] * cs[j - 1] + q->b[j] * cs[j + 3]);
-        }
+        const double d1 = dq(q, x, d2);
         if (d1 < 0.0)
             lo = x;
         else
@@ -207,37 +228,6 @@ static double least(const trig4 *q, double lo, double hi, double *d2)
         x = nx;
     }
     return x;
-}
-
-/* q' (returned) and q'' (into *d2) at theta, for q = |x_t x x_w|^2 */
-static double dq(const trig4 *q, double th, double *d2)
-{
-    double cs[8], d1 = 0.0;
-    harmonics(th, cs);
-    *d2 = 0.0;
-    for (int j = 1; j <= 4; j++) {
-        d1 += j * (q->b[j] * cs[j - 1] - q->a[j] * cs[j + 3]);
-        *d2 -= j * j * (q->a[j] * cs[j - 1] + q->b[j] * cs[j + 3]);
-    }
-    return d1;
-}
-
-/* q's derivatives 1 to TAYLOR at theta into d[1..TAYLOR]: with C_j = a_j cos j theta + b_j sin j theta and
- * S_j = b_j cos j theta - a_j sin j theta, the kth is sum_j j^k of S_j, -C_j, -S_j, C_j for k = 1, 2, 3, 4 mod 4 */
-#define TAYLOR 8
-static void dq_all(const trig4 *q, double th, double d[TAYLOR + 1])
-{
-    double cs[8], C[4], S[4];
-    harmonics(th, cs);
-    for (int j = 0; j < 4; j++)
-        C[j] = q->a[j + 1] * cs[j] + q->b[j + 1] * cs[j + 4], S[j] = q->b[j + 1] * cs[j] - q->a[j + 1] * cs[j + 4];
-    double jk[4] = { 1.0, 1.0, 1.0, 1.0 };   /* j^k */
-    for (int k = 1; k <= TAYLOR; k++) {
-        double s = 0.0;
-        for (int j = 0; j < 4; j++)
-            jk[j] *= j + 1, s += jk[j] * (k % 2 ? S[j] : C[j]);
-        d[k] = k % 4 == 1 || k % 4 == 0 ? s : -s;
-    }
 }
 
 /*
@@ -264,7 +254,7 @@ static int minima(const trig4 *q, double lo, double hi, double d1lo, double d1hi
     double d[TAYLOR + 1], r[2];
     if (--*left < 0)
         return 0;
-    dq_all(q, mid, d);
+    dq_all(q, mid, TAYLOR, d);
     for (int i = 0; i < 2; i++) {   /* the series of q' (i = 0) and q'' (i = 1) about mid, but its first term */
         double hk = 1.0, s = 0.0;
         for (int k = 2 + i; k <= TAYLOR; k++)

@@ -49,8 +49,9 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
               size_t *nodes);
 
 /* The mean over theta of |v[0] + v[1] cos theta + v[2] sin theta + v[3] cos 2 theta + v[4] sin 2 theta|,
- * as harm_face takes it at a point of w (x, wt: its n-point Gauss-Legendre rule on [0, 1]); for the
- * tests. Reentrant. */
+ * as harm_face takes it at a point of w (x, wt: its n-point Gauss-Legendre rule on [0, 1]); NaN where
+ * the search for its least values ran out of work (harm_face then declines the face); for the tests.
+ * Reentrant. */
 double harm_mean(const double v[5][3], const double *x, const double *wt, int n);
 
 #endif
