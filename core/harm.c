@@ -59,10 +59,15 @@
 #define DIP_EPS 1e-7    /* ... is cut at the least place, located to this of the panel, */
 #define W_GRADE 0.1     /* ... and graded towards it, each piece this of the distance left, */
 #define W_LEVELS 2      /* ... in this many pieces and the last */
-#define POLL_NODES 256  /* points of w between polls of the caller's stop() */
+#define POLL_NODES 256  /* points of w between polls of the caller's stop(), */
+#define POLL_THETA 1e5  /* ... or points of theta of one harmonic's cuts (about 2 ms) */
 #define MAX_SPLITS 32   /* cuts at dips of w in a face, at most: a cut inside a graded piece may cut
                          * again (a stiff model's valley of dips cut 30 deep, each deeper) */
 #define MAX_NODES 40000 /* points of w in a face, at most (fig. 2c: 2400), else the panels */
+#define CUT_WORK 4e6    /* a face of one harmonic: the points of theta of its sections' cuts and their
+                         * minima's intervals, at most, else the panels (stiff models 2.8e6, the cusp
+                         * loft of test_props 2.9e6, presets 352; a loft of sections alternating a
+                         * segment along z and along x took 1.2e7, 0.55 s, four times the estimate) */
 #define MANY_WORK 1.5e7 /* a face of many harmonics (below): its points of theta times (harmonics + 1), at
                          * most, else the panels (tower and blade 5.4e6: 1.65e5 points of 32 harmonics; a
                          * loft of 80 harmonics took 2e6 points, 1.6e8, before it gave up) */
@@ -131,17 +136,19 @@ typedef struct {
     double kpi, tol[2];
     double dip, dip_at;        /* the least element over its largest at the points of w since reset, and where */
     size_t nodes, next_poll;
+    double next_poll_work;     /* ... or once H->work reaches this (one harmonic's cuts: 1200 points of theta a section) */
     int splits;                /* cuts at a dip of w left */
     int stopped;               /* o->cancel asked to stop */
     ev_hint roots;             /* even_mean's last roots */
     size_t poll_every, max_nodes;
+    double max_work;           /* H->work at most (MANY_WORK or CUT_WORK), else the panels */
     /* Many harmonics (the section below): */
     int many, nh;              /* the harmonics along t are hj[0..nh - 1] */
     int *hj, *mslot;           /* per mode: (0: D, 1 + 2 h: sin of hj[h], 2 + 2 h: cos) * 3 + c */
     double *cf;                /* per such entry: x's 3 components, then x_w's */
     double *e;                 /* the samples of the element on MT points */
     double big;                /* the largest sample at the w being integrated */
-    double work;               /* points of theta so far */
+    double work;               /* points of theta so far (one harmonic's: of its cuts, and their minima's intervals) */
     int fold;                  /* the element met 0 at a point of theta: a fold's cuspidal edge */
 } harm_ctx;
 
@@ -287,9 +294,10 @@ static double elem_off(const trig4 *q, double cb, double sb, double t)
 
 /* [c + lo, c + d] (offsets of either sign) by the rule, in pieces no wider than PIECE_MAX (a wide
  * dip's: the rest of theta too); one sin and cos a piece, at its start */
-static double span(const harm_opts *o, const trig4 *q, double c, double lo, double d)
+static double span(const harm_opts *o, const trig4 *q, double c, double lo, double d, double *work)
 {
     const int np = (int)ceil(fabs(d - lo) / PIECE_MAX);
+    *work += (double)np * o->n;
     const double len = (d - lo) / np;
     double sum = 0.0;
     for (int p = 0; p < np; p++) {
@@ -309,12 +317,12 @@ static double span(const harm_opts *o, const trig4 *q, double c, double lo, doub
  * singularity lies at least 2 GRADE / (1 - GRADE) of its half-length beyond its end, where the rule's
  * error falls like 5^-2n; the last piece's lies 8 of them away.
  */
-static double toward(const harm_opts *o, const trig4 *q, double far, double c, double scale)
+static double toward(const harm_opts *o, const trig4 *q, double far, double c, double scale, double *work)
 {
     double sum = 0.0, d = far - c;
     for (int k = 0; k <= GRADE_LEVELS; k++, d *= GRADE) {
         const int last = k == GRADE_LEVELS || !(fabs(d) > fmax(0.25 * scale, 1e-7));
-        sum += span(o, q, c, last ? 0.0 : GRADE * d, d);
+        sum += span(o, q, c, last ? 0.0 : GRADE * d, d, work);
         if (last)
             break;
     }
@@ -330,15 +338,16 @@ static double toward(const harm_opts *o, const trig4 *q, double far, double c, d
  * only to asinh(|d| / scale), where the graded pieces took log(4 |d| / scale) / log(1 / GRADE) of
  * them. One exp a point.
  */
-static double toward_sinh(const harm_opts *o, const trig4 *q, double far, double c, double scale)
+static double toward_sinh(const harm_opts *o, const trig4 *q, double far, double c, double scale, double *work)
 {
     double d = far - c, sum = 0.0;
     for (int k = 0; k < U_LEVELS && fabs(d) > U_NEAR * scale; k++, d *= GRADE)
-        sum += span(o, q, c, GRADE * d, d);
+        sum += span(o, q, c, GRADE * d, d, work);
     if (fabs(d) > PIECE_MAX)
-        return sum + toward(o, q, c + d, c, scale);
+        return sum + toward(o, q, c + d, c, scale, work);
     const double sg = d < 0.0 ? -1.0 : 1.0, U = asinh(fabs(d) / scale), cb = cos(c), sb = sin(c);
     const int np = (int)ceil(U / U_WIDTH);
+    *work += (double)np * o->n;
     double in = 0.0;
     for (int p = 0; p < np; p++) {
         const double lo = U * p / np, hi = U * (p + 1) / np;
@@ -687,7 +696,7 @@ static void samples(const trig4 *q, double *e, int from, int step, int per, doub
     *sum = sm, *lo = l, *big = bg;
 }
 
-static double elem_mean(const harm_opts *o, const trig4 *q, ev_hint *hint, double *dip)
+static double elem_mean(const harm_opts *o, const trig4 *q, ev_hint *hint, double *dip, double *work)
 {
     double ev = 0.0;
     const int per = q->odd ? NT : NT / 2;
@@ -744,6 +753,7 @@ static double elem_mean(const harm_opts *o, const trig4 *q, ev_hint *hint, doubl
     for (int p = 0; p < 16; p++)
         if (!minima(q, period * p / 16, period * (p + 1) / 16, d1[p], d1[p + 1], L, 0, cut, &ncut, &left))
             return NAN;   /* harm_face then declines the face (at_w's NaN): the general path's panels */
+    *work += CRIT_WORK - left;
     for (int j = 0; j < ncut; j++) {
         double m;
         dq(q, cut[j], &d2);
@@ -757,8 +767,8 @@ static double elem_mean(const harm_opts *o, const trig4 *q, ev_hint *hint, doubl
         const int k = (j + 1) % ncut;
         const double a = cut[j], b = j + 1 < ncut ? cut[j + 1] : cut[0] + period, mid = 0.5 * (a + b);
         if (b > a)
-            total += (scale[j] > 0.0 ? toward_sinh : toward)(o, q, mid, a, scale[j]) +
-                     (scale[k] > 0.0 ? toward_sinh : toward)(o, q, mid, b, scale[k]);
+            total += (scale[j] > 0.0 ? toward_sinh : toward)(o, q, mid, a, scale[j], work) +
+                     (scale[k] > 0.0 ? toward_sinh : toward)(o, q, mid, b, scale[k], work);
     }
     return total / period;
 }
@@ -819,11 +829,11 @@ double harm_mean(const double v[5][3], const double *x, const double *wt, int n)
 {
     const harm_opts o = { .x = x, .wt = wt, .n = n };
     trig4 q;
-    double dip;
+    double dip, work = 0.0;
     memcpy(q.v, v, sizeof q.v);
     square(&q);
     pthread_once(&trig_once, trig_init);
-    return elem_mean(&o, &q, NULL, &dip);
+    return elem_mean(&o, &q, NULL, &dip, &work);
 }
 
 /* At w: val[0] the element's mean over theta, val[1] the flux's; the least of the element over its
@@ -836,7 +846,7 @@ static void at_w(void *arg, double w, double *val)
     trig4 q;
     double dip;
     val[1] = section(H, w, &q);
-    val[0] = elem_mean(H->o, &q, &H->roots, &dip);
+    val[0] = elem_mean(H->o, &q, &H->roots, &dip, &H->work);
     if (dip < H->dip)
         H->dip = dip, H->dip_at = w;
 }
@@ -1135,11 +1145,11 @@ static int outer(harm_ctx *H, double a, double b, const wpanel *coarse, int dept
     const double m = 0.5 * (a + b);
     double K[2], kv[11][2];
     wpanel l, r;
-    if (H->nodes >= H->next_poll) {   /* a dip's points of w may take a few ms */
-        H->next_poll = H->nodes + H->poll_every;
+    if (H->nodes >= H->next_poll || H->work >= H->next_poll_work) {   /* a dip's points of w may take a few ms */
+        H->next_poll = H->nodes + H->poll_every, H->next_poll_work = H->work + POLL_THETA;
         H->stopped |= pde_stopped(H->o->cancel);
     }
-    if (H->stopped || H->nodes > H->max_nodes || H->work > MANY_WORK || H->fold)
+    if (H->stopped || H->nodes > H->max_nodes || H->work > H->max_work || H->fold)
         return 0;   /* the panels then, which bound their work */
     H->dip = INFINITY;
     if (H->many) {   /* a loft's: its halves (the Kronrod rule moved the tower's area by 1.3e-12) */
@@ -1544,7 +1554,8 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
     double k;
     unsigned char seen[MANY_MAX + 1];
     int over;
-    harm_ctx H = { .o = o, .s = s, .splits = MAX_SPLITS, .poll_every = POLL_NODES, .max_nodes = MAX_NODES };
+    harm_ctx H = { .o = o, .s = s, .splits = MAX_SPLITS, .poll_every = POLL_NODES, .max_nodes = MAX_NODES,
+                   .max_work = CUT_WORK };
     for (int c = 0; c < 3; c++)
         H.nm += s->comp[c].nmodes;
     if (!face_form(s, axis == 1, seen, &k, &over))
@@ -1558,7 +1569,7 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
     H.tab = wtable_new(s);
     int ok = H.wt && H.slot && H.tab && (!H.many || (!over && many_form(s, axis == 1, seen, &H)));
     if (H.many)   /* no cuts of w at dips: least_at's one harmonic */
-        H.splits = 0, H.poll_every = MANY_POLL, H.max_nodes = MANY_NODES;
+        H.splits = 0, H.poll_every = MANY_POLL, H.max_nodes = MANY_NODES, H.max_work = MANY_WORK;
     if (ok) {
         H.h = H.wt + H.nm, H.dh = H.h + H.nm;
         for (int c = 0, m = 0; c < 3; c++)
@@ -1591,7 +1602,7 @@ int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, dou
         rule_w(&H, NULL, o->edge[i], o->edge[i + 1], &coarse);
         ok = outer(&H, o->edge[i], o->edge[i + 1], &coarse, 0, 2, sum);
     }
-    if (H.fold || H.work > MANY_WORK)
+    if (H.fold || H.work > H.max_work)
         ok = 0;
     if (H.stopped)
         ok = -1;

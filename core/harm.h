@@ -41,8 +41,9 @@ typedef struct {
 /*
  * The face (axis, side), axis 0 or 1 (or 2: a cap of many harmonics), when it has that form: returns 1 with its area in *area, the
  * integral of x . (x_a x x_b) over it in *flux (a, b its parameters in axis order) and the points of w
- * evaluated added to *nodes; 0, nothing set, where the face is not of that form, memory ran out, or
- * the integration did not converge within its depth (the general path then); -1 where o->cancel
+ * evaluated added to *nodes; 0, nothing set, where the face is not of that form, memory ran out,
+ * the integration did not converge within its depth, or it ran past its work (points of w, or of
+ * theta: harm.c's MAX_NODES, CUT_WORK, MANY_WORK; the general path then); -1 where o->cancel
  * stopped it. Reentrant.
  */
 int harm_face(const pde_solution *s, int axis, int side, const harm_opts *o, double *area, double *flux,
