@@ -34,6 +34,7 @@
  * took 2.4k boxes a coordinate, 5k for det J's maximum and 10.7k to certify its minimum, 0 (D1 > 0);
  * the blade 150 to 1000. */
 #define RADIAL_BOXES 16000
+#define JZERO 1e-10            /* det J's largest sample below this of its terms' magnitude: 0 but for rounding */
 #define RADIAL_JSIGN 1e-5      /* of det J's tolerance (1e-9 of its scale): below the sign's 1e-13 */
 
 /*
@@ -1618,7 +1619,12 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
      * first cost more than it saved: the boxes' centres converge on the extreme as fast). */
     double jlow[2], jat[2][3];   /* det J's certified lower bounds of +det J, -det J, without the pad */
     int single[3] = { 0, 0, 0 };   /* components of one mode: both extremes from single_mode_extremes */
-    const size_t jbudget = sp.axis < 0 && radial_detj_axis(s) >= 0 ? RADIAL_BOXES : pde_properties_detj_boxes(s);
+    /* A loft's det J takes RADIAL_BOXES a sign; but where it is at rounding at every sample (every section a
+     * segment: the solid a surface, det J 0 but for rounding), no tolerance of its scale can be met and
+     * the search took them all: the general budget then, its gap reported. */
+    const double jmag = obj_magnitude(s, OBJ_DETJ);
+    const int jzero = !(fmax(fabs(e.jmin), fabs(e.jmax)) > JZERO * jmag);
+    const size_t jbudget = sp.axis < 0 && radial_detj_axis(s) >= 0 && !jzero ? RADIAL_BOXES : pde_properties_detj_boxes(s);
     int ra;
     double rn;
     bb_result sb[3][2];
