@@ -1622,9 +1622,9 @@ pde_status pde_properties(const pde_solution *s, const pde_props_opts *opts, pde
     /* A loft's det J takes RADIAL_BOXES a sign; but where it is at rounding at every sample (every section a
      * segment: the solid a surface, det J 0 but for rounding), no tolerance of its scale can be met and
      * the search took them all: the general budget then, its gap reported. */
-    const double jmag = obj_magnitude(s, OBJ_DETJ);
-    const int jzero = !(fmax(fabs(e.jmin), fabs(e.jmax)) > JZERO * jmag);
-    const size_t jbudget = sp.axis < 0 && radial_detj_axis(s) >= 0 && !jzero ? RADIAL_BOXES : pde_properties_detj_boxes(s);
+    const int radial = sp.axis < 0 && radial_detj_axis(s) >= 0;
+    const int jzero = radial && !(fmax(fabs(e.jmin), fabs(e.jmax)) > JZERO * obj_magnitude(s, OBJ_DETJ));
+    const size_t jbudget = radial && !jzero ? RADIAL_BOXES : pde_properties_detj_boxes(s);
     int ra;
     double rn;
     bb_result sb[3][2];
